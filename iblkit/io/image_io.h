@@ -1,0 +1,42 @@
+// Reading and writing images through OpenImageIO: .exr, .hdr (RGBE), .pfm, .tif, .png/.jpg
+// (8-bit sRGB, decoded to linear on read and encoded on write). Every failure throws ibl::Error
+// naming the file.
+#pragma once
+#include <string>
+
+#include "iblkit/core/image.h"
+
+namespace ibl::io {
+
+struct ReadDesc {
+  // Replace NaN/Inf by 0 and negative values by 0 instead of rejecting the image.
+  bool sanitize = false;
+  // Keep at most this many channels (e.g. 3 drops alpha); 0 keeps all.
+  int max_channels = 0;
+};
+
+struct ReadReport {
+  int sanitized = 0;         // values replaced because of `sanitize`
+  bool srgb_decoded = false;  // 8-bit sRGB input decoded to linear
+  std::string format;         // OpenImageIO format name ("openexr", "hdr", …)
+};
+
+Image read_image(const std::string& path, const ReadDesc& desc = {}, ReadReport* report = nullptr);
+
+// Checks for NaN/Inf/negative values; throws ibl::Error with the first bad pixel's position,
+// or with `sanitize` replaces them by 0 and returns how many were replaced.
+int check_pixels(Image& img, const std::string& what, bool sanitize);
+
+struct WriteDesc {
+  bool half = false;  // .exr: 16-bit half floats instead of 32-bit
+};
+
+// Writes img; the format follows the extension. .png/.jpg get sRGB-encoded 8 bits, clamped to [0,1]
+// (use io/tonemap.h first for HDR content). Creates no folders.
+void write_image(const std::string& path, const Image& img, const WriteDesc& desc = {});
+
+// sRGB transfer function (IEC 61966-2-1).
+float srgb_to_linear(float v);
+float linear_to_srgb(float v);
+
+}  // namespace ibl::io

@@ -1,0 +1,55 @@
+#include "iblkit/io/tonemap.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "iblkit/core/parallel.h"
+
+namespace ibl::io {
+
+double auto_exposure_scale(const Image& img, double key) {
+  std::vector<float> lum;
+  lum.reserve(img.pixel_count());
+  for (int y = 0; y < img.height(); ++y)
+    for (int x = 0; x < img.width(); ++x) {
+      float l = static_cast<float>(luminance(img.rgb(x, y)));
+      if (l > 0) lum.push_back(l);
+    }
+  if (lum.empty()) return 1.0;
+  auto mid = lum.begin() + static_cast<ptrdiff_t>(lum.size() / 2);
+  std::nth_element(lum.begin(), mid, lum.end());
+  return *mid > 0 ? key / *mid : 1.0;
+}
+
+namespace {
+// Narkowicz 2015, "ACES Filmic Tone Mapping Curve": a fit of the ACES RRT+ODT.
+inline double aces(double x) {
+  constexpr double a = 2.51, b = 0.03, c = 2.43, d = 0.59, e = 0.14;
+  return std::clamp((x * (a * x + b)) / (x * (c * x + d) + e), 0.0, 1.0);
+}
+}  // namespace
+
+Image tonemap(const Image& img, const ToneMapDesc& desc) {
+  double scale = (desc.auto_exposure ? auto_exposure_scale(img, desc.key) : 1.0) * std::exp2(desc.exposure_stops);
+  Image out(img.width(), img.height(), 3);
+  parallel_for(0, img.height(), [&](int64_t y) {
+    for (int x = 0; x < img.width(); ++x) {
+      Vec3 c = img.rgb(x, static_cast<int>(y)) * scale;
+      switch (desc.curve) {
+        case ToneCurve::Clamp: break;
+        case ToneCurve::Reinhard: {
+          // Reinhard et al. 2002 on luminance, so hues are kept.
+          double l = luminance(c);
+          if (l > 0) c = c * (1.0 / (1.0 + l));
+          break;
+        }
+        case ToneCurve::Aces: c = {aces(c.x), aces(c.y), aces(c.z)}; break;
+      }
+      out.set_rgb(x, static_cast<int>(y), {std::clamp(c.x, 0.0, 1.0), std::clamp(c.y, 0.0, 1.0), std::clamp(c.z, 0.0, 1.0)});
+    }
+  });
+  return out;
+}
+
+}  // namespace ibl::io
