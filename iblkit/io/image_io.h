@@ -24,7 +24,8 @@ struct ReadReport {
 Image read_image(const std::string& path, const ReadDesc& desc = {}, ReadReport* report = nullptr);
 
 // Checks for NaN/Inf/negative values; throws ibl::Error with the first bad pixel's position,
-// or with `sanitize` replaces them by 0 and returns how many were replaced.
+// or with `sanitize` replaces them by 0 and returns how many were replaced. Negative values
+// within 5% of the mean |value| are compression noise and become 0 without complaint.
 int check_pixels(Image& img, const std::string& what, bool sanitize);
 
 struct WriteDesc {

@@ -1,0 +1,165 @@
+#include "cli.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <mutex>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "iblkit/core/error.h"
+
+namespace iblcli {
+
+namespace fs = std::filesystem;
+
+Globals& globals() {
+  static Globals g;
+  return g;
+}
+
+std::vector<CommandEntry>& command_registry() {
+  static std::vector<CommandEntry> r;
+  return r;
+}
+Command::Command(std::string name, std::string description, Setup setup, int order) {
+  command_registry().push_back({std::move(name), std::move(description), std::move(setup), order});
+}
+
+std::vector<DemoEntry>& demo_registry() {
+  static std::vector<DemoEntry> r;
+  return r;
+}
+DemoStep::DemoStep(std::string name, int order, Fn fn) {
+  demo_registry().push_back({std::move(name), order, std::move(fn)});
+}
+
+namespace {
+struct Bar {
+  std::mutex mu;
+  std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
+  std::chrono::steady_clock::time_point last{};
+  std::string stage;
+  bool drawn = false;
+};
+Bar& bar() {
+  static Bar b;
+  return b;
+}
+}  // namespace
+
+ibl::ProgressFn progress_bar() {
+  if (globals().quiet || !isatty(STDERR_FILENO)) return {};
+  bar().start = std::chrono::steady_clock::now();
+  return [](std::string_view stage, double f) {
+    Bar& b = bar();
+    std::lock_guard<std::mutex> lock(b.mu);
+    auto now = std::chrono::steady_clock::now();
+    // Only for work longer than a second, and at most 20 redraws a second.
+    if (now - b.start < std::chrono::seconds(1)) return;
+    if (stage == b.stage && now - b.last < std::chrono::milliseconds(50) && f < 1.0) return;
+    b.last = now;
+    b.stage = std::string(stage);
+    int width = 30, filled = static_cast<int>(std::clamp(f, 0.0, 1.0) * width);
+    std::fprintf(stderr, "\r%-24.24s [%s%s] %3d%%", std::string(stage).c_str(), std::string(filled, '#').c_str(),
+                 std::string(width - filled, ' ').c_str(), static_cast<int>(f * 100));
+    std::fflush(stderr);
+    b.drawn = true;
+  };
+}
+
+void progress_done() {
+  Bar& b = bar();
+  std::lock_guard<std::mutex> lock(b.mu);
+  if (b.drawn) std::fprintf(stderr, "\r%-70s\r", "");
+  b.drawn = false;
+  b.stage.clear();
+}
+
+void emit(const nlohmann::json& j, const std::function<void()>& table) {
+  if (globals().json) {
+    std::printf("%s\n", j.dump(2).c_str());
+  } else {
+    table();
+  }
+}
+
+void info(const std::string& msg) {
+  if (!globals().quiet) std::fprintf(stderr, "%s\n", msg.c_str());
+}
+
+ibl::Vec3 parse_vec3(const std::string& s, const std::string& what) {
+  ibl::Vec3 v;
+  std::stringstream ss(s);
+  std::string part;
+  int i = 0;
+  while (std::getline(ss, part, ',')) {
+    if (i >= 3) break;
+    try {
+      size_t used = 0;
+      v[i] = std::stod(part, &used);
+      if (used != part.size()) throw std::invalid_argument("trailing");
+    } catch (const std::exception&) {
+      ibl::fail(ibl::ErrorKind::Value, "{} '{}': expected three numbers x,y,z", what, s);
+    }
+    ++i;
+  }
+  if (i != 3 || std::getline(ss, part, ','))
+    ibl::fail(ibl::ErrorKind::Value, "{} '{}': expected three numbers x,y,z", what, s);
+  return v;
+}
+
+std::vector<int> parse_int_list(const std::string& s, const std::string& what) {
+  std::vector<int> out;
+  std::stringstream ss(s);
+  std::string part;
+  while (std::getline(ss, part, ',')) {
+    try {
+      size_t used = 0;
+      out.push_back(std::stoi(part, &used));
+      if (used != part.size()) throw std::invalid_argument("trailing");
+    } catch (const std::exception&) {
+      ibl::fail(ibl::ErrorKind::Value, "{} '{}': expected whole numbers separated by commas", what, s);
+    }
+  }
+  if (out.empty()) ibl::fail(ibl::ErrorKind::Value, "{} is empty", what);
+  return out;
+}
+
+ibl::sphere::MappingKind mapping_from_name(const std::string& name) {
+  auto k = ibl::sphere::parse_mapping_kind(name);
+  if (!k)
+    ibl::fail(ibl::ErrorKind::Value,
+              "unknown mapping '{}': use latlong, mirrorball, angular, hcross, vcross, cubestrip or octahedral", name);
+  return *k;
+}
+
+ibl::io::EnvReadDesc& add_probe_read_options(CLI::App& app) {
+  auto* desc = new ibl::io::EnvReadDesc();  // lives as long as the app (the process)
+  auto* mapping = new std::string();
+  app.add_option("--in-mapping", *mapping,
+                 "mapping of the input (latlong, mirrorball, angular, hcross, vcross, cubestrip, octahedral); "
+                 "default: detected from the image shape and name")
+      ->each([desc](const std::string& s) { desc->mapping = mapping_from_name(s); });
+  app.add_option("--dead-angle", desc->dead_angle_deg, "mirror ball: unusable cone behind the ball, degrees")
+      ->check(CLI::Range(0.0, 89.0));
+  app.add_flag("--sanitize", desc->sanitize, "replace NaN/Inf/negative pixels by 0 (and say how many) instead of failing");
+  return *desc;
+}
+
+std::string default_probe() {
+  const char* candidates[] = {
+      "/usr/share/blender/datafiles/studiolights/world/forest.exr",
+      IBLKIT_SOURCE_DIR "/../shared/probes/ict/grace_latlong_256.hdr",
+  };
+  for (const char* c : candidates)
+    if (fs::exists(c)) return c;
+  ibl::fail(ibl::ErrorKind::Io,
+            "no built-in probe found: install Debian's blender-data (scripts/install-deps) or pass a probe file");
+}
+
+}  // namespace iblcli

@@ -1,0 +1,77 @@
+// Shared pieces of the iblkit command-line tool: subcommand registration, demo steps, output
+// (tables or --json), a progress bar, and argument parsers for vectors and mappings.
+#pragma once
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "iblkit/core/progress.h"
+#include "iblkit/core/vec.h"
+#include "iblkit/io/envmap_io.h"
+
+namespace iblcli {
+
+// Options every subcommand shares.
+struct Globals {
+  bool json = false;   // print machine-readable JSON on stdout instead of tables
+  bool quiet = false;  // no progress bar, no chatter on stderr
+};
+Globals& globals();
+
+// A subcommand registers itself from its own file:
+//   static iblcli::Command reg("sh", "Project a probe onto spherical harmonics", setup_fn);
+// setup_fn adds options to the CLI11 sub-app and sets its callback.
+struct Command {
+  using Setup = std::function<void(CLI::App&)>;
+  Command(std::string name, std::string description, Setup setup, int order = 100);
+};
+struct CommandEntry {
+  std::string name, description;
+  Command::Setup setup;
+  int order;
+};
+std::vector<CommandEntry>& command_registry();
+
+// A step of `iblkit demo`, registered by the module's command file; steps run in `order`.
+struct DemoContext {
+  std::string out_dir;    // folder for pictures and numbers
+  std::string probe;      // the real probe the demo starts from
+  nlohmann::json summary; // numbers each step adds; written to OUT/summary.json
+  std::vector<std::pair<std::string, std::string>> pictures;  // (caption, png path) for the contact sheet
+};
+struct DemoStep {
+  using Fn = std::function<void(DemoContext&)>;
+  DemoStep(std::string name, int order, Fn fn);
+};
+struct DemoEntry {
+  std::string name;
+  int order;
+  DemoStep::Fn fn;
+};
+std::vector<DemoEntry>& demo_registry();
+
+// A progress callback that draws a bar on stderr when it is a terminal and not --quiet.
+ibl::ProgressFn progress_bar();
+// Ends the bar line (call when the work is done).
+void progress_done();
+
+// Prints a result: JSON when --json, else the table callback writes human text.
+void emit(const nlohmann::json& j, const std::function<void()>& table);
+// A line of chatter on stderr (suppressed by --quiet).
+void info(const std::string& msg);
+
+// Parsers for option values.
+ibl::Vec3 parse_vec3(const std::string& s, const std::string& what);  // "x,y,z"
+std::vector<int> parse_int_list(const std::string& s, const std::string& what);  // "1,2,4"
+// Adds --mapping, --dead-angle, --sanitize to an app and returns the read settings they fill.
+ibl::io::EnvReadDesc& add_probe_read_options(CLI::App& app);
+// Validates a --mapping string and returns the kind (throws ibl::Error on an unknown name).
+ibl::sphere::MappingKind mapping_from_name(const std::string& name);
+
+// Path of a real probe to use when none is given: blender-data's, else shared/probes.
+std::string default_probe();
+
+}  // namespace iblcli
