@@ -54,6 +54,8 @@ EnvMap read_envmap(const std::string& path, const EnvReadDesc& desc, ReadReport*
     return EnvMap(std::move(cross), m);
   }
   Image img = read_image(path, rd, report);
+  if (img.channels() == 2 || img.channels() > 4)
+    fail(ErrorKind::Value, "{}: {} channels; a probe needs 1 (grey), 3 (RGB) or 4 (RGBA)", path, img.channels());
   return EnvMap::from_image(std::move(img), desc.mapping, fs::path(path).filename().string(), desc.dead_angle_deg);
 }
 

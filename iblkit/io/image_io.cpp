@@ -2,7 +2,9 @@
 
 #include <cmath>
 #include <filesystem>
+#include <cstdio>
 #include <memory>
+#include <vector>
 
 #include <OpenImageIO/imageio.h>
 
@@ -95,10 +97,31 @@ Image read_image(const std::string& path, const ReadDesc& desc, ReadReport* repo
   return img;
 }
 
+namespace {
+// Portable float map: Debian's OpenImageIO 2.4 reads PFM but has no writer for it. Little-endian
+// (scale −1), rows bottom to top, 1 or 3 channels.
+void write_pfm(const std::string& path, const Image& img) {
+  int nc = img.channels() >= 3 ? 3 : 1;
+  std::FILE* f = std::fopen(path.c_str(), "wb");
+  if (!f) fail(ErrorKind::Io, "{}: cannot write", path);
+  std::fprintf(f, "%s\n%d %d\n-1.0\n", nc == 3 ? "PF" : "Pf", img.width(), img.height());
+  std::vector<float> row(static_cast<size_t>(img.width()) * nc);
+  bool ok = true;
+  for (int y = img.height() - 1; y >= 0; --y) {
+    for (int x = 0; x < img.width(); ++x)
+      for (int c = 0; c < nc; ++c) row[static_cast<size_t>(x) * nc + c] = img.at(x, y, c);
+    ok = ok && std::fwrite(row.data(), sizeof(float), row.size(), f) == row.size();
+  }
+  ok = (std::fclose(f) == 0) && ok;
+  if (!ok) fail(ErrorKind::Io, "{}: write failed", path);
+}
+}  // namespace
+
 void write_image(const std::string& path, const Image& img, const WriteDesc& desc) {
   if (img.empty()) fail(ErrorKind::Value, "{}: refusing to write an empty image", path);
   std::string ext = fs::path(path).extension().string();
   for (auto& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+  if (ext == ".pfm") return write_pfm(path, img);
   auto out = OIIO::ImageOutput::create(path);
   if (!out) fail(ErrorKind::Format, "{}: no image writer for extension '{}' ({})", path, ext, OIIO::geterror());
   bool ldr = ext == ".png" || ext == ".jpg" || ext == ".jpeg";

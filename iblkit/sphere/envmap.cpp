@@ -1,8 +1,10 @@
 #include "iblkit/sphere/envmap.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "iblkit/core/error.h"
+#include "iblkit/core/fastmath.h"
 #include "iblkit/core/parallel.h"
 
 namespace ibl::sphere {
@@ -75,47 +77,110 @@ Image solid_angle_image(const Mapping& m) {
   return out;
 }
 
+namespace {
+
+// Bilinear lookup in a lat-long image for a batch of directions, in float: the (u,v) of every
+// direction first, in a loop that vectorises (fast_atan2), then the gathers. The hot path of
+// most conversions.
+void latlong_lookup_batch(const Image& img, const float* dx, const float* dy, const float* dz, int count,
+                          float* u_buf, float* v_buf, float* out) {
+  constexpr float kInv2Pi = 0.159154943091895f, kInvPi = 0.318309886183791f;
+  const float fw = static_cast<float>(img.width()), fh = static_cast<float>(img.height());
+  for (int k = 0; k < count; ++k) {
+    float x = dx[k], y = dy[k], z = dz[k];
+    u_buf[k] = (fast_atan2(z, x) * kInv2Pi + 0.5f) * fw - 0.5f;
+    v_buf[k] = fast_atan2(std::sqrt(x * x + z * z), y) * kInvPi * fh - 0.5f;
+  }
+  const int w = img.width(), h = img.height(), nc = img.channels();
+  for (int k = 0; k < count; ++k) {
+    float px = u_buf[k], py = v_buf[k];
+    float x0f = std::floor(px), y0f = std::floor(py);
+    float tx = px - x0f, ty = py - y0f;
+    int x0 = static_cast<int>(x0f), y0 = static_cast<int>(y0f);
+    int xa = x0 < 0 ? x0 + w : (x0 >= w ? x0 - w : x0);
+    int xb = x0 + 1 >= w ? x0 + 1 - w : x0 + 1;
+    int ya = std::clamp(y0, 0, h - 1), yb = std::clamp(y0 + 1, 0, h - 1);
+    const float* p00 = img.pixel(xa, ya);
+    const float* p10 = img.pixel(xb, ya);
+    const float* p01 = img.pixel(xa, yb);
+    const float* p11 = img.pixel(xb, yb);
+    float w00 = (1 - tx) * (1 - ty), w10 = tx * (1 - ty), w01 = (1 - tx) * ty, w11 = tx * ty;
+    float* o = out + static_cast<size_t>(k) * nc;
+    for (int c = 0; c < nc; ++c) o[c] = w00 * p00[c] + w10 * p10[c] + w01 * p01[c] + w11 * p11[c];
+  }
+}
+
+// Sub-samples along one output-pixel axis whose step moves `extent` input pixels. Point samples of
+// the bilinear tent at a non-integer spacing h miss or double-count part of an isolated bright
+// pixel's power (up to 12% at h = 0.75, none at h = 1/k), so samples stay no further apart than
+// about kSpacing input pixels. Measured on blender-data's night.exr, whose single 7000-nit lamp
+// pixel holds much of its power: this keeps round trips through every mapping within 0.5%.
+int supersampling(double extent, int max_n) {
+  constexpr double kSpacing = 0.6;
+  return std::clamp(static_cast<int>(std::ceil(extent / kSpacing - 0.25)), 1, max_n);
+}
+
+// Distance in input pixels between two input positions, across the lat-long seam if shorter.
+double pixel_distance(const Mapping& m, double ax, double ay, double bx, double by) {
+  double dx = std::abs(ax - bx), dy = std::abs(ay - by);
+  if (m.kind() == MappingKind::LatLong) dx = std::min(dx, m.width() - dx);
+  return std::sqrt(dx * dx + dy * dy);
+}
+
+}  // namespace
+
 Image resample(const EnvMap& src, const Mapping& dst, const ResampleDesc& desc) {
   int nc = src.image.channels();
   Image out(dst.width(), dst.height(), nc);
-  // Mean input pixel solid angle (discs fill π/4 of their square).
-  double src_pixels = static_cast<double>(src.mapping.width()) * src.mapping.height();
-  switch (src.mapping.kind()) {
-    case MappingKind::MirrorBall:
-    case MappingKind::Angular: src_pixels *= kPi / 4; break;
-    case MappingKind::CubeHCross: src_pixels *= 0.5; break;
-    case MappingKind::CubeVCross: src_pixels *= 0.5; break;
-    default: break;
-  }
-  double src_omega = kFourPi / src_pixels;
   bool rotate = false;
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) rotate |= std::abs(desc.rotation.m[i][j] - (i == j ? 1.0 : 0.0)) > 0;
   Mat3 inv = desc.rotation.transposed();
+  bool fast = src.mapping.kind() == MappingKind::LatLong;
   parallel_for(0, dst.height(), [&](int64_t yy) {
     int y = static_cast<int>(yy);
-    std::vector<float> acc(nc), tmp(nc);
+    // Pass 1: the row's sub-sample directions; pass 2: look them all up; pass 3: average.
+    std::vector<float> dx, dy, dz;
+    std::vector<int> owner;
     for (int x = 0; x < dst.width(); ++x) {
-      float* o = out.pixel(x, y);
-      double omega = dst.solid_angle(x, y);
-      if (omega <= 0) continue;
-      // Sub-samples per axis: one while the output pixel is at most ~1.5 input pixels (the bilinear
-      // tent already spans that), then one more per input pixel across.
-      int n = std::clamp(static_cast<int>(std::ceil(std::sqrt(omega / src_omega) - 0.25)), 1,
-                         desc.max_supersampling);
-      std::fill(acc.begin(), acc.end(), 0.0f);
-      int count = 0;
-      for (int j = 0; j < n; ++j)
-        for (int i = 0; i < n; ++i) {
+      // The output pixel's footprint in the input: where its centre and its two neighbours land.
+      Vec3 c, cx, cy;
+      if (!dst.to_direction(x + 0.5, y + 0.5, &c)) continue;
+      bool okx = dst.to_direction(x + 1.5, y + 0.5, &cx) || dst.to_direction(x - 0.5, y + 0.5, &cx);
+      bool oky = dst.to_direction(x + 0.5, y + 1.5, &cy) || dst.to_direction(x + 0.5, y - 0.5, &cy);
+      if (rotate) { c = inv * c; cx = inv * cx; cy = inv * cy; }
+      double p0x, p0y, p1x, p1y, p2x, p2y;
+      src.mapping.to_pixel(c, &p0x, &p0y);
+      src.mapping.to_pixel(cx, &p1x, &p1y);
+      src.mapping.to_pixel(cy, &p2x, &p2y);
+      int nx = okx ? supersampling(pixel_distance(src.mapping, p0x, p0y, p1x, p1y), desc.max_supersampling) : 1;
+      int ny = oky ? supersampling(pixel_distance(src.mapping, p0x, p0y, p2x, p2y), desc.max_supersampling) : 1;
+      for (int j = 0; j < ny; ++j)
+        for (int i = 0; i < nx; ++i) {
           Vec3 d;
-          if (!dst.to_direction(x + (i + 0.5) / n, y + (j + 0.5) / n, &d)) continue;
+          if (!dst.to_direction(x + (i + 0.5) / nx, y + (j + 0.5) / ny, &d)) continue;
           if (rotate) d = inv * d;
-          src.sample(d, tmp.data());
-          for (int c = 0; c < nc; ++c) acc[c] += tmp[c];
-          ++count;
+          dx.push_back(static_cast<float>(d.x));
+          dy.push_back(static_cast<float>(d.y));
+          dz.push_back(static_cast<float>(d.z));
+          owner.push_back(x);
         }
-      if (count == 0) continue;
-      for (int c = 0; c < nc; ++c) o[c] = acc[c] / count;
+    }
+    int count = static_cast<int>(dx.size());
+    std::vector<float> vals(static_cast<size_t>(count) * nc), ub(count), vb(count);
+    if (fast) {
+      latlong_lookup_batch(src.image, dx.data(), dy.data(), dz.data(), count, ub.data(), vb.data(), vals.data());
+    } else {
+      for (int k = 0; k < count; ++k) src.sample({dx[k], dy[k], dz[k]}, vals.data() + static_cast<size_t>(k) * nc);
+    }
+    std::vector<float> acc(nc);
+    for (int k = 0; k < count;) {
+      int x = owner[k], m = 0;
+      std::fill(acc.begin(), acc.end(), 0.0f);
+      for (; k < count && owner[k] == x; ++k, ++m)
+        for (int c = 0; c < nc; ++c) acc[c] += vals[static_cast<size_t>(k) * nc + c];
+      float* o = out.pixel(x, y);
+      for (int c = 0; c < nc; ++c) o[c] = acc[c] / m;
     }
   });
   return out;

@@ -382,6 +382,29 @@ double Mapping::octahedral_solid_angle(int x, int y) const {
   return total;
 }
 
+double Mapping::solid_angle_estimate(int x, int y) const {
+  switch (kind_) {
+    case MappingKind::LatLong: return solid_angle(x, y);  // already cheap: two cosines
+    case MappingKind::MirrorBall:
+    case MappingKind::Angular: {
+      double a = 2.0 * (x + 0.5) / width_ - 1, b = 1 - 2.0 * (y + 0.5) / height_;
+      double r = std::sqrt(a * a + b * b), area = 4.0 / (static_cast<double>(width_) * height_);
+      if (r > 1) return 0.0;
+      if (kind_ == MappingKind::MirrorBall) return 4.0 * area;
+      return area * (r < 1e-12 ? kPi * kPi : kPi * std::sin(kPi * r) / r);
+    }
+    case MappingKind::Octahedral: return solid_angle(x, y);
+    default: {
+      int cx = x / face_, cy = y / face_, face;
+      bool rot;
+      if (!cell_face(cx, cy, &face, &rot)) return 0.0;
+      double s = 2.0 * (x - cx * face_ + 0.5) / face_ - 1, t = 2.0 * (y - cy * face_ + 0.5) / face_ - 1;
+      double q = s * s + t * t + 1;
+      return (4.0 / (static_cast<double>(face_) * face_)) / (q * std::sqrt(q));  // dω = dA / (1+s²+t²)^{3/2}
+    }
+  }
+}
+
 double Mapping::solid_angle(int x, int y) const {
   switch (kind_) {
     case MappingKind::LatLong: {

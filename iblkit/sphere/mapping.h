@@ -58,6 +58,9 @@ class Mapping {
   // Exact solid angle of pixel (x,y), in steradians; 0 where the pixel covers no direction.
   // Σ over all pixels = 4π.
   double solid_angle(int x, int y) const;
+  // Cheap estimate of solid_angle(x, y) (the Jacobian at the pixel centre × pixel area); 0 where
+  // the pixel centre has no direction. For choosing sampling rates, not for integrals.
+  double solid_angle_estimate(int x, int y) const;
   // True where the pixel centre carries data (inside the disc, a used cell, outside the dead angle).
   bool valid(int x, int y) const;
 

@@ -1,0 +1,179 @@
+#include "iblkit/io/image_io.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+
+#include "iblkit/core/error.h"
+#include "iblkit/io/envmap_io.h"
+#include "iblkit/io/tonemap.h"
+
+namespace ibl::io {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path tmpdir() {
+  fs::path d = fs::temp_directory_path() / ("iblkit_io_test_" + std::to_string(::getpid()));
+  fs::create_directories(d);
+  return d;
+}
+
+Image gradient(int w, int h, int c) {
+  Image img(w, h, c);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int k = 0; k < c; ++k) img.at(x, y, k) = 0.01f * x + 0.1f * y + 3.0f * k + 0.5f;
+  return img;
+}
+
+// Expects an ibl::Error of `kind` whose message contains every fragment.
+template <typename F>
+void expect_error(F&& f, ErrorKind kind, std::initializer_list<std::string> fragments) {
+  try {
+    f();
+    FAIL() << "no error thrown";
+  } catch (const Error& e) {
+    EXPECT_EQ(static_cast<int>(e.kind()), static_cast<int>(kind)) << e.what();
+    for (const auto& frag : fragments) EXPECT_NE(std::string(e.what()).find(frag), std::string::npos) << e.what();
+  }
+}
+
+TEST(ImageIo, FloatFormatsRoundTripExactly) {
+  Image img = gradient(13, 7, 3);
+  for (const char* ext : {".exr", ".pfm", ".tif"}) {
+    std::string p = (tmpdir() / (std::string("rt") + ext)).string();
+    write_image(p, img);
+    Image back = read_image(p);
+    ASSERT_EQ(back.width(), 13);
+    ASSERT_EQ(back.height(), 7);
+    ASSERT_EQ(back.channels(), 3);
+    for (size_t i = 0; i < img.size(); ++i) ASSERT_EQ(back.data()[i], img.data()[i]) << ext << " " << i;
+  }
+}
+
+TEST(ImageIo, RgbeAndHalfKeepRelativePrecision) {
+  constexpr double kRgbeRelTol = 1.0 / 128;  // 8-bit mantissa shared exponent: ≤ 2^-8 of the largest channel
+  constexpr double kHalfRelTol = 1.0 / 1024;  // 10-bit mantissa
+  Image img = gradient(16, 8, 3);
+  std::string hdr = (tmpdir() / "rt.hdr").string(), exr = (tmpdir() / "half.exr").string();
+  write_image(hdr, img);
+  write_image(exr, img, {true});
+  Image a = read_image(hdr), b = read_image(exr);
+  for (size_t i = 0; i < img.size(); ++i) {
+    EXPECT_NEAR(a.data()[i], img.data()[i], kRgbeRelTol * img.data()[(i / 3) * 3 + 2]);
+    EXPECT_NEAR(b.data()[i], img.data()[i], kHalfRelTol * img.data()[i]);
+  }
+}
+
+TEST(ImageIo, PngIsSrgbEncodedAndDecoded) {
+  constexpr double kQuantTol = 1.0 / 255 * 2.5;  // one 8-bit step in sRGB, slope ≤ 2.4 near 1 in linear
+  Image img(4, 1, 3);
+  float vals[4] = {0.0f, 0.05f, 0.214f, 1.0f};  // 0.214 linear ≈ 0.5 sRGB
+  for (int x = 0; x < 4; ++x) img.set_rgb(x, 0, {vals[x], vals[x], vals[x]});
+  std::string p = (tmpdir() / "srgb.png").string();
+  write_image(p, img);
+  ReadReport rep;
+  Image back = read_image(p, {}, &rep);
+  EXPECT_TRUE(rep.srgb_decoded);
+  for (int x = 0; x < 4; ++x) EXPECT_NEAR(back.at(x, 0, 0), vals[x], kQuantTol);
+  EXPECT_NEAR(linear_to_srgb(0.214f), 0.5f, 2e-3);
+  EXPECT_NEAR(srgb_to_linear(linear_to_srgb(0.37f)), 0.37f, 1e-6);
+}
+
+TEST(ImageIo, MissingFileNamesTheFile) {
+  expect_error([] { read_image("/nonexistent/probe.exr"); }, ErrorKind::Io, {"/nonexistent/probe.exr", "no such file"});
+  expect_error([] { read_image(tmpdir().string()); }, ErrorKind::Io, {"folder"});
+}
+
+TEST(ImageIo, UnknownFormatIsAFormatError) {
+  std::string p = (tmpdir() / "notes.txt").string();
+  std::ofstream(p) << "this is not an image\n";
+  expect_error([&] { read_image(p); }, ErrorKind::Format, {p});
+}
+
+TEST(ImageIo, TruncatedFileIsAFormatError) {
+  Image img = gradient(64, 64, 3);
+  std::string good = (tmpdir() / "full.hdr").string(), cut = (tmpdir() / "cut.hdr").string();
+  write_image(good, img);
+  auto size = fs::file_size(good);
+  std::ifstream in(good, std::ios::binary);
+  std::string bytes(size / 2, '\0');
+  in.read(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  std::ofstream(cut, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  expect_error([&] { read_image(cut); }, ErrorKind::Format, {cut});
+  // And a corrupt header.
+  std::string junk = (tmpdir() / "junk.exr").string();
+  std::ofstream(junk, std::ios::binary) << "\x76\x2f\x31\x01garbage-after-the-magic-number";
+  expect_error([&] { read_image(junk); }, ErrorKind::Format, {junk});
+}
+
+TEST(ImageIo, BadPixelsAreRejectedWithTheirPositionOrSanitized) {
+  for (float bad : {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity(), -5.0f}) {
+    Image img = gradient(8, 8, 3);
+    img.at(5, 2, 1) = bad;
+    std::string p = (tmpdir() / "bad.exr").string();
+    write_image(p, img);
+    expect_error([&] { read_image(p); }, ErrorKind::Value, {p, "(5, 2)", "channel 1", "--sanitize"});
+    ReadReport rep;
+    Image fixed = read_image(p, {true, 0}, &rep);
+    EXPECT_EQ(rep.sanitized, 1);
+    EXPECT_EQ(fixed.at(5, 2, 1), 0.0f);
+  }
+}
+
+TEST(ImageIo, ProcessingNoiseNegativesBecomeZero) {
+  Image img = gradient(8, 8, 3);
+  img.at(1, 1, 0) = -1e-3f;  // far within 5% of the mean
+  int n = check_pixels(img, "noise", false);
+  EXPECT_EQ(n, 0);
+  EXPECT_EQ(img.at(1, 1, 0), 0.0f);
+}
+
+TEST(ImageIo, BlenderProbesReadAsLatLong) {
+  const std::string dir = "/usr/share/blender/datafiles/studiolights/world/";
+  if (!fs::exists(dir + "forest.exr")) GTEST_SKIP() << "blender-data not installed";
+  auto env = read_envmap(dir + "forest.exr");
+  EXPECT_EQ(env.mapping.kind(), sphere::MappingKind::LatLong);
+  EXPECT_EQ(env.image.width(), 1024);
+  EXPECT_EQ(env.image.height(), 512);
+  auto p = env.integral();
+  EXPECT_GT(p[0], 0.0);
+}
+
+TEST(EnvMapIo, WrongChannelCountIsRejected) {
+  Image two(16, 8, 2, 1.0f);
+  std::string p = (tmpdir() / "two.exr").string();
+  write_image(p, two);
+  expect_error([&] { read_envmap(p); }, ErrorKind::Value, {p, "2 channels"});
+}
+
+TEST(EnvMapIo, CubeFaceFolderRoundTrip) {
+  Image cross = gradient(64, 48, 3);
+  sphere::EnvMap env(cross, sphere::Mapping(sphere::MappingKind::CubeHCross, 64, 48));
+  std::string dir = (tmpdir() / "faces").string();
+  write_cube_faces(dir, env, ".exr");
+  auto back = read_envmap(dir);
+  ASSERT_EQ(back.mapping.kind(), sphere::MappingKind::CubeHCross);
+  for (int y = 0; y < 48; ++y)
+    for (int x = 0; x < 64; ++x)
+      if (env.mapping.solid_angle(x, y) > 0) ASSERT_EQ(back.image.at(x, y, 0), cross.at(x, y, 0)) << x << "," << y;
+  fs::remove(fs::path(dir) / "pz.exr");
+  expect_error([&] { read_envmap(dir); }, ErrorKind::Io, {"pz"});
+}
+
+TEST(ToneMap, AutoExposurePutsMedianOnKey) {
+  Image img(10, 1, 3);
+  for (int x = 0; x < 10; ++x) img.set_rgb(x, 0, Vec3{1, 1, 1} * (x + 1.0));
+  double s = auto_exposure_scale(img, 0.18);
+  EXPECT_NEAR(s * 6.0, 0.18, 1e-6);  // median of 1..10 by nth_element at index 5 is 6
+  Image out = tonemap(img, {});
+  for (int x = 1; x < 10; ++x) EXPECT_GE(out.at(x, 0, 0), out.at(x - 1, 0, 0));  // monotone
+  EXPECT_LE(out.at(9, 0, 0), 1.0f);
+}
+
+}  // namespace
+}  // namespace ibl::io
