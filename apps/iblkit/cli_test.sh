@@ -1,16 +1,55 @@
 #!/usr/bin/env bash
-# End-to-end checks of the CLI as a user meets it (registered with CTest as cli_smoke).
+# End-to-end checks of the CLI as a new user meets it (registered with CTest as cli_smoke):
+# --help everywhere, the main commands on a real probe, and every bad-input class failing with a
+# one-line message and a non-zero exit code, never a crash.
 set -u
 BIN="$1"
-fail=0; pass=0
-check() {  # check NAME EXPECTED_RC CMD...
-  local name="$1" want="$2"; shift 2
+T=$(mktemp -d)
+trap 'rm -rf "$T"' EXIT
+PROBE=/usr/share/blender/datafiles/studiolights/world/forest.exr
+fail=0; pass=0; skip=0
+
+# check NAME EXPECT(ok|fail) [PATTERN] -- CMD...
+check() {
+  local name="$1" want="$2" pat="$3"; shift 4
   local out rc
   out=$("$@" 2>&1); rc=$?
-  if [ "$want" = "0" ] && [ $rc -ne 0 ]; then echo "FAIL $name: exit $rc: $out"; fail=$((fail+1)); return; fi
-  if [ "$want" != "0" ] && [ $rc -eq 0 ]; then echo "FAIL $name: expected failure, got success: $out"; fail=$((fail+1)); return; fi
+  if [ $rc -ge 128 ]; then echo "FAIL $name: crashed (signal $((rc-128))): $out"; fail=$((fail+1)); return; fi
+  if [ "$want" = ok ] && [ $rc -ne 0 ]; then echo "FAIL $name: exit $rc: $out"; fail=$((fail+1)); return; fi
+  if [ "$want" = fail ] && [ $rc -eq 0 ]; then echo "FAIL $name: expected failure, got success: $out"; fail=$((fail+1)); return; fi
+  if [ -n "$pat" ] && ! grep -qE -- "$pat" <<<"$out"; then echo "FAIL $name: output lacks /$pat/: $out"; fail=$((fail+1)); return; fi
+  if [ "$want" = fail ] && [ "$(wc -l <<<"$out")" -gt 3 ]; then echo "FAIL $name: error message is not short: $out"; fail=$((fail+1)); return; fi
   pass=$((pass+1))
 }
-check help 0 "$BIN" --help
-echo "$pass passed, $fail failed"
+
+check help ok "Subcommands" -- "$BIN" --help
+for sub in $("$BIN" --help | awk '/^Subcommands:/{f=1;next} f&&NF{print $1}'); do
+  check "help-$sub" ok "Example" -- "$BIN" "$sub" --help
+done
+check no-subcommand fail "" -- "$BIN"
+check unknown-subcommand fail "" -- "$BIN" frobnicate
+check missing-file fail "nothere.exr: no such file" -- "$BIN" info "$T/nothere.exr"
+printf 'not an image at all\n' > "$T/notes.exr"
+check corrupt-image fail "notes.exr" -- "$BIN" info "$T/notes.exr"
+check folder-not-image fail "folder" -- "$BIN" preview "$T" "$T/x.png"
+
+if [ -f "$PROBE" ]; then
+  check info ok "latlong" -- "$BIN" info "$PROBE"
+  check info-json ok '"mapping": "latlong"' -- "$BIN" --json info "$PROBE"
+  check convert ok "power out/in" -- "$BIN" convert "$PROBE" "$T/cross.exr" --mapping hcross --size 64
+  check convert-back ok "" -- "$BIN" convert "$T/cross.exr" "$T/ll.exr" --mapping latlong --size 64
+  check convert-faces ok "" -- "$BIN" convert "$PROBE" "$T/faces" --mapping cubestrip --size 32 --faces
+  check read-faces ok "hcross" -- "$BIN" info "$T/faces"
+  check bad-mapping fail "unknown mapping 'sphere'" -- "$BIN" convert "$PROBE" "$T/x.exr" --mapping sphere
+  check bad-in-mapping fail "aspect" -- "$BIN" info "$PROBE" --in-mapping mirrorball
+  check bad-size fail "" -- "$BIN" convert "$PROBE" "$T/x.exr" --size 0
+  check bad-extension fail "no image writer" -- "$BIN" convert "$PROBE" "$T/x.xyz" --size 8
+  check preview ok "wrote" -- "$BIN" preview "$PROBE" "$T/p.png"
+  check demo-mappings ok "contact sheet" -- "$BIN" demo --out "$T/demo" --only mappings
+  [ -s "$T/demo/contact_sheet.png" ] && pass=$((pass+1)) || { echo "FAIL demo wrote no contact sheet"; fail=$((fail+1)); }
+else
+  skip=$((skip+1))
+fi
+
+echo "$pass passed, $fail failed, $skip skipped"
 [ $fail -eq 0 ]
