@@ -82,6 +82,8 @@ namespace {
 // Bilinear lookup in a lat-long image for a batch of directions, in float: the (u,v) of every
 // direction first, in a loop that vectorises (fast_atan2), then the gathers. The hot path of
 // most conversions.
+// kNc > 0 fixes the channel count at compile time (the common RGB case); 0 reads it from the image.
+template <int kNc>
 void latlong_lookup_batch(const Image& img, const float* dx, const float* dy, const float* dz, int count,
                           float* u_buf, float* v_buf, float* out) {
   constexpr float kInv2Pi = 0.159154943091895f, kInvPi = 0.318309886183791f;
@@ -91,7 +93,9 @@ void latlong_lookup_batch(const Image& img, const float* dx, const float* dy, co
     u_buf[k] = (fast_atan2(z, x) * kInv2Pi + 0.5f) * fw - 0.5f;
     v_buf[k] = fast_atan2(std::sqrt(x * x + z * z), y) * kInvPi * fh - 0.5f;
   }
-  const int w = img.width(), h = img.height(), nc = img.channels();
+  const int w = img.width(), h = img.height();
+  const int nc = kNc > 0 ? kNc : img.channels();
+  const float* base = img.data();
   for (int k = 0; k < count; ++k) {
     float px = u_buf[k], py = v_buf[k];
     float x0f = std::floor(px), y0f = std::floor(py);
@@ -100,10 +104,10 @@ void latlong_lookup_batch(const Image& img, const float* dx, const float* dy, co
     int xa = x0 < 0 ? x0 + w : (x0 >= w ? x0 - w : x0);
     int xb = x0 + 1 >= w ? x0 + 1 - w : x0 + 1;
     int ya = std::clamp(y0, 0, h - 1), yb = std::clamp(y0 + 1, 0, h - 1);
-    const float* p00 = img.pixel(xa, ya);
-    const float* p10 = img.pixel(xb, ya);
-    const float* p01 = img.pixel(xa, yb);
-    const float* p11 = img.pixel(xb, yb);
+    const float* p00 = base + (static_cast<size_t>(ya) * w + xa) * nc;
+    const float* p10 = base + (static_cast<size_t>(ya) * w + xb) * nc;
+    const float* p01 = base + (static_cast<size_t>(yb) * w + xa) * nc;
+    const float* p11 = base + (static_cast<size_t>(yb) * w + xb) * nc;
     float w00 = (1 - tx) * (1 - ty), w10 = tx * (1 - ty), w01 = (1 - tx) * ty, w11 = tx * ty;
     float* o = out + static_cast<size_t>(k) * nc;
     for (int c = 0; c < nc; ++c) o[c] = w00 * p00[c] + w10 * p10[c] + w01 * p01[c] + w11 * p11[c];
@@ -127,6 +131,14 @@ double pixel_distance(const Mapping& m, double ax, double ay, double bx, double 
   return std::sqrt(dx * dx + dy * dy);
 }
 
+// The face a cube-layout pixel belongs to (the pixel must be inside a used cell).
+int cube_face_at(const Mapping& m, int x, int y) {
+  Vec3 d;
+  m.to_direction(x + 0.5, y + 0.5, &d);
+  double s, t;
+  return cube_face_of(d, &s, &t);
+}
+
 }  // namespace
 
 Image resample(const EnvMap& src, const Mapping& dst, const ResampleDesc& desc) {
@@ -137,24 +149,63 @@ Image resample(const EnvMap& src, const Mapping& dst, const ResampleDesc& desc) 
     for (int j = 0; j < 3; ++j) rotate |= std::abs(desc.rotation.m[i][j] - (i == j ? 1.0 : 0.0)) > 0;
   Mat3 inv = desc.rotation.transposed();
   bool fast = src.mapping.kind() == MappingKind::LatLong;
+  bool cube_dst = dst.kind() == MappingKind::CubeHCross || dst.kind() == MappingKind::CubeVCross ||
+                  dst.kind() == MappingKind::CubeStrip;
   parallel_for(0, dst.height(), [&](int64_t yy) {
     int y = static_cast<int>(yy);
     // Pass 1: the row's sub-sample directions; pass 2: look them all up; pass 3: average.
     std::vector<float> dx, dy, dz;
     std::vector<int> owner;
+    size_t guess = static_cast<size_t>(dst.width()) * 4;
+    dx.reserve(guess); dy.reserve(guess); dz.reserve(guess); owner.reserve(guess);
+    int nx = 1, ny = 1, footprint_at = -1000;
     for (int x = 0; x < dst.width(); ++x) {
-      // The output pixel's footprint in the input: where its centre and its two neighbours land.
-      Vec3 c, cx, cy;
+      Vec3 c;
       if (!dst.to_direction(x + 0.5, y + 0.5, &c)) continue;
-      bool okx = dst.to_direction(x + 1.5, y + 0.5, &cx) || dst.to_direction(x - 0.5, y + 0.5, &cx);
-      bool oky = dst.to_direction(x + 0.5, y + 1.5, &cy) || dst.to_direction(x + 0.5, y - 0.5, &cy);
-      if (rotate) { c = inv * c; cx = inv * cx; cy = inv * cy; }
-      double p0x, p0y, p1x, p1y, p2x, p2y;
-      src.mapping.to_pixel(c, &p0x, &p0y);
-      src.mapping.to_pixel(cx, &p1x, &p1y);
-      src.mapping.to_pixel(cy, &p2x, &p2y);
-      int nx = okx ? supersampling(pixel_distance(src.mapping, p0x, p0y, p1x, p1y), desc.max_supersampling) : 1;
-      int ny = oky ? supersampling(pixel_distance(src.mapping, p0x, p0y, p2x, p2y), desc.max_supersampling) : 1;
+      // The output pixel's footprint in the input: where its centre and its two neighbours land.
+      // It changes slowly, so it is measured every kFootprintStride pixels.
+      constexpr int kFootprintStride = 4;
+      if (x - footprint_at >= kFootprintStride) {
+        footprint_at = x;
+        Vec3 cx, cy;
+        bool okx = dst.to_direction(x + 1.5, y + 0.5, &cx) || dst.to_direction(x - 0.5, y + 0.5, &cx);
+        bool oky = dst.to_direction(x + 0.5, y + 1.5, &cy) || dst.to_direction(x + 0.5, y - 0.5, &cy);
+        Vec3 cc = c;
+        if (rotate) { cc = inv * cc; cx = inv * cx; cy = inv * cy; }
+        double p0x, p0y, p1x, p1y, p2x, p2y;
+        src.mapping.to_pixel(cc, &p0x, &p0y);
+        src.mapping.to_pixel(cx, &p1x, &p1y);
+        src.mapping.to_pixel(cy, &p2x, &p2y);
+        nx = okx ? supersampling(pixel_distance(src.mapping, p0x, p0y, p1x, p1y), desc.max_supersampling) : 1;
+        ny = oky ? supersampling(pixel_distance(src.mapping, p0x, p0y, p2x, p2y), desc.max_supersampling) : 1;
+      }
+      if (cube_dst && !rotate) {
+        // Cube faces: the sub-sample directions straight from the face's (s, t), in float.
+        int face = cube_face_at(dst, x, y);
+        const int F = dst.face_size();
+        const float fx = static_cast<float>(x % F), fy = static_cast<float>(y % F), inv_f = 2.0f / F;
+        const bool rot = dst.kind() == MappingKind::CubeVCross && face == 5;
+        for (int j = 0; j < ny; ++j)
+          for (int i = 0; i < nx; ++i) {
+            float s = (fx + (i + 0.5f) / nx) * inv_f - 1.0f, t = (fy + (j + 0.5f) / ny) * inv_f - 1.0f;
+            if (rot) { s = -s; t = -t; }
+            float px, py, pz;
+            switch (face) {
+              case 0: px = 1; py = -t; pz = -s; break;
+              case 1: px = -1; py = -t; pz = s; break;
+              case 2: px = s; py = 1; pz = t; break;
+              case 3: px = s; py = -1; pz = -t; break;
+              case 4: px = s; py = -t; pz = 1; break;
+              default: px = -s; py = -t; pz = -1; break;
+            }
+            float inv_len = 1.0f / std::sqrt(px * px + py * py + pz * pz);
+            dx.push_back(px * inv_len);
+            dy.push_back(py * inv_len);
+            dz.push_back(pz * inv_len);
+            owner.push_back(x);
+          }
+        continue;
+      }
       for (int j = 0; j < ny; ++j)
         for (int i = 0; i < nx; ++i) {
           Vec3 d;
@@ -169,9 +220,24 @@ Image resample(const EnvMap& src, const Mapping& dst, const ResampleDesc& desc) 
     int count = static_cast<int>(dx.size());
     std::vector<float> vals(static_cast<size_t>(count) * nc), ub(count), vb(count);
     if (fast) {
-      latlong_lookup_batch(src.image, dx.data(), dy.data(), dz.data(), count, ub.data(), vb.data(), vals.data());
+      if (nc == 3) latlong_lookup_batch<3>(src.image, dx.data(), dy.data(), dz.data(), count, ub.data(), vb.data(), vals.data());
+      else latlong_lookup_batch<0>(src.image, dx.data(), dy.data(), dz.data(), count, ub.data(), vb.data(), vals.data());
     } else {
       for (int k = 0; k < count; ++k) src.sample({dx[k], dy[k], dz[k]}, vals.data() + static_cast<size_t>(k) * nc);
+    }
+    if (nc == 3) {
+      for (int k = 0; k < count;) {
+        int x = owner[k], m = 0;
+        float a0 = 0, a1 = 0, a2 = 0;
+        for (; k < count && owner[k] == x; ++k, ++m) {
+          const float* v = vals.data() + static_cast<size_t>(k) * 3;
+          a0 += v[0]; a1 += v[1]; a2 += v[2];
+        }
+        float* o = out.pixel(x, y);
+        float inv_m = 1.0f / m;
+        o[0] = a0 * inv_m; o[1] = a1 * inv_m; o[2] = a2 * inv_m;
+      }
+      return;
     }
     std::vector<float> acc(nc);
     for (int k = 0; k < count;) {
