@@ -1,0 +1,70 @@
+#include "iblkit/geometry/mesh_io.h"
+
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include <assimp/Importer.hpp>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+
+#include "iblkit/core/error.h"
+
+namespace ibl::geometry {
+
+namespace {
+void gather(const aiScene* sc, const aiNode* node, const aiMatrix4x4& parent, TriMesh& out, bool& all_uv) {
+  aiMatrix4x4 m = parent * node->mTransformation;
+  for (unsigned i = 0; i < node->mNumMeshes; ++i) {
+    const aiMesh* am = sc->mMeshes[node->mMeshes[i]];
+    TriMesh part;
+    for (unsigned v = 0; v < am->mNumVertices; ++v) {
+      aiVector3D p = m * am->mVertices[v];
+      part.positions.push_back({p.x, p.y, p.z});
+      if (am->HasTextureCoords(0)) part.uvs.push_back({am->mTextureCoords[0][v].x, am->mTextureCoords[0][v].y});
+    }
+    all_uv = all_uv && am->HasTextureCoords(0);
+    for (unsigned f = 0; f < am->mNumFaces; ++f) {
+      const aiFace& face = am->mFaces[f];
+      if (face.mNumIndices != 3) continue;  // points and lines left by triangulation
+      part.triangles.push_back({face.mIndices[0], face.mIndices[1], face.mIndices[2]});
+    }
+    if (!all_uv) part.uvs.clear();
+    out.append(part);
+  }
+  for (unsigned c = 0; c < node->mNumChildren; ++c) gather(sc, node->mChildren[c], m, out, all_uv);
+}
+}  // namespace
+
+TriMesh read_mesh(const std::string& path) {
+  if (!std::filesystem::exists(path)) fail(ErrorKind::Io, "{}: no such mesh file", path);
+  Assimp::Importer imp;
+  const aiScene* sc = imp.ReadFile(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                                             aiProcess_SortByPType | aiProcess_PreTransformVertices);
+  if (!sc || !sc->mRootNode) fail(ErrorKind::Format, "{}: cannot read mesh ({})", path, imp.GetErrorString());
+  TriMesh out;
+  bool all_uv = true;
+  gather(sc, sc->mRootNode, aiMatrix4x4(), out, all_uv);
+  if (!all_uv) out.uvs.clear();
+  if (out.triangle_count() == 0) fail(ErrorKind::Format, "{}: the mesh has no triangles", path);
+  out.validate(path);
+  return out;
+}
+
+void write_obj(const std::string& path, const TriMesh& mesh, const std::string& comment) {
+  std::unique_ptr<FILE, int (*)(FILE*)> f(std::fopen(path.c_str(), "w"), &std::fclose);
+  if (!f) fail(ErrorKind::Io, "{}: cannot write", path);
+  if (!comment.empty()) std::fprintf(f.get(), "# %s\n", comment.c_str());
+  for (const Vec3& p : mesh.positions) std::fprintf(f.get(), "v %.6g %.6g %.6g\n", p.x, p.y, p.z);
+  bool uv = !mesh.uvs.empty();
+  for (const Vec2& t : mesh.uvs) std::fprintf(f.get(), "vt %.6g %.6g\n", t.x, t.y);
+  for (const auto& t : mesh.triangles) {
+    if (uv)
+      std::fprintf(f.get(), "f %u/%u %u/%u %u/%u\n", t[0] + 1, t[0] + 1, t[1] + 1, t[1] + 1, t[2] + 1, t[2] + 1);
+    else
+      std::fprintf(f.get(), "f %u %u %u\n", t[0] + 1, t[1] + 1, t[2] + 1);
+  }
+  if (std::ferror(f.get())) fail(ErrorKind::Io, "{}: write failed", path);
+}
+
+}  // namespace ibl::geometry

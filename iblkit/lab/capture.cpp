@@ -1,0 +1,90 @@
+#include "iblkit/lab/capture.h"
+
+#include <atomic>
+#include <cmath>
+
+#include "iblkit/core/error.h"
+#include "iblkit/core/parallel.h"
+#include "iblkit/lab/radiance.h"
+
+namespace ibl::lab {
+
+using sphere::MappingKind;
+
+sphere::Mapping capture_mapping(MappingKind k, int size, double dead_angle_deg) {
+  if (size < 1 || size > 16384) fail(ErrorKind::Value, "capture size {} is out of range [1, 16384]", size);
+  switch (k) {
+    case MappingKind::LatLong: return {k, 2 * size, size};
+    case MappingKind::CubeHCross: return {k, 4 * size, 3 * size};
+    case MappingKind::CubeVCross: return {k, 3 * size, 4 * size};
+    case MappingKind::CubeStrip: return {k, 6 * size, size};
+    default: return {k, size, size, dead_angle_deg};
+  }
+}
+
+namespace {
+
+// A ray of the physical mirror-ball camera through image point (px, py): the orthographic ray along
+// −Z reflects off the ball at normal n = (x, y, √(1−x²−y²)) into d = (0,0,−1) + 2 n_z n.
+bool ball_ray(const sphere::Mapping& m, double px, double py, Vec3* n, Vec3* d) {
+  double x = 2 * px / m.width() - 1, y = 1 - 2 * py / m.height(), r2 = x * x + y * y;
+  if (r2 >= 1) return false;
+  *n = {x, y, std::sqrt(1 - r2)};
+  *d = Vec3{0, 0, -1} + *n * (2 * n->z);
+  return true;
+}
+
+}  // namespace
+
+Capture capture_probe(const Scene& scene, Vec3 position, const CaptureDesc& desc, uint64_t probe_index,
+                      const ProgressFn& progress) {
+  if (!scene.built()) fail(ErrorKind::Internal, "capture_probe: scene {} is not built", scene.name);
+  if (desc.samples < 1 || desc.samples > 64) fail(ErrorKind::Value, "samples per pixel axis {} is out of range [1, 64]", desc.samples);
+  bool ball = desc.camera == Camera::MirrorBall;
+  if (ball && desc.mapping != MappingKind::MirrorBall)
+    fail(ErrorKind::Value, "the mirror-ball camera makes mirrorball images, not {}", sphere::mapping_name(desc.mapping));
+  if (ball && !(desc.ball_radius >= 0)) fail(ErrorKind::Value, "ball radius {} must be ≥ 0", desc.ball_radius);
+  Capture cap;
+  cap.mapping = capture_mapping(desc.mapping, desc.size, ball ? 0.0 : desc.dead_angle_deg);
+  const sphere::Mapping& m = cap.mapping;
+  const int W = m.width(), H = m.height(), n = desc.samples;
+  cap.radiance = Image(W, H, 3);
+  if (desc.depth) cap.depth = Image(W, H, 1);
+  std::atomic<int> rows_done{0};
+  parallel_for(0, H, [&](int64_t y) {
+    for (int x = 0; x < W; ++x) {
+      uint64_t pixel = static_cast<uint64_t>(y) * W + x;
+      Vec3 sum;
+      int used = 0;
+      for (int s = 0; s < n * n; ++s) {
+        double px = x + (s % n + 0.5) / n, py = y + (s / n + 0.5) / n;
+        Rng rng(stream_key(desc.render.seed, probe_index, pixel, s));
+        Vec3 d, o = position, nb;
+        if (ball) {
+          ++used;  // sub-samples that miss the ball see nothing (a black backdrop)
+          if (!ball_ray(m, px, py, &nb, &d)) continue;
+          if (desc.ball_parallax) o = position + desc.rotation * nb * desc.ball_radius;
+          sum += radiance(scene, o, desc.rotation * d, rng, desc.render) * desc.ball_reflectance;
+        } else {
+          if (!m.to_direction(px, py, &d)) continue;
+          ++used;
+          sum += radiance(scene, o, desc.rotation * d, rng, desc.render);
+        }
+      }
+      if (used) cap.radiance.set_rgb(x, static_cast<int>(y), sum / used);
+      if (desc.depth) {
+        Vec3 d, o = position, nb;
+        bool ok = ball ? ball_ray(m, x + 0.5, y + 0.5, &nb, &d) : m.to_direction(x + 0.5, y + 0.5, &d);
+        if (ok) {
+          if (ball && desc.ball_parallax) o = position + desc.rotation * nb * desc.ball_radius;
+          double t = first_hit_distance(scene, o, desc.rotation * d);
+          cap.depth.at(x, static_cast<int>(y), 0) = std::isfinite(t) ? static_cast<float>(t) : 0.0f;
+        }
+      }
+    }
+    if (progress) report(progress, "capture", static_cast<double>(++rows_done) / H);
+  });
+  return cap;
+}
+
+}  // namespace ibl::lab

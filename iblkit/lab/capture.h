@@ -1,0 +1,47 @@
+// Synthetic light probes: radiance (and depth) seen from a point, in any sphere mapping, or through
+// a physical mirror-ball camera.
+#pragma once
+#include <cstdint>
+
+#include "iblkit/core/image.h"
+#include "iblkit/core/progress.h"
+#include "iblkit/lab/scene.h"
+#include "iblkit/sphere/mapping.h"
+
+namespace ibl::lab {
+
+enum class Camera {
+  Ideal,        // each pixel looks along the mapping's directions (sphere::Mapping::to_direction)
+  MirrorBall,   // an orthographic camera looking along −Z at a chrome ball (mirrorball mapping only)
+};
+
+struct CaptureDesc {
+  sphere::MappingKind mapping = sphere::MappingKind::LatLong;  // pixel layout
+  int size = 64;                 // lat-long height, cube face edge, or disc/octahedral diameter (pixels)
+  double dead_angle_deg = 0;     // ideal mirror balls: cone around −Z left without data
+  Mat3 rotation;                 // probe frame -> world (the probe's +Z, +Y in the world)
+  int samples = 1;               // n: n×n stratified sub-pixel samples (1: the pixel centre)
+  Camera camera = Camera::Ideal; // how pixels map to rays
+  double ball_radius = 0.04;     // MirrorBall: radius of the chrome ball, metres
+  bool ball_parallax = false;    // MirrorBall: rays leave the ball's surface (non-single viewpoint)
+  double ball_reflectance = 1;   // MirrorBall: mirror reflectance (chrome is ~0.6–0.7)
+  bool depth = false;            // also compute the distance to the first hit at each pixel centre
+  RenderDesc render;             // light estimation settings and seed
+};
+
+struct Capture {
+  Image radiance;                // RGB, W/(sr·m²); 0 where a pixel carries no direction
+  Image depth;                   // one channel, metres; 0 where a pixel carries no direction or the
+                                 // ray leaves the scene (empty unless CaptureDesc::depth)
+  sphere::Mapping mapping{sphere::MappingKind::LatLong, 2, 1};  // the layout of both images
+};
+
+// The mapping of a capture: width × height from `size` (see CaptureDesc::size).
+sphere::Mapping capture_mapping(sphere::MappingKind kind, int size, double dead_angle_deg = 0);
+
+// Captures the probe at `position`. `probe_index` keys the random streams of this probe, so probe
+// k of a sequence is the same whether it is captured alone or with the others.
+Capture capture_probe(const Scene& scene, Vec3 position, const CaptureDesc& desc, uint64_t probe_index = 0,
+                      const ProgressFn& progress = {});
+
+}  // namespace ibl::lab

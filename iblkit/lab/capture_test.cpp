@@ -1,0 +1,241 @@
+// The lab's exact answers: checks listed in issue 4.
+#include <gtest/gtest.h>
+
+#include <cstring>
+
+#include <tbb/task_arena.h>
+
+#include "iblkit/geometry/mesh.h"
+#include "iblkit/lab/capture.h"
+#include "iblkit/lab/radiance.h"
+#include "iblkit/lab/truth.h"
+#include "iblkit/sphere/envmap.h"
+
+namespace ibl::lab {
+namespace {
+
+Scene emitting_sphere(Vec3 L, double albedo) {
+  Scene s;
+  s.name = "emitting sphere";
+  Surface sph;
+  sph.mesh = geometry::make_sphere({0, 1, 0}, 2.0, 24, 48, true);
+  sph.emission = L;
+  sph.albedo.constant = {albedo, albedo, albedo};
+  s.surfaces.push_back(sph);
+  s.build();
+  return s;
+}
+
+// A disc light of radius R, radiance L, at height h above the origin, facing down; nothing else.
+Scene disc_light(double R, double h, Vec3 L) {
+  Scene s;
+  s.name = "disc light";
+  Emitter e;
+  e.type = EmitterType::Area;
+  e.disc = true;
+  e.center = {0, h, 0};
+  e.normal = {0, -1, 0};
+  e.radius = R;
+  e.radiance = L;
+  s.emitters.push_back(e);
+  s.build();
+  return s;
+}
+
+TEST(LabCapture, ClosedEmittingSphereIsUniformEverywhereInside) {
+  constexpr double kFloatTol = 1e-6;  // relative: radiance is stored as float
+  const Vec3 L{2.0, 1.0, 0.5};
+  Scene black = emitting_sphere(L, 0.0);
+  Scene grey = emitting_sphere(L, 0.5);
+  CaptureDesc cd;
+  cd.size = 16;
+  for (Vec3 p : {Vec3{0, 1, 0}, Vec3{1.2, 0.3, -0.5}, Vec3{-0.4, 2.5, 1.0}}) {
+    cd.render.bounces = 0;
+    Capture c = capture_probe(black, p, cd);
+    cd.render.bounces = 3;  // every path hits the sphere: L·(1 + a + a² + a³) exactly
+    Capture g = capture_probe(grey, p, cd);
+    const double series = 1 + 0.5 + 0.25 + 0.125;
+    for (int y = 0; y < c.radiance.height(); ++y)
+      for (int x = 0; x < c.radiance.width(); ++x)
+        for (int k = 0; k < 3; ++k) {
+          ASSERT_NEAR(c.radiance.rgb(x, y)[k], L[k], kFloatTol * L[k]) << x << "," << y;
+          ASSERT_NEAR(g.radiance.rgb(x, y)[k], L[k] * series, kFloatTol * L[k] * series);
+        }
+  }
+}
+
+TEST(LabCapture, DiscLightSeenFromAxisMatchesClosedForm) {
+  // A disc of radius R at height h subtends Ω = 2π(1 − h/√(h²+R²)) and delivers E = πL R²/(h²+R²)
+  // to an upward normal below its centre.
+  constexpr double kMapTol = 0.02;     // relative: 64×128 map, 4×4 sub-pixels, the disc's rim pixels
+  constexpr double kSampledTol = 0.01; // relative: 16×16 stratified area samples of a disc
+  const double R = 0.5, h = 1.5, L = 3.0;
+  Scene s = disc_light(R, h, {L, L, L});
+  TruthDesc td;
+  td.size = 64;
+  td.samples = 4;
+  td.bands = 0;
+  td.normals = {{0, 1, 0}};
+  Truth t = ground_truth(s, {0, 0, 0}, td);
+  double omega = kTwoPi * (1 - h / std::sqrt(h * h + R * R)), E = kPi * L * R * R / (h * h + R * R);
+  EXPECT_NEAR(t.radiance.integral()[0] / (L * omega), 1.0, kMapTol);
+  EXPECT_NEAR(t.irradiance[0].x / E, 1.0, kMapTol);
+  RenderDesc rd;
+  rd.area_samples = 256;
+  Rng rng(7);
+  EXPECT_NEAR(direct_irradiance(s, {0, 0, 0}, {0, 1, 0}, rng, rd).y / E, 1.0, kSampledTol);
+}
+
+TEST(LabCapture, DepthMapsMatchDistancesInABox) {
+  constexpr double kDepthTol = 2e-5;  // relative: Embree intersects in float
+  Vec3 lo{-2, 0, -1.5}, hi{1, 2.5, 3}, o{0.4, 0.9, -0.3};
+  Scene s;
+  Surface box;
+  box.mesh = geometry::make_box(lo, hi, true);
+  s.surfaces.push_back(box);
+  s.build();
+  for (auto kind : {sphere::MappingKind::LatLong, sphere::MappingKind::CubeHCross, sphere::MappingKind::MirrorBall}) {
+    CaptureDesc cd;
+    cd.mapping = kind;
+    cd.size = 24;
+    cd.depth = true;
+    Capture c = capture_probe(s, o, cd);
+    int checked = 0;
+    for (int y = 0; y < c.depth.height(); ++y)
+      for (int x = 0; x < c.depth.width(); ++x) {
+        Vec3 d;
+        if (!c.mapping.to_direction(x + 0.5, y + 0.5, &d)) continue;
+        double t = 1e30;
+        for (int k = 0; k < 3; ++k)
+          if (d[k] != 0) t = std::min(t, ((d[k] > 0 ? hi[k] : lo[k]) - o[k]) / d[k]);
+        ASSERT_NEAR(c.depth.at(x, y, 0), t, kDepthTol * t) << sphere::mapping_name(kind) << " " << x << "," << y;
+        ++checked;
+      }
+    EXPECT_GT(checked, 200);
+  }
+}
+
+// A room lit by an area light and a soft spotlight: smooth enough that pixel footprints matter little.
+Scene lit_room() {
+  Scene s;
+  Surface room;
+  geometry::RoomDesc rd;
+  rd.lo = {-2, 0, -2};
+  rd.hi = {2, 2.5, 2};
+  room.mesh = geometry::make_room(rd);
+  room.albedo.constant = {0.6, 0.6, 0.6};
+  s.surfaces.push_back(room);
+  Emitter a;
+  a.type = EmitterType::Area;
+  a.center = {0.5, 2.49, 0.3};
+  a.normal = {0, -1, 0};
+  a.size = {1.5, 1.0};
+  a.radiance = {5, 5, 4};
+  s.emitters.push_back(a);
+  Emitter sp;
+  sp.type = EmitterType::Spot;
+  sp.position = {-1.5, 2, 1.5};
+  sp.direction = {1, -0.6, -1};
+  sp.cone_deg = 50;
+  sp.falloff_deg = 10;
+  sp.intensity = {4, 2, 1};
+  sp.aperture_radius = 0;  // no visible lamp: a tiny disc of huge radiance would only add sampling noise
+  s.emitters.push_back(sp);
+  s.build();
+  return s;
+}
+
+TEST(LabCapture, MirrorBallCameraMatchesLatLongCapture) {
+  constexpr double kMeanRelTol = 0.03;   // mean |Δ|/mean L over lat-long pixels: footprint + sampling noise
+  constexpr double kPowerTol = 0.02;     // ∫L dω of the two
+  constexpr double kDeadDeg = 40;        // directions this close to −Z are compressed into the ball's rim
+  Scene s = lit_room();
+  Vec3 p{0.2, 1.2, -0.3};
+  CaptureDesc ll;
+  ll.size = 32;
+  ll.samples = 4;
+  ll.render.area_samples = 16;
+  Capture a = capture_probe(s, p, ll);
+  CaptureDesc mb = ll;
+  mb.mapping = sphere::MappingKind::MirrorBall;
+  mb.camera = Camera::MirrorBall;
+  mb.size = 192;
+  mb.samples = 2;
+  Capture b = capture_probe(s, p, mb);
+  Image conv = sphere::resample(sphere::EnvMap(b.radiance, sphere::Mapping(sphere::MappingKind::MirrorBall, 192, 192)), a.mapping);
+  double diff = 0, sum = 0, pa = 0, pb = 0;
+  for (int y = 0; y < a.radiance.height(); ++y)
+    for (int x = 0; x < a.radiance.width(); ++x) {
+      Vec3 d;
+      a.mapping.to_direction(x + 0.5, y + 0.5, &d);
+      if (d.z < -std::cos(kDeadDeg * kPi / 180)) continue;
+      double la = luminance(a.radiance.rgb(x, y)), lb = luminance(conv.rgb(x, y)), w = a.mapping.solid_angle(x, y);
+      diff += std::abs(la - lb) * w;
+      sum += la * w;
+      pa += la * w;
+      pb += lb * w;
+    }
+  EXPECT_LT(diff / sum, kMeanRelTol);
+  EXPECT_NEAR(pb / pa, 1.0, kPowerTol);
+}
+
+TEST(LabCapture, SameSeedSameBytesOnAnyThreadCount) {
+  Scene s = lit_room();
+  CaptureDesc cd;
+  cd.size = 16;
+  cd.render.bounces = 1;
+  Capture a = capture_probe(s, {0, 1, 0}, cd, 3);
+  Capture b;
+  tbb::task_arena one(1);
+  one.execute([&] { b = capture_probe(s, {0, 1, 0}, cd, 3); });
+  ASSERT_EQ(a.radiance.size(), b.radiance.size());
+  EXPECT_EQ(std::memcmp(a.radiance.data(), b.radiance.data(), a.radiance.size() * sizeof(float)), 0);
+  cd.render.seed = 2;
+  Capture c = capture_probe(s, {0, 1, 0}, cd, 3);
+  EXPECT_NE(std::memcmp(a.radiance.data(), c.radiance.data(), a.radiance.size() * sizeof(float)), 0);
+}
+
+TEST(LabCapture, SpotApertureDeliversTheLampsIntensity) {
+  // Seen from a point in the beam, the lamp's disc must carry E = I/d² (its radiance is I/(A cos α)).
+  constexpr double kApertureTol = 0.03;  // relative: the disc covers ~700 pixels of the 1024×512 map
+  Scene s;
+  Emitter sp;
+  sp.type = EmitterType::Spot;
+  sp.position = {0, 2, 0};
+  sp.direction = {0.3, -1, 0};
+  sp.cone_deg = 60;
+  sp.falloff_deg = 60;
+  sp.intensity = {10, 10, 10};
+  sp.aperture_radius = 0.1;
+  s.emitters.push_back(sp);
+  s.build();
+  TruthDesc td;
+  td.size = 512;
+  td.samples = 1;
+  td.bands = 0;
+  Vec3 p{0.2, 0.5, 0.1}, w = normalize(sp.position - p);
+  td.normals = {w};
+  Truth t = ground_truth(s, p, td);
+  double d2 = dot(sp.position - p, sp.position - p);
+  EXPECT_NEAR(t.irradiance[0].x / (10 / d2), 1.0, kApertureTol);
+}
+
+TEST(LabTruth, UniformEnvironmentGivesPiLIrradiance) {
+  constexpr double kQuadTol = 3e-3;  // relative: pixel-centre cosines over a 64×32 map (horizon pixels)
+  Scene s;
+  Emitter env;
+  env.type = EmitterType::Environment;
+  env.radiance = {1.5, 1.5, 1.5};
+  s.emitters.push_back(env);
+  s.build();
+  TruthDesc td;
+  td.size = 32;
+  td.samples = 1;
+  td.bands = 0;
+  td.normals = {{0, 1, 0}, {1, 1, 1}};
+  Truth t = ground_truth(s, {0, 0, 0}, td);
+  for (Vec3 e : t.irradiance) EXPECT_NEAR(e.y, kPi * 1.5, kQuadTol * kPi * 1.5);
+}
+
+}  // namespace
+}  // namespace ibl::lab

@@ -1,0 +1,84 @@
+#include "iblkit/lab/truth.h"
+
+#include <atomic>
+
+#include "iblkit/core/error.h"
+#include "iblkit/core/parallel.h"
+#include "iblkit/lab/capture.h"
+#if __has_include("iblkit/sh/basis.h")
+#include "iblkit/sh/basis.h"
+#define IBLKIT_LAB_HAVE_SH 1
+#endif
+
+namespace ibl::lab {
+
+namespace {
+// Per-row partial sums in a fixed order keep the result independent of scheduling.
+template <typename RowF>
+std::vector<Vec3> row_sums(const sphere::EnvMap& map, size_t k, RowF row) {
+  int H = map.image.height();
+  std::vector<std::vector<Vec3>> rows(H, std::vector<Vec3>(k));
+  parallel_for(0, H, [&](int64_t y) { row(static_cast<int>(y), rows[y]); });
+  std::vector<Vec3> total(k);
+  for (auto& r : rows)
+    for (size_t i = 0; i < k; ++i) total[i] += r[i];
+  return total;
+}
+}  // namespace
+
+Vec3 irradiance(const sphere::EnvMap& map, Vec3 n) {
+  n = normalize(n);
+  return row_sums(map, 1, [&](int y, std::vector<Vec3>& acc) {
+    for (int x = 0; x < map.image.width(); ++x) {
+      Vec3 d;
+      double sa = map.mapping.solid_angle(x, y);
+      if (sa <= 0 || !map.mapping.to_direction(x + 0.5, y + 0.5, &d)) continue;
+      double c = dot(n, d);
+      if (c > 0) acc[0] += map.image.rgb(x, y) * (c * sa);
+    }
+  })[0];
+}
+
+std::vector<Vec3> project_sh(const sphere::EnvMap& map, int bands) {
+  if (bands < 1 || bands > 16) fail(ErrorKind::Value, "SH bands {} out of range [1, 16]", bands);
+#ifdef IBLKIT_LAB_HAVE_SH
+  size_t K = static_cast<size_t>(bands) * bands;
+  return row_sums(map, K, [&](int y, std::vector<Vec3>& acc) {
+    std::vector<double> basis(K);
+    for (int x = 0; x < map.image.width(); ++x) {
+      Vec3 d;
+      double sa = map.mapping.solid_angle(x, y);
+      if (sa <= 0 || !map.mapping.to_direction(x + 0.5, y + 0.5, &d)) continue;
+      sh::eval_basis(bands, d, basis.data());
+      Vec3 L = map.image.rgb(x, y) * sa;
+      for (size_t k = 0; k < K; ++k) acc[k] += L * basis[k];
+    }
+  });
+#else
+  fail(ErrorKind::Unsupported, "SH projection needs iblkit/sh (not in this build)");
+#endif
+}
+
+Truth ground_truth(const Scene& scene, Vec3 position, const TruthDesc& desc, const ProgressFn& progress) {
+  if (desc.area_samples < 1) fail(ErrorKind::Value, "area samples {} must be ≥ 1", desc.area_samples);
+  CaptureDesc cd;
+  cd.mapping = sphere::MappingKind::LatLong;
+  cd.size = desc.size;
+  cd.samples = desc.samples;
+  cd.render = scene.render;
+  cd.render.area_samples = desc.area_samples;
+  cd.render.env_samples = std::max(scene.render.env_samples, desc.area_samples);
+  cd.render.seed = desc.seed;
+  Capture cap = capture_probe(scene, position, cd, 0, progress);
+  Truth t;
+  t.radiance = sphere::EnvMap(std::move(cap.radiance), cap.mapping);
+  if (desc.bands > 0) t.sh = project_sh(t.radiance, desc.bands);
+  for (Vec3 n : desc.normals) {
+    if (length(n) == 0) fail(ErrorKind::Value, "irradiance normal (0,0,0) has no direction");
+    t.normals.push_back(normalize(n));
+    t.irradiance.push_back(irradiance(t.radiance, n));
+  }
+  return t;
+}
+
+}  // namespace ibl::lab

@@ -1,0 +1,36 @@
+// Ground truth at a point: the local radiance map at any resolution, its SH coefficients and the
+// irradiance for any normals — the answers the ILF, fusion and near-field modules are judged against.
+#pragma once
+#include <vector>
+
+#include "iblkit/core/progress.h"
+#include "iblkit/lab/scene.h"
+#include "iblkit/sphere/envmap.h"
+
+namespace ibl::lab {
+
+struct TruthDesc {
+  int size = 128;          // lat-long height of the radiance map (width 2·size)
+  int samples = 4;         // n×n sub-pixel samples per pixel (the map is a pixel-area average)
+  int area_samples = 64;   // shadow rays per area light per diffuse hit (more than a capture: less noise)
+  int bands = 3;           // SH bands of the projection (0: none)
+  std::vector<Vec3> normals;  // irradiance is computed for each (normalised here)
+  uint64_t seed = 1;       // random streams
+};
+
+struct Truth {
+  sphere::EnvMap radiance{Image(2, 1, 3), sphere::Mapping(sphere::MappingKind::LatLong, 2, 1)};  // lat-long map
+  std::vector<Vec3> sh;          // bands² RGB coefficients (DESIGN.md's real orthonormal basis)
+  std::vector<Vec3> normals;     // the unit normals of `irradiance`
+  std::vector<Vec3> irradiance;  // E(n) = ∫ L(ω) max(0, n·ω) dω, W/m²
+};
+
+// Irradiance of a radiance map for normal n by quadrature over its pixels with exact solid angles.
+Vec3 irradiance(const sphere::EnvMap& map, Vec3 n);
+
+// SH projection of a radiance map with exact pixel solid angles: c_k = Σ L(ω_p) Y_k(ω_p) Ω_p.
+std::vector<Vec3> project_sh(const sphere::EnvMap& map, int bands);
+
+Truth ground_truth(const Scene& scene, Vec3 position, const TruthDesc& desc, const ProgressFn& progress = {});
+
+}  // namespace ibl::lab
