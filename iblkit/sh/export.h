@@ -1,0 +1,47 @@
+// Export of 3-band SH radiance coefficients into other engines' layouts (docs/formats.md). Each is
+// a conversion of iblkit's coefficients (DESIGN.md: real, orthonormal, no Condon–Shortley phase,
+// world axes +Y up, right-handed — the same axes as three.js, Filament and glTF):
+//
+//  - threejs:  SphericalHarmonics3 [1]: radiance coefficients in the same basis and order, as
+//              the flat array of 27 numbers that SphericalHarmonics3.fromArray() reads.
+//  - filament: cmgen's sh.txt [2]: the shader-ready, "pre-scaled" irradiance of
+//              Irradiance_SphericalHarmonics(n) = Σ_i s_i p_i(n), p = (1, y, z, x, yx, yz, 3z²−1,
+//              zx, x²−y²), which is E(n)/π (the Lambertian 1/π folded in):
+//              s_i = (Â_l / π) · K_i · L_i with K_i the constant of the basis polynomial.
+//  - gltf:     EXT_lights_image_based "irradianceCoefficients" [3]: the 9×3 SH coefficients of
+//              irradiance E_lm = Â_l L_lm in the basis its reference loader (Babylon.js) evaluates,
+//              which carries the Condon–Shortley phase: odd-m coefficients change sign.
+//
+// References
+//  [1] three.js src/math/SphericalHarmonics3.js (getAt, fromArray).
+//  [2] Filament libs/ibl CubemapSH (preprocessSHForShader, renderPreScaledSH3Bands), cmgen.
+//  [3] KhronosGroup/glTF extensions/2.0/Vendor/EXT_lights_image_based; Babylon.js
+//      sphericalPolynomial (SH3ylmBasisConstants) and its EXT_lights_image_based loader.
+#pragma once
+#include <string>
+
+#include "iblkit/sh/coeffs.h"
+
+namespace ibl::sh {
+
+enum class ExportFormat { Iblkit, ThreeJs, Filament, Gltf };
+std::string export_format_name(ExportFormat f);
+// "iblkit", "threejs", "filament", "gltf"; throws ibl::Error on anything else.
+ExportFormat parse_export_format(const std::string& name);
+
+// The 9 values each layout stores, from radiance coefficients (bands ≠ 3 are truncated or
+// zero-padded to 3 bands; truncation does not change the lower coefficients).
+Coeffs to_threejs(const Coeffs& radiance);
+Coeffs to_filament(const Coeffs& radiance);
+Coeffs to_gltf(const Coeffs& radiance);
+// Inverses, for round-trip tests and for reading other engines' numbers back.
+Coeffs from_filament(const Coeffs& filament);
+Coeffs from_gltf(const Coeffs& gltf);
+
+// The file text of each layout: iblkit.sh/1 JSON (all bands), three.js JSON
+// {"type":"SphericalHarmonics3","coefficients":[27 numbers]}, Filament sh.txt lines
+// "( r, g, b); // L00, irradiance, pre-scaled base", glTF JSON fragment
+// {"extensions":{"EXT_lights_image_based":{"lights":[{…,"irradianceCoefficients":[[r,g,b]×9]}]}}}.
+std::string export_text(const Coeffs& radiance, ExportFormat f);
+
+}  // namespace ibl::sh

@@ -1,0 +1,236 @@
+#include "iblkit/sh/project.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+
+#include "iblkit/core/error.h"
+#include "iblkit/core/parallel.h"
+#include "iblkit/sh/basis.h"
+#include "iblkit/sh/rotate.h"
+
+namespace ibl::sh {
+
+namespace {
+
+using sphere::MappingKind;
+
+void check_bands(int bands) {
+  if (bands < 1 || bands > kMaxBands) fail(ErrorKind::Value, "SH bands must be in 1..{} (got {})", kMaxBands, bands);
+}
+
+Vec3 pixel_rgb(const float* p, int channels) {
+  return channels >= 3 ? Vec3{p[0], p[1], p[2]} : Vec3{p[0], p[0], p[0]};
+}
+
+// Partial sums of one chunk of rows: K RGB coefficients.
+struct Partial {
+  std::vector<double> v;  // 3K
+};
+Partial add(Partial a, const Partial& b) {
+  if (a.v.empty()) return b;
+  for (size_t i = 0; i < a.v.size(); ++i) a.v[i] += b.v[i];
+  return a;
+}
+
+// ---- lat-long: separable path ------------------------------------------------------------------
+//
+// With the frame d' = (d.z, d.x, d.y) (a cyclic permutation, i.e. a rotation P), the lat-long
+// polar axis +Y becomes the SH polar axis z' = cos θ, and for the pixel column at a = 2πu,
+//   d'.x + i d'.y = sin θ (−sin a − i cos a) = sin θ · w(a),  w(a) = −i e^{−ia}.
+// So Y_lm(d') = K_lm P̃_lm(cos θ) sin^m θ · {Re, Im} w(a)^m, and the integral over pixel (x, y)
+//   ∫∫ Y_lm dω = [∫_{z₁}^{z₀} K_lm P̃_lm(z) (1−z²)^{m/2} dz] · [∫ {Re, Im} w^m da]
+// factors into a row term G_lm(y) (4-point Gauss–Legendre over the row's z range) and a column
+// term Δ sinc(mΔ/2) {Re, Im} w(a_x)^m with Δ = 2π/W (exact). Per row, the radiance is summed
+// against the 2L+1 column tables (vectorised dot products), then multiplied by G. The result is
+// in the d' frame; rotating by Pᵀ brings it back to world axes.
+
+constexpr int kLanes = 8;  // floats per vector lane group the row loops are written for
+
+// acc[j] = Σ_x a[x] · t_j[x] for 4 tables at once; n a multiple of kLanes.
+inline void dot4(const float* a, const float* t0, const float* t1, const float* t2, const float* t3, int n, double* out) {
+  float s0[kLanes] = {}, s1[kLanes] = {}, s2[kLanes] = {}, s3[kLanes] = {};
+  for (int x = 0; x < n; x += kLanes) {
+    for (int k = 0; k < kLanes; ++k) {
+      float v = a[x + k];
+      s0[k] += v * t0[x + k];
+      s1[k] += v * t1[x + k];
+      s2[k] += v * t2[x + k];
+      s3[k] += v * t3[x + k];
+    }
+  }
+  double r[4] = {0, 0, 0, 0};
+  for (int k = 0; k < kLanes; ++k) {
+    r[0] += s0[k];
+    r[1] += s1[k];
+    r[2] += s2[k];
+    r[3] += s3[k];
+  }
+  for (int j = 0; j < 4; ++j) out[j] = r[j];
+}
+
+Coeffs project_latlong(const sphere::EnvMap& env, int bands, const ProgressFn& progress) {
+  const Image& img = env.image;
+  const int W = img.width(), H = img.height(), C = img.channels(), K = coeff_count(bands);
+  const int Wp = (W + kLanes - 1) / kLanes * kLanes;
+  const int J = 2 * bands - 1;            // tables: cos 0, then (Re, Im) w^m for m = 1..L
+  const int Jp = (J + 3) / 4 * 4;          // padded to groups of 4 (extra tables are zero)
+  // Column tables, with the exact pixel integral Δ sinc(mΔ/2) folded in.
+  const double delta = kTwoPi / W;
+  std::vector<float> tab(static_cast<size_t>(Jp) * Wp, 0.0f);
+  for (int x = 0; x < W; ++x) {
+    double a = kTwoPi * (x + 0.5) / W;
+    double wr = -std::sin(a), wi = -std::cos(a), cr = 1.0, ci = 0.0;
+    tab[x] = static_cast<float>(delta);
+    for (int m = 1; m < bands; ++m) {
+      double nr = cr * wr - ci * wi;
+      ci = cr * wi + ci * wr;
+      cr = nr;
+      double h = 0.5 * m * delta, sinc = std::sin(h) / h;
+      tab[static_cast<size_t>(2 * m - 1) * Wp + x] = static_cast<float>(delta * sinc * cr);
+      tab[static_cast<size_t>(2 * m) * Wp + x] = static_cast<float>(delta * sinc * ci);
+    }
+  }
+  std::vector<double> gz, gw;
+  gauss_legendre(4, &gz, &gw);
+  std::vector<double> norm(bands * bands, 0.0);
+  for (int l = 0; l < bands; ++l)
+    for (int m = 0; m <= l; ++m) norm[l * bands + m] = norm_constant(l, m);
+
+  std::atomic<int> rows_done{0};
+  const int64_t chunk = 16;
+  Partial total = parallel_reduce_fixed<Partial>(
+      0, H, chunk, Partial{},
+      [&](int64_t y0, int64_t y1) {
+        Partial p;
+        p.v.assign(3 * K, 0.0);
+        std::vector<float> ch(3 * static_cast<size_t>(Wp), 0.0f);
+        std::vector<double> sums(3 * static_cast<size_t>(Jp));
+        std::vector<double> G(bands * bands), P(bands * bands);
+        for (int64_t y = y0; y < y1; ++y) {
+          // Row term G_lm = ∫ K_lm P̃_lm(z) (1−z²)^{m/2} dz over the row.
+          double z0 = std::cos(kPi * y / H), z1 = std::cos(kPi * (y + 1) / H);
+          std::fill(G.begin(), G.end(), 0.0);
+          for (int g = 0; g < 4; ++g) {
+            double z = 0.5 * (z0 + z1) + 0.5 * (z0 - z1) * gz[g], w = 0.5 * (z0 - z1) * gw[g];
+            double s = std::sqrt(std::max(0.0, 1.0 - z * z));
+            legendre_table(bands, z, P.data());
+            double sm = 1.0;
+            for (int m = 0; m < bands; ++m) {
+              for (int l = m; l < bands; ++l) G[l * bands + m] += w * norm[l * bands + m] * P[l * bands + m] * sm;
+              sm *= s;
+            }
+          }
+          // De-interleave the row.
+          const float* row = img.pixel(0, static_cast<int>(y));
+          for (int x = 0; x < W; ++x) {
+            const float* px = row + static_cast<size_t>(x) * C;
+            ch[x] = px[0];
+            ch[Wp + x] = C >= 3 ? px[1] : px[0];
+            ch[2 * Wp + x] = C >= 3 ? px[2] : px[0];
+          }
+          for (int c = 0; c < 3; ++c)
+            for (int j = 0; j < Jp; j += 4)
+              dot4(ch.data() + static_cast<size_t>(c) * Wp, &tab[static_cast<size_t>(j) * Wp], &tab[static_cast<size_t>(j + 1) * Wp],
+                   &tab[static_cast<size_t>(j + 2) * Wp], &tab[static_cast<size_t>(j + 3) * Wp], Wp, &sums[c * Jp + j]);
+          for (int l = 0; l < bands; ++l) {
+            for (int c = 0; c < 3; ++c) {
+              p.v[3 * index(l, 0) + c] += G[l * bands] * sums[c * Jp];
+              for (int m = 1; m <= l; ++m) {
+                p.v[3 * index(l, m) + c] += G[l * bands + m] * sums[c * Jp + 2 * m - 1];
+                p.v[3 * index(l, -m) + c] += G[l * bands + m] * sums[c * Jp + 2 * m];
+              }
+            }
+          }
+        }
+        int done = rows_done.fetch_add(static_cast<int>(y1 - y0)) + static_cast<int>(y1 - y0);
+        report(progress, "SH projection", static_cast<double>(done) / H);
+        return p;
+      },
+      [](Partial a, const Partial& b) { return add(std::move(a), b); });
+
+  Coeffs primed(bands);
+  for (int k = 0; k < K; ++k) primed.c[k] = {total.v[3 * k], total.v[3 * k + 1], total.v[3 * k + 2]};
+  // f(d) = h(P d) with h the primed function, i.e. f = h(Rᵀ d) with R = Pᵀ.
+  const Mat3 P = Mat3::rows({0, 0, 1}, {1, 0, 0}, {0, 1, 0});
+  return rotate(primed, P.transposed());
+}
+
+}  // namespace
+
+Coeffs project_generic(const sphere::EnvMap& env, int bands, const ProgressFn& progress) {
+  check_bands(bands);
+  const Image& img = env.image;
+  const sphere::Mapping& m = env.mapping;
+  const int W = img.width(), H = img.height(), C = img.channels(), K = coeff_count(bands);
+  std::atomic<int> rows_done{0};
+  Partial total = parallel_reduce_fixed<Partial>(
+      0, H, 8, Partial{},
+      [&](int64_t y0, int64_t y1) {
+        Partial p;
+        p.v.assign(3 * K, 0.0);
+        std::vector<double> yb(K);
+        for (int64_t y = y0; y < y1; ++y) {
+          for (int x = 0; x < W; ++x) {
+            double w = m.solid_angle(x, static_cast<int>(y));
+            if (w <= 0) continue;
+            Vec3 d;
+            if (!m.to_direction(x + 0.5, y + 0.5, &d)) continue;
+            Vec3 L = pixel_rgb(img.pixel(x, static_cast<int>(y)), C) * w;
+            eval_basis(bands, d, yb.data());
+            for (int k = 0; k < K; ++k) {
+              p.v[3 * k] += L.x * yb[k];
+              p.v[3 * k + 1] += L.y * yb[k];
+              p.v[3 * k + 2] += L.z * yb[k];
+            }
+          }
+        }
+        int done = rows_done.fetch_add(static_cast<int>(y1 - y0)) + static_cast<int>(y1 - y0);
+        report(progress, "SH projection", static_cast<double>(done) / H);
+        return p;
+      },
+      [](Partial a, const Partial& b) { return add(std::move(a), b); });
+  Coeffs out(bands);
+  for (int k = 0; k < K; ++k) out.c[k] = {total.v[3 * k], total.v[3 * k + 1], total.v[3 * k + 2]};
+  return out;
+}
+
+Coeffs project(const sphere::EnvMap& env, int bands, const ProgressFn& progress) {
+  check_bands(bands);
+  if (env.image.empty()) fail(ErrorKind::Value, "cannot project an empty image onto SH");
+  if (env.mapping.kind() == MappingKind::LatLong) return project_latlong(env, bands, progress);
+  return project_generic(env, bands, progress);
+}
+
+Coeffs project_function(const std::function<Vec3(Vec3)>& f, int bands, int degree) {
+  check_bands(bands);
+  const SphereQuadrature q = exact_quadrature(degree >= 0 ? degree : 2 * (bands - 1) + 8);
+  Coeffs out(bands);
+  std::vector<double> y(coeff_count(bands));
+  for (size_t i = 0; i < q.directions.size(); ++i) {
+    Vec3 v = f(q.directions[i]) * q.weights[i];
+    eval_basis(bands, q.directions[i], y.data());
+    for (int k = 0; k < coeff_count(bands); ++k) out.c[k] += v * y[k];
+  }
+  return out;
+}
+
+Image reconstruct(const Coeffs& c, const sphere::Mapping& m) {
+  c.validate("SH coefficients");
+  Image out(m.width(), m.height(), 3);
+  const int K = coeff_count(c.bands);
+  parallel_for(0, m.height(), [&](int64_t y) {
+    std::vector<double> yb(K);
+    for (int x = 0; x < m.width(); ++x) {
+      Vec3 d;
+      if (!m.to_direction(x + 0.5, y + 0.5, &d)) continue;
+      eval_basis(c.bands, d, yb.data());
+      Vec3 s;
+      for (int k = 0; k < K; ++k) s += c.c[k] * yb[k];
+      out.set_rgb(x, static_cast<int>(y), s);
+    }
+  });
+  return out;
+}
+
+}  // namespace ibl::sh
