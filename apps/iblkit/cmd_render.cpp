@@ -1,0 +1,166 @@
+// iblkit render: a mesh scene lit by an iblkit representation, on the CPU (reference) or with
+// OpenGL (real time, headless EGL). Prints per-frame GPU time and fps for the GL backend.
+#ifdef IBLKIT_HAVE_GEOMETRY
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+
+#include <fmt/format.h>
+
+#include "cli.h"
+#include "iblkit/core/error.h"
+#include "iblkit/io/envmap_io.h"
+#include "iblkit/io/image_io.h"
+#include "iblkit/io/tonemap.h"
+#include "iblkit/render/cpu_renderer.h"
+#include "iblkit/render/mesh.h"
+#include "iblkit/sh/project.h"
+#ifdef IBLKIT_HAVE_GL
+#include "iblkit/render/gl/context.h"
+#include "iblkit/render/gl/renderer.h"
+#endif
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace ibl;
+using namespace ibl::render;
+
+// Reads --light: an iblkit.lights/1 or iblkit.sh/1 JSON file, or a probe image (projected to SH).
+void load_lighting(const std::string& path, int bands, const io::EnvReadDesc& rd, Lighting* L, std::string* kind) {
+  std::string ext = fs::path(path).extension().string();
+  if (ext == ".json") {
+    std::ifstream in(path);
+    if (!in) fail(ErrorKind::Io, "{}: cannot open", path);
+    nlohmann::json j;
+    try {
+      in >> j;
+    } catch (const std::exception& e) {
+      fail(ErrorKind::Format, "{}: not valid JSON ({})", path, e.what());
+    }
+    std::string format = j.value("format", "");
+    if (format == "iblkit.lights/1") {
+      if (!j.contains("lights") || !j["lights"].is_array()) fail(ErrorKind::Format, "{}: no \"lights\" array", path);
+      for (size_t i = 0; i < j["lights"].size(); ++i) {
+        const auto& l = j["lights"][i];
+        if (!l.contains("direction") || !l.contains("irradiance"))
+          fail(ErrorKind::Format, "{}: light {} lacks \"direction\" or \"irradiance\"", path, i);
+        auto dv = l["direction"].get<std::vector<double>>(), ev = l["irradiance"].get<std::vector<double>>();
+        if (dv.size() != 3 || ev.size() != 3) fail(ErrorKind::Format, "{}: light {}: direction and irradiance need 3 numbers", path, i);
+        L->lights.push_back({normalize(Vec3{dv[0], dv[1], dv[2]}), {ev[0], ev[1], ev[2]}, l.value("shadow", i < 4)});
+      }
+      *kind = fmt::format("{} directional lights", L->lights.size());
+      return;
+    }
+    if (format == "iblkit.sh/1") {
+      sh::Coeffs c;
+      c.bands = j.at("bands").get<int>();
+      for (const auto& v : j.at("coefficients")) c.c.push_back({v[0].get<double>(), v[1].get<double>(), v[2].get<double>()});
+      if (static_cast<int>(c.c.size()) != c.bands * c.bands)
+        fail(ErrorKind::Format, "{}: {} bands need {} coefficients, found {}", path, c.bands, c.bands * c.bands, c.c.size());
+      L->environment = c;
+      *kind = fmt::format("SH environment, {} bands", c.bands);
+      return;
+    }
+    fail(ErrorKind::Format, "{}: \"format\" is '{}'; expected iblkit.lights/1 or iblkit.sh/1", path, format);
+  }
+  auto env = io::read_envmap(path, rd);
+  L->environment = sh::project(env, bands);
+  *kind = fmt::format("probe projected to {} SH bands", bands);
+}
+
+void setup(CLI::App& app) {
+  struct Opts {
+    std::string scene = "blob", light, out = "frame.png", backend = "auto", size = "1024x768", eye = "0,0.5,1.6",
+                target = "0,0,0";
+    int frames = 1, bands = 5, triangles = 100000;
+    double gloss = 0, exponent = 20;
+  };
+  auto* o = new Opts();
+  app.add_option("scene", o->scene, "built-in scene: blob (a bunny-sized object on a floor) or sphere")
+      ->check(CLI::IsMember({"blob", "sphere"}))
+      ->capture_default_str();
+  app.add_option("-l,--light", o->light, "lighting: a probe image, iblkit.sh/1 or iblkit.lights/1 JSON")->required();
+  app.add_option("-o,--out", o->out, "output .png (tone mapped) or .exr (linear)")->capture_default_str();
+  app.add_option("--backend", o->backend, "cpu, gl or auto (gl when available)")->check(CLI::IsMember({"cpu", "gl", "auto"}))->capture_default_str();
+  app.add_option("--size", o->size, "frame size WxH")->capture_default_str();
+  app.add_option("--frames", o->frames, "GL: render this many frames and report the median GPU time")->check(CLI::Range(1, 10000));
+  app.add_option("--bands", o->bands, "SH bands when projecting a probe")->check(CLI::Range(1, 9))->capture_default_str();
+  app.add_option("--triangles", o->triangles, "triangles of the blob")->check(CLI::Range(100, 5000000))->capture_default_str();
+  app.add_option("--gloss", o->gloss, "weight of the glossy Phong lobe (0..1)")->check(CLI::Range(0.0, 1.0));
+  app.add_option("--exponent", o->exponent, "Phong exponent of the glossy lobe")->check(CLI::Range(1.0, 10000.0));
+  app.add_option("--eye", o->eye, "camera position x,y,z")->capture_default_str();
+  app.add_option("--target", o->target, "camera target x,y,z")->capture_default_str();
+  auto& rd = iblcli::add_probe_read_options(app);
+  app.footer("Examples:\n  iblkit render blob --light probe.exr --out blob.png --backend cpu --size 400x300\n"
+             "  iblkit render blob --light lights.json --backend gl --frames 100 --out blob.exr");
+  app.callback([o, &rd] {
+    int w = 0, h = 0;
+    if (std::sscanf(o->size.c_str(), "%dx%d", &w, &h) != 2 || w < 1 || h < 1 || w > 16384 || h > 16384)
+      fail(ErrorKind::Value, "--size '{}': expected WxH, e.g. 1024x768", o->size);
+    FrameDesc d;
+    d.camera.width = w;
+    d.camera.height = h;
+    d.camera.eye = iblcli::parse_vec3(o->eye, "--eye");
+    d.camera.target = iblcli::parse_vec3(o->target, "--target");
+    Mesh object = o->scene == "blob" ? make_blob(o->triangles, 0.8) : make_sphere(0.4, 128, 256);
+    Mesh floor = make_floor(6, -0.42);
+    Material mat{{0.75, 0.75, 0.75}, Vec3{1, 1, 1} * o->gloss, o->exponent};
+    d.objects = {{&object, mat}, {&floor, Material{{0.5, 0.5, 0.5}, {0, 0, 0}, 1}}};
+    std::string kind;
+    load_lighting(o->light, o->bands, rd, &d.lighting, &kind);
+    std::string backend = o->backend;
+    nlohmann::json j = {{"scene", o->scene}, {"light", o->light}, {"lighting", kind}, {"size", o->size}};
+    RenderResult f;
+#ifdef IBLKIT_HAVE_GL
+    std::unique_ptr<gl::Context> ctx;
+    if (backend != "cpu") {
+      try {
+        ctx = std::make_unique<gl::Context>();
+        backend = "gl";
+      } catch (const Error& e) {
+        if (backend == "gl") throw;
+        iblcli::info(fmt::format("no OpenGL here ({}); rendering on the CPU", e.what()));
+        backend = "cpu";
+      }
+    }
+    if (backend == "gl") {
+      gl::Renderer r;
+      gl::GpuTiming t;
+      f = r.render(d, o->frames, &t);
+      std::vector<double> ms = t.frame_ms;
+      std::sort(ms.begin(), ms.end());
+      double med = ms[ms.size() / 2];
+      j["gl_renderer"] = ctx->renderer();
+      j["gpu_ms_median"] = med;
+      j["fps_gpu"] = med > 0 ? 1000.0 / med : 0.0;
+    }
+#else
+    if (backend == "gl") fail(ErrorKind::Unsupported, "this build has no OpenGL renderer (libepoxy missing)");
+    backend = "cpu";
+#endif
+    if (backend == "cpu") {
+      auto t0 = std::chrono::steady_clock::now();
+      f = render_cpu(d, iblcli::progress_bar());
+      iblcli::progress_done();
+      j["cpu_ms"] = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    }
+    j["backend"] = backend;
+    std::string ext = fs::path(o->out).extension().string();
+    if (ext == ".png" || ext == ".jpg") io::write_image(o->out, io::tonemap(f.color));
+    else io::write_image(o->out, f.color);
+    j["output"] = o->out;
+    iblcli::emit(j, [&] {
+      fmt::print("rendered {} ({}, {} backend) lit by {}\n", o->out, o->size, backend, kind);
+      if (j.contains("gpu_ms_median"))
+        fmt::print("GPU time {:.3f} ms/frame median of {} ({:.0f} fps) on {}\n", j["gpu_ms_median"].get<double>(), o->frames,
+                   j["fps_gpu"].get<double>(), j["gl_renderer"].get<std::string>());
+      if (j.contains("cpu_ms")) fmt::print("CPU time {:.0f} ms\n", j["cpu_ms"].get<double>());
+    });
+  });
+}
+
+iblcli::Command reg("render", "Render a scene lit by a probe, SH or lights (CPU reference or OpenGL)", setup, 80);
+
+}  // namespace
+#endif

@@ -1,0 +1,373 @@
+#include "iblkit/render/gl/renderer.h"
+
+#include <epoxy/gl.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "iblkit/core/error.h"
+#include "iblkit/render/gl/program.h"
+#include "iblkit/render/gl/sh_glsl.h"
+#include "iblkit/sh/convolve.h"
+
+namespace ibl::render::gl {
+
+namespace {
+
+struct MeshBuffers {
+  GLuint vao = 0, vbo[2] = {0, 0}, ebo = 0;
+  GLsizei count = 0;
+};
+
+MeshBuffers upload(const Mesh& m) {
+  MeshBuffers b;
+  glCreateVertexArrays(1, &b.vao);
+  glCreateBuffers(2, b.vbo);
+  glCreateBuffers(1, &b.ebo);
+  glNamedBufferStorage(b.vbo[0], static_cast<GLsizeiptr>(m.positions.size() * sizeof(float)), m.positions.data(), 0);
+  glNamedBufferStorage(b.vbo[1], static_cast<GLsizeiptr>(m.normals.size() * sizeof(float)), m.normals.data(), 0);
+  glNamedBufferStorage(b.ebo, static_cast<GLsizeiptr>(m.indices.size() * sizeof(uint32_t)), m.indices.data(), 0);
+  for (int a = 0; a < 2; ++a) {
+    glVertexArrayVertexBuffer(b.vao, a, b.vbo[a], 0, 3 * sizeof(float));
+    glVertexArrayAttribFormat(b.vao, a, 3, GL_FLOAT, GL_FALSE, 0);
+    glVertexArrayAttribBinding(b.vao, a, a);
+    glEnableVertexArrayAttrib(b.vao, a);
+  }
+  glVertexArrayElementBuffer(b.vao, b.ebo);
+  b.count = static_cast<GLsizei>(m.indices.size());
+  return b;
+}
+
+void release(MeshBuffers& b) {
+  glDeleteVertexArrays(1, &b.vao);
+  glDeleteBuffers(2, b.vbo);
+  glDeleteBuffers(1, &b.ebo);
+}
+
+void set_vec3(GLuint prog, const char* name, Vec3 v) {
+  glProgramUniform3f(prog, glGetUniformLocation(prog, name), static_cast<float>(v.x), static_cast<float>(v.y),
+                     static_cast<float>(v.z));
+}
+
+}  // namespace
+
+struct Renderer::Impl {
+  RendererDesc desc;
+  // Programs by (SH bands (0 → 1), glossy, stage kind).
+  enum Kind { Forward, GBuffer, Compute };
+  std::map<std::tuple<int, bool, int>, GLuint> programs;
+  GLuint shadow_program = 0;
+
+  GLuint program(int bands, bool glossy, Kind kind) {
+    auto key = std::make_tuple(std::max(1, bands), glossy, static_cast<int>(kind));
+    auto it = programs.find(key);
+    if (it != programs.end()) return it->second;
+    std::string lib = sh_glsl_source(std::get<0>(key)) + (glossy ? "#define GLOSSY 1\n" : "#define GLOSSY 0\n") +
+                      "#line 1\n" + shader_source("shading.glsl");
+    GLuint p = 0;
+    switch (kind) {
+      case Forward: p = build_program({{GL_VERTEX_SHADER, "mesh.vert", ""}, {GL_FRAGMENT_SHADER, "shade.frag", lib}}); break;
+      case GBuffer: p = build_program({{GL_VERTEX_SHADER, "mesh.vert", ""}, {GL_FRAGMENT_SHADER, "visibility.frag", ""}}); break;
+      case Compute: p = build_program({{GL_COMPUTE_SHADER, "shade.comp", lib}}); break;
+    }
+    programs[key] = p;
+    return p;
+  }
+  ~Impl() {
+    for (auto& [k, p] : programs) glDeleteProgram(p);
+    if (shadow_program) glDeleteProgram(shadow_program);
+  }
+};
+
+Renderer::Renderer(const RendererDesc& desc) : impl_(std::make_unique<Impl>()) {
+  impl_->desc = desc;
+  impl_->shadow_program = build_program({{GL_VERTEX_SHADER, "shadow.vert", ""}, {GL_FRAGMENT_SHADER, "shadow.frag", ""}});
+}
+Renderer::~Renderer() = default;
+
+RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing) {
+  const Camera& cam = d.camera;
+  const int W = cam.width, H = cam.height;
+  if (W <= 0 || H <= 0 || W > 16384 || H > 16384) fail(ErrorKind::Value, "frame size {}x{} is invalid", W, H);
+  const Lighting& L = d.lighting;
+  int bands = L.grid ? L.grid->bands : (L.environment ? L.environment->bands : 0);
+  bool glossy = false;
+  for (const auto& o : d.objects) glossy |= max_component(o.material.specular) > 0;
+  const bool deferred = impl_->desc.deferred;
+  GLuint prog = impl_->program(bands, glossy, deferred ? Impl::Compute : Impl::Forward);
+  GLuint raster = deferred ? impl_->program(bands, glossy, Impl::GBuffer) : prog;
+  int K = std::max(1, bands) * std::max(1, bands);
+
+  // Scene bounds for the shadow maps' orthographic frusta.
+  Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+  std::vector<MeshBuffers> meshes;
+  for (const auto& o : d.objects) {
+    Vec3 a, b;
+    o.mesh->bounds(&a, &b);
+    for (int k = 0; k < 3; ++k) { lo[k] = std::min(lo[k], a[k]); hi[k] = std::max(hi[k], b[k]); }
+    meshes.push_back(upload(*o.mesh));
+  }
+  Vec3 centre = (lo + hi) * 0.5;
+  double radius = std::max(1e-6, 0.5 * length(hi - lo));
+
+  // Lights and shadow matrices.
+  std::vector<float> light_data;
+  std::vector<Mat4f> shadow_mats;
+  for (const auto& l : L.lights) {
+    float layer = -1;
+    if (l.shadow && static_cast<int>(shadow_mats.size()) < kMaxShadowMaps) {
+      layer = static_cast<float>(shadow_mats.size());
+      shadow_mats.push_back(light_view_projection(l.direction, centre, radius));
+    }
+    Vec3 dir = normalize(l.direction);
+    light_data.insert(light_data.end(), {static_cast<float>(dir.x), static_cast<float>(dir.y), static_cast<float>(dir.z), layer,
+                                         static_cast<float>(l.irradiance.x), static_cast<float>(l.irradiance.y),
+                                         static_cast<float>(l.irradiance.z), 0.0f});
+  }
+  GLuint ssbo[2];
+  glCreateBuffers(2, ssbo);
+  glNamedBufferStorage(ssbo[0], static_cast<GLsizeiptr>(std::max<size_t>(1, light_data.size()) * sizeof(float)),
+                       light_data.empty() ? nullptr : light_data.data(), 0);
+  glNamedBufferStorage(ssbo[1], static_cast<GLsizeiptr>(std::max<size_t>(1, shadow_mats.size()) * sizeof(Mat4f)),
+                       shadow_mats.empty() ? nullptr : shadow_mats.data(), 0);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, ssbo[0]);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, ssbo[1]);
+
+  // Shadow-map array and its framebuffer.
+  int S = d.shadow_map_size, layers = std::max<int>(1, static_cast<int>(shadow_mats.size()));
+  GLuint shadow_tex, shadow_fbo;
+  glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, &shadow_tex);
+  glTextureStorage3D(shadow_tex, 1, GL_DEPTH_COMPONENT32F, S, S, layers);
+  glTextureParameteri(shadow_tex, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTextureParameteri(shadow_tex, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTextureParameteri(shadow_tex, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTextureParameteri(shadow_tex, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  glTextureParameteri(shadow_tex, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+  glTextureParameteri(shadow_tex, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+  glCreateFramebuffers(1, &shadow_fbo);
+
+  // SH grid: one RGBA16F 3D texture, coefficient k in slices [k·nz, (k+1)·nz).
+  GLuint grid_tex = 0;
+  if (L.grid) {
+    const SHGridData& g = *L.grid;
+    if (g.nx < 1 || g.ny < 1 || g.nz < 1 || g.data.size() != static_cast<size_t>(g.nx) * g.ny * g.nz * K * 3)
+      fail(ErrorKind::Value, "SH grid {}x{}x{} with {} bands holds {} values, expected {}", g.nx, g.ny, g.nz, g.bands,
+           g.data.size(), static_cast<size_t>(g.nx) * g.ny * g.nz * K * 3);
+    GLint max3d = 0;
+    glGetIntegerv(GL_MAX_3D_TEXTURE_SIZE, &max3d);
+    if (g.nz * K > max3d)
+      fail(ErrorKind::Unsupported, "SH grid needs a 3D texture {} deep; this GL allows {}", g.nz * K, max3d);
+    const size_t points = static_cast<size_t>(g.nx) * g.ny * g.nz;
+    std::vector<float> packed(points * K * 4, 0.0f);
+    for (size_t p = 0; p < points; ++p)
+      for (int k = 0; k < K; ++k)
+        for (int c = 0; c < 3; ++c) packed[(static_cast<size_t>(k) * points + p) * 4 + c] = g.data[(p * K + k) * 3 + c];
+    glCreateTextures(GL_TEXTURE_3D, 1, &grid_tex);
+    glTextureStorage3D(grid_tex, 1, GL_RGBA16F, g.nx, g.ny, g.nz * K);
+    glTextureSubImage3D(grid_tex, 0, 0, 0, 0, g.nx, g.ny, g.nz * K, GL_RGBA, GL_FLOAT, packed.data());
+    glTextureParameteri(grid_tex, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTextureParameteri(grid_tex, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    for (GLenum w : {GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T, GL_TEXTURE_WRAP_R}) glTextureParameteri(grid_tex, w, GL_CLAMP_TO_EDGE);
+  }
+
+  // Colour target (the forward pass renders into it; the deferred pass writes it as an image), and
+  // the deferred G-buffer.
+  GLuint color_tex, depth_rb, fbo, vis_tex = 0, geom_ssbo[4] = {0, 0, 0, 0};
+  glCreateTextures(GL_TEXTURE_2D, 1, &color_tex);
+  glTextureStorage2D(color_tex, 1, GL_RGBA32F, W, H);
+  glCreateRenderbuffers(1, &depth_rb);
+  glNamedRenderbufferStorage(depth_rb, GL_DEPTH_COMPONENT32F, W, H);
+  glCreateFramebuffers(1, &fbo);
+  if (deferred) {
+    glCreateTextures(GL_TEXTURE_2D, 1, &vis_tex);
+    glTextureStorage2D(vis_tex, 1, GL_R32UI, W, H);
+    glTextureParameteri(vis_tex, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTextureParameteri(vis_tex, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, vis_tex, 0);
+    // Geometry for the compute pass: all objects' vertices and indices, and where each starts.
+    std::vector<uint32_t> object_table;
+    std::vector<float> pos, nrm;
+    std::vector<uint32_t> idx;
+    for (const auto& o : d.objects) {
+      if (o.mesh->triangle_count() >= (1u << 24)) fail(ErrorKind::Value, "a mesh of {} triangles is over the deferred path's 2^24", o.mesh->triangle_count());
+      object_table.insert(object_table.end(), {static_cast<uint32_t>(pos.size() / 3), static_cast<uint32_t>(idx.size()), 0u, 0u});
+      pos.insert(pos.end(), o.mesh->positions.begin(), o.mesh->positions.end());
+      nrm.insert(nrm.end(), o.mesh->normals.begin(), o.mesh->normals.end());
+      idx.insert(idx.end(), o.mesh->indices.begin(), o.mesh->indices.end());
+    }
+    if (d.objects.size() > 255) fail(ErrorKind::Value, "the deferred path draws at most 255 objects ({} given)", d.objects.size());
+    glCreateBuffers(4, geom_ssbo);
+    glNamedBufferStorage(geom_ssbo[0], static_cast<GLsizeiptr>(std::max<size_t>(4, object_table.size()) * 4), object_table.data(), 0);
+    glNamedBufferStorage(geom_ssbo[1], static_cast<GLsizeiptr>(std::max<size_t>(1, pos.size()) * 4), pos.data(), 0);
+    glNamedBufferStorage(geom_ssbo[2], static_cast<GLsizeiptr>(std::max<size_t>(1, nrm.size()) * 4), nrm.data(), 0);
+    glNamedBufferStorage(geom_ssbo[3], static_cast<GLsizeiptr>(std::max<size_t>(1, idx.size()) * 4), idx.data(), 0);
+    for (int i = 0; i < 4; ++i) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3 + i, geom_ssbo[i]);
+  } else {
+    glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, color_tex, 0);
+  }
+  glNamedFramebufferRenderbuffer(fbo, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth_rb);
+  if (glCheckNamedFramebufferStatus(fbo, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+    fail(ErrorKind::Unsupported, "GL framebuffer {}x{} is incomplete", W, H);
+
+  // Materials (deferred: a table indexed from the G-buffer; forward: uniforms per object).
+  std::vector<float> materials;
+  for (const auto& o : d.objects) {
+    const Material& m = o.material;
+    float row[20] = {static_cast<float>(m.albedo.x),   static_cast<float>(m.albedo.y),   static_cast<float>(m.albedo.z),   0,
+                     static_cast<float>(m.specular.x), static_cast<float>(m.specular.y), static_cast<float>(m.specular.z),
+                     static_cast<float>(m.exponent)};
+    if (bands > 0) {
+      auto gz = sh::phong_zh(bands, m.exponent);
+      for (int l = 0; l < std::min(bands, 12); ++l) row[8 + l] = static_cast<float>(gz[l]);
+    }
+    materials.insert(materials.end(), row, row + 20);
+  }
+  GLuint material_ssbo;
+  glCreateBuffers(1, &material_ssbo);
+  glNamedBufferStorage(material_ssbo, static_cast<GLsizeiptr>(std::max<size_t>(1, materials.size()) * sizeof(float)),
+                       materials.empty() ? nullptr : materials.data(), 0);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, material_ssbo);
+
+  // Uniforms of the shading program.
+  Mat4f vp = mul(cam.projection(), cam.view());
+  glProgramUniformMatrix4fv(raster, glGetUniformLocation(raster, "u_view_projection"), 1, GL_FALSE, vp.data());
+  set_vec3(prog, "u_eye", cam.eye);
+  set_vec3(prog, "u_background", d.background);
+  if (deferred) {
+    // Camera rays: dir(x, y) ∝ f + r·sx + u·sy with sx, sy linear in the pixel position.
+    Vec3 f = normalize(cam.target - cam.eye), r = normalize(cross(f, cam.up)), u = cross(r, f);
+    double t = std::tan(cam.fov_y_deg * kPi / 360.0), aspect = static_cast<double>(W) / H;
+    set_vec3(prog, "u_ray00", f - r * (t * aspect) + u * t);
+    set_vec3(prog, "u_ray_dx", r * (2 * t * aspect / W));
+    set_vec3(prog, "u_ray_dy", u * (-2 * t / H));
+  }
+  glProgramUniform1i(prog, glGetUniformLocation(prog, "u_light_count"), static_cast<GLint>(L.lights.size()));
+  glProgramUniform1f(prog, glGetUniformLocation(prog, "u_shadow_bias"), static_cast<float>(d.shadow_bias));
+  glProgramUniform1i(prog, glGetUniformLocation(prog, "u_shadow_maps"), 0);
+  int mode = L.grid ? 2 : (L.environment ? 1 : 0);
+  glProgramUniform1i(prog, glGetUniformLocation(prog, "u_sh_mode"), mode);
+  std::vector<float> env(static_cast<size_t>(K) * 3, 0.0f);
+  if (mode == 1)
+    for (int k = 0; k < K; ++k)
+      for (int c = 0; c < 3; ++c) env[k * 3 + c] = static_cast<float>(L.environment->c[k][c]);
+  glProgramUniform3fv(prog, glGetUniformLocation(prog, "u_env"), K, env.data());
+  if (mode == 2) {
+    set_vec3(prog, "u_grid_min", L.grid->min);
+    set_vec3(prog, "u_grid_max", L.grid->max);
+    set_vec3(prog, "u_grid_res", {static_cast<double>(L.grid->nx), static_cast<double>(L.grid->ny), static_cast<double>(L.grid->nz)});
+  }
+  if (bands > 0) {
+    auto dz = sh::clamped_cosine_zh(bands);
+    std::vector<float> df(dz.begin(), dz.end());
+    glProgramUniform1fv(prog, glGetUniformLocation(prog, "u_diffuse_zh"), bands, df.data());
+  }
+  // Every sampler gets its own unit even when unused: two sampler types on one unit is an error.
+  glProgramUniform1i(prog, glGetUniformLocation(prog, "u_grid"), 1);
+  GLint loc_albedo = glGetUniformLocation(prog, "u_albedo"), loc_specular = glGetUniformLocation(prog, "u_specular"),
+        loc_exponent = glGetUniformLocation(prog, "u_exponent"), loc_glossy = glGetUniformLocation(prog, "u_glossy_zh"),
+        loc_material = glGetUniformLocation(raster, "u_object"),
+        loc_light_vp = glGetUniformLocation(impl_->shadow_program, "u_light_view_projection");
+
+  // One timer query per frame, read after the last frame so that the CPU never waits on the GPU
+  // between frames (a per-frame wait would count the GPU's idle gaps as frame time).
+  const int nframes = std::max(1, frames);
+  std::vector<GLuint> queries(nframes);
+  glGenQueries(nframes, queries.data());
+  std::vector<double> times;
+  for (int f = 0; f < nframes; ++f) {
+    glBeginQuery(GL_TIME_ELAPSED, queries[f]);
+    // Shadow passes.
+    if (!shadow_mats.empty()) {
+      glUseProgram(impl_->shadow_program);
+      glBindFramebuffer(GL_FRAMEBUFFER, shadow_fbo);
+      glViewport(0, 0, S, S);
+      glEnable(GL_DEPTH_TEST);
+      glEnable(GL_POLYGON_OFFSET_FILL);
+      glPolygonOffset(1.5f, 2.0f);
+      for (size_t i = 0; i < shadow_mats.size(); ++i) {
+        glNamedFramebufferTextureLayer(shadow_fbo, GL_DEPTH_ATTACHMENT, shadow_tex, 0, static_cast<GLint>(i));
+        glClear(GL_DEPTH_BUFFER_BIT);
+        glUniformMatrix4fv(loc_light_vp, 1, GL_FALSE, shadow_mats[i].data());
+        for (auto& m : meshes) {
+          glBindVertexArray(m.vao);
+          glDrawElements(GL_TRIANGLES, m.count, GL_UNSIGNED_INT, nullptr);
+        }
+      }
+      glDisable(GL_POLYGON_OFFSET_FILL);
+    }
+    // Shading pass (forward), or G-buffer pass then compute shading (deferred).
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    glViewport(0, 0, W, H);
+    glClearColor(static_cast<float>(d.background.x), static_cast<float>(d.background.y), static_cast<float>(d.background.z), 0.0f);
+    if (deferred) {
+      const GLuint zero[4] = {0, 0, 0, 0};
+      glClearBufferuiv(GL_COLOR, 0, zero);
+      glClear(GL_DEPTH_BUFFER_BIT);
+    } else {
+      glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    }
+    glEnable(GL_DEPTH_TEST);
+    glEnable(GL_CULL_FACE);
+    glCullFace(GL_BACK);
+    glUseProgram(raster);
+    glBindTextureUnit(0, shadow_tex);
+    if (grid_tex) glBindTextureUnit(1, grid_tex);
+    for (size_t i = 0; i < meshes.size(); ++i) {
+      if (deferred) {
+        glUniform1ui(loc_material, static_cast<GLuint>(i));
+      } else {
+        const Material& mat = d.objects[i].material;
+        glUniform3f(loc_albedo, static_cast<float>(mat.albedo.x), static_cast<float>(mat.albedo.y), static_cast<float>(mat.albedo.z));
+        glUniform3f(loc_specular, static_cast<float>(mat.specular.x), static_cast<float>(mat.specular.y), static_cast<float>(mat.specular.z));
+        glUniform1f(loc_exponent, static_cast<float>(mat.exponent));
+        if (bands > 0) glUniform1fv(loc_glossy, bands, materials.data() + i * 20 + 8);
+      }
+      glBindVertexArray(meshes[i].vao);
+      glDrawElements(GL_TRIANGLES, meshes[i].count, GL_UNSIGNED_INT, nullptr);
+    }
+    if (deferred) {
+      glUseProgram(prog);
+      glBindTextureUnit(2, vis_tex);
+      glBindImageTexture(0, color_tex, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+      glDispatchCompute(static_cast<GLuint>((W + 7) / 8), static_cast<GLuint>((H + 7) / 8), 1);
+      glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
+    }
+    glEndQuery(GL_TIME_ELAPSED);
+  }
+  for (int f = 0; f < nframes; ++f) {
+    GLuint64 ns = 0;
+    glGetQueryObjectui64v(queries[f], GL_QUERY_RESULT, &ns);
+    times.push_back(ns * 1e-6);
+  }
+  if (timing) timing->frame_ms = times;
+
+  RenderResult out{Image(W, H, 3), Image(W, H, 1)};
+  std::vector<float> rgba(static_cast<size_t>(W) * H * 4);
+  glGetTextureImage(color_tex, 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(rgba.size() * sizeof(float)), rgba.data());
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      const float* p = rgba.data() + (static_cast<size_t>(H - 1 - y) * W + x) * 4;  // GL rows go up
+      out.color.set_rgb(x, y, {p[0], p[1], p[2]});
+      out.coverage.at(x, y, 0) = p[3];
+    }
+  GLenum err = glGetError();
+  glDeleteQueries(nframes, queries.data());
+  glDeleteFramebuffers(1, &fbo);
+  glDeleteFramebuffers(1, &shadow_fbo);
+  glDeleteRenderbuffers(1, &depth_rb);
+  if (deferred) {
+    glDeleteTextures(1, &vis_tex);
+    glDeleteBuffers(4, geom_ssbo);
+  }
+  glDeleteBuffers(1, &material_ssbo);
+  glDeleteTextures(1, &color_tex);
+  glDeleteTextures(1, &shadow_tex);
+  if (grid_tex) glDeleteTextures(1, &grid_tex);
+  glDeleteBuffers(2, ssbo);
+  for (auto& m : meshes) release(m);
+  if (err != GL_NO_ERROR) fail(ErrorKind::Internal, "OpenGL error 0x{:x} while rendering", err);
+  return out;
+}
+
+}  // namespace ibl::render::gl

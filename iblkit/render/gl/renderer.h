@@ -1,0 +1,39 @@
+// The real-time renderer: OpenGL 4.5 core, headless through EGL. Draws a FrameDesc (render/frame.h)
+// with the shading model of render/shading.h: SH environment or SH grid (coefficients in RGB16F 3D
+// textures with hardware trilinear filtering, zonal harmonics rotated per fragment), and any number
+// of directional lights in one pass, the shadow-casting ones through a shadow-map array.
+#pragma once
+#include <memory>
+#include <vector>
+
+#include "iblkit/render/frame.h"
+#include "iblkit/render/gl/context.h"
+
+namespace ibl::render::gl {
+
+struct GpuTiming {
+  std::vector<double> frame_ms;  // GPU time per frame (GL_TIME_ELAPSED), shadow passes included
+};
+
+struct RendererDesc {
+  // Shade in a compute pass over a G-buffer instead of in the fragment shader. Faster on GPUs whose
+  // fragment stage runs on few units (the H100: see bench/RESULTS.md); both give the same image.
+  bool deferred = true;
+};
+
+class Renderer {
+ public:
+  // Needs a current context (the Context must outlive the Renderer).
+  explicit Renderer(const RendererDesc& desc = {});
+  ~Renderer();
+  // Renders `frames` times (uploads once; frames > 1 for timing) and reads back the last frame.
+  RenderResult render(const FrameDesc& desc, int frames = 1, GpuTiming* timing = nullptr);
+
+  static constexpr int kMaxShadowMaps = 16;  // shadow-casting lights per pass
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace ibl::render::gl

@@ -1,0 +1,81 @@
+// The shading model of iblkit/render/shading.h, formula for formula, shared by the forward
+// fragment shader (shade.frag) and the deferred compute shader (shade.comp):
+//   L_o = (albedo/π)·E(n) + specular·G(r)
+//   E(n) = Σ Â_l c_lm Y_lm(n),  G(r) = Σ ρ̂_l(s) c_lm Y_lm(r)   (SH environment or SH grid at p)
+//   + per directional light: V·E_i·max(0, n·l) and V·E_i·(s+1)/2π·max(0, r·l)^s where n·l > 0.
+// Needs SH_BANDS, SH_K, sh_eval() and GLOSSY defined before it.
+uniform vec3 u_eye;
+
+uniform int u_sh_mode;  // 0: no SH light, 1: environment, 2: SH grid
+uniform vec3 u_env[SH_K];
+uniform float u_diffuse_zh[SH_BANDS];
+// All coefficients in one RGBA16F 3D texture: coefficient k occupies slices [k·nz, (k+1)·nz).
+// Lookups clamp z to the block's texel centres, so trilinear filtering never mixes coefficients.
+uniform sampler3D u_grid;
+uniform vec3 u_grid_min;
+uniform vec3 u_grid_max;
+uniform vec3 u_grid_res;
+
+struct Light {
+  vec4 direction;   // xyz: unit direction towards the light; w: shadow layer or −1
+  vec4 irradiance;  // rgb
+};
+layout(std430, binding = 0) readonly buffer Lights { Light lights[]; };
+layout(std430, binding = 1) readonly buffer ShadowMatrices { mat4 shadow_matrices[]; };
+uniform int u_light_count;
+uniform sampler2DArrayShadow u_shadow_maps;
+uniform float u_shadow_bias;
+
+const float PI = 3.14159265358979;
+
+// ρ̂_l(s) of the material being shaded: defined by the including shader (a uniform array in the
+// forward path, the material table in the deferred path).
+float glossy_factor(int l);
+
+float visibility(vec3 p, vec3 n, int layer) {
+  vec4 q = shadow_matrices[layer] * vec4(p + n * u_shadow_bias, 1.0);
+  vec3 t = q.xyz / q.w * 0.5 + 0.5;
+  if (any(lessThan(t.xy, vec2(0.0))) || any(greaterThan(t.xy, vec2(1.0)))) return 1.0;
+  return texture(u_shadow_maps, vec4(t.xy, float(layer), t.z));
+}
+
+vec3 shade(vec3 p, vec3 n_in, vec3 albedo, vec3 specular, float exponent) {
+  vec3 n = normalize(n_in);
+  vec3 v = normalize(u_eye - p);
+  vec3 r = normalize(2.0 * dot(n, v) * n - v);
+  vec3 E = vec3(0.0), G = vec3(0.0);
+  if (u_sh_mode != 0) {
+    float yn[SH_K], yr[SH_K];
+    sh_eval(n, yn);
+#if GLOSSY
+    sh_eval(r, yr);
+#endif
+    vec3 tc = vec3(0.0);
+    if (u_sh_mode == 2) {
+      vec3 rel = clamp((p - u_grid_min) / (u_grid_max - u_grid_min), 0.0, 1.0);
+      tc = rel * (u_grid_res - 1.0) + 0.5;  // in texels of one coefficient block
+      tc.xy /= u_grid_res.xy;
+    }
+    float inv_depth = 1.0 / (u_grid_res.z * float(SH_K));
+    for (int l = 0; l < SH_BANDS; ++l)
+      for (int k = l * l; k < (l + 1) * (l + 1); ++k) {
+        vec3 c = u_sh_mode == 2 ? texture(u_grid, vec3(tc.xy, (float(k) * u_grid_res.z + tc.z) * inv_depth)).rgb : u_env[k];
+        E += c * (u_diffuse_zh[l] * yn[k]);
+#if GLOSSY
+        G += c * (glossy_factor(l) * yr[k]);
+#endif
+      }
+  }
+  float lobe_norm = (exponent + 1.0) / (2.0 * PI);
+  for (int i = 0; i < u_light_count; ++i) {
+    vec3 l = lights[i].direction.xyz;
+    float ndl = dot(n, l);
+    if (ndl <= 0.0) continue;
+    float vis = lights[i].direction.w >= 0.0 ? visibility(p, n, int(lights[i].direction.w)) : 1.0;
+    vec3 irr = lights[i].irradiance.rgb * vis;
+    E += irr * ndl;
+    float rdl = dot(r, l);
+    if (rdl > 0.0) G += irr * (lobe_norm * pow(rdl, exponent));
+  }
+  return max(albedo * E / PI + specular * G, vec3(0.0));
+}

@@ -1,0 +1,3 @@
+#version 450 core
+// Depth-only: nothing to write.
+void main() {}

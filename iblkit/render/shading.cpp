@@ -1,0 +1,76 @@
+#include "iblkit/render/shading.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "iblkit/sh/basis.h"
+#include "iblkit/sh/convolve.h"
+
+namespace ibl::render {
+
+sh::Coeffs SHGridData::at(Vec3 p) const {
+  const int K = bands * bands;
+  sh::Coeffs out;
+  out.bands = bands;
+  out.c.assign(K, Vec3{});
+  double f[3];
+  int i0[3], n[3] = {nx, ny, nz};
+  for (int a = 0; a < 3; ++a) {
+    double span = max[a] - min[a];
+    double t = span > 0 ? std::clamp((p[a] - min[a]) / span, 0.0, 1.0) * (n[a] - 1) : 0.0;
+    i0[a] = std::min(static_cast<int>(t), std::max(0, n[a] - 2));
+    f[a] = n[a] > 1 ? t - i0[a] : 0.0;
+  }
+  for (int corner = 0; corner < 8; ++corner) {
+    int ix = std::min(i0[0] + (corner & 1), nx - 1), iy = std::min(i0[1] + ((corner >> 1) & 1), ny - 1),
+        iz = std::min(i0[2] + ((corner >> 2) & 1), nz - 1);
+    double w = ((corner & 1) ? f[0] : 1 - f[0]) * (((corner >> 1) & 1) ? f[1] : 1 - f[1]) *
+               (((corner >> 2) & 1) ? f[2] : 1 - f[2]);
+    if (w == 0) continue;
+    const float* src = data.data() + ((static_cast<size_t>(iz) * ny + iy) * nx + ix) * K * 3;
+    for (int k = 0; k < K; ++k) out.c[k] += Vec3{src[3 * k], src[3 * k + 1], src[3 * k + 2]} * w;
+  }
+  return out;
+}
+
+Vec3 shade(const Lighting& lighting, const Material& m, Vec3 p, Vec3 n, Vec3 v, const VisibilityFn& visible) {
+  Vec3 r = normalize(n * (2 * dot(n, v)) - v);
+  Vec3 E, G;
+  const sh::Coeffs* c = nullptr;
+  sh::Coeffs local;
+  if (lighting.grid) {
+    local = lighting.grid->at(p);
+    c = &local;
+  } else if (lighting.environment) {
+    c = &*lighting.environment;
+  }
+  if (c && c->bands > 0) {
+    int bands = c->bands;
+    auto diffuse = sh::clamped_cosine_zh(bands);
+    auto glossy = sh::phong_zh(bands, m.exponent);
+    std::vector<double> yn(bands * bands), yr(bands * bands);
+    sh::eval_basis(bands, n, yn.data());
+    sh::eval_basis(bands, r, yr.data());
+    for (int l = 0; l < bands; ++l)
+      for (int mm = -l; mm <= l; ++mm) {
+        int k = l * (l + 1) + mm;
+        E += c->c[k] * (diffuse[l] * yn[k]);
+        G += c->c[k] * (glossy[l] * yr[k]);
+      }
+  }
+  const double lobe_norm = (m.exponent + 1) / kTwoPi;
+  for (size_t i = 0; i < lighting.lights.size(); ++i) {
+    const DirectionalLight& L = lighting.lights[i];
+    double ndl = dot(n, L.direction);
+    if (ndl <= 0) continue;
+    if (L.shadow && visible && !visible(p, static_cast<int>(i))) continue;
+    E += L.irradiance * ndl;
+    double rdl = dot(r, L.direction);
+    if (rdl > 0) G += L.irradiance * (lobe_norm * std::pow(rdl, m.exponent));
+  }
+  Vec3 out = m.albedo * E * (1.0 / kPi) + m.specular * G;
+  // SH ringing can make a few values negative; light is never negative.
+  return {std::max(0.0, out.x), std::max(0.0, out.y), std::max(0.0, out.z)};
+}
+
+}  // namespace ibl::render

@@ -1,0 +1,57 @@
+// What the renderers compute at a surface point: one shading model, written once here in C++ (the
+// CPU reference uses it directly; the GLSL in gl/shaders/shade.frag implements the same formulas and
+// a test holds the two to a named tolerance).
+//
+// Outgoing radiance towards the eye at point p with normal n, reflection vector r = reflect(−v, n):
+//   L_o = (albedo/π)·E(n) + specular·G(r)
+// with, for a distant SH environment or an SH grid sampled at p (coefficients c_lm),
+//   E(n) = Σ_lm Â_l c_lm Y_lm(n)         Â_l: clamped cosine (Ramamoorthi & Hanrahan 2001)
+//   G(r) = Σ_lm ρ̂_l(s) c_lm Y_lm(r)      ρ̂_l(s): normalised Phong lobe (s+1)/2π (r·ω)^s, its
+//                                          zonal harmonics rotated to r (Löw et al. 2009 §4)
+// and for each directional light (direction l towards the light, irradiance E_i, visibility V_i)
+//   E(n) += V_i E_i max(0, n·l),   G(r) += V_i E_i (s+1)/2π max(0, r·l)^s   (only where n·l > 0).
+#pragma once
+#include <functional>
+#include <optional>
+#include <vector>
+
+#include "iblkit/core/vec.h"
+#include "iblkit/sh/coeffs.h"
+
+namespace ibl::render {
+
+struct Material {
+  Vec3 albedo{0.8, 0.8, 0.8};  // Lambertian reflectance (RGB, 0..1)
+  Vec3 specular{0, 0, 0};      // weight of the normalised Phong lobe (RGB)
+  double exponent = 20.0;      // Phong exponent s of the glossy lobe
+};
+
+struct DirectionalLight {
+  Vec3 direction;       // unit direction towards the light
+  Vec3 irradiance;      // W/m² delivered at normal incidence (RGB)
+  bool shadow = false;  // cast shadows (shadow rays on the CPU, shadow maps on the GPU)
+};
+
+// A regular grid of SH radiance (the .shgrid layout of DESIGN.md): value index
+// (((z·ny + y)·nx + x)·K + k)·3 + channel; point (i,j,k) at min + (max−min)·(i/(nx−1), …).
+struct SHGridData {
+  int bands = 0;
+  int nx = 0, ny = 0, nz = 0;
+  Vec3 min, max;
+  std::vector<float> data;
+  // Trilinear interpolation of the coefficients at p (clamped to the box).
+  sh::Coeffs at(Vec3 p) const;
+};
+
+struct Lighting {
+  std::optional<sh::Coeffs> environment;  // distant light
+  std::optional<SHGridData> grid;         // local light field (takes precedence over environment)
+  std::vector<DirectionalLight> lights;   // directional or localised-as-directional lights
+};
+
+// Visibility of light `i` from point p (true = lit). Null means everything is lit.
+using VisibilityFn = std::function<bool(Vec3 p, int light)>;
+
+Vec3 shade(const Lighting& lighting, const Material& m, Vec3 p, Vec3 n, Vec3 v, const VisibilityFn& visible = {});
+
+}  // namespace ibl::render
