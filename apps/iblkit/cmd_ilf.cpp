@@ -1,0 +1,293 @@
+// iblkit ilf build|query|slice|info|synth: incident light fields — probe sequences resampled into SH
+// grids (Löw et al. 2009, docs/ilf.md).
+#include <filesystem>
+
+#include <fmt/format.h>
+
+#include "cli.h"
+#include "iblkit/core/error.h"
+#include "iblkit/ilf/analytic.h"
+#include "iblkit/ilf/build.h"
+#include "iblkit/io/image_io.h"
+#include "iblkit/io/tonemap.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace ibl;
+
+std::vector<int> parse_grid(const std::string& s) {
+  auto v = iblcli::parse_int_list(s, "--grid");
+  if (v.size() == 1) v = {v[0], v[0], v[0]};
+  if (v.size() != 3) fail(ErrorKind::Value, "--grid: expected N or NX,NY,NZ, got \"{}\"", s);
+  for (int n : v)
+    if (n < 2 || n > 1024) fail(ErrorKind::Value, "--grid: {} points per axis is outside [2, 1024]", n);
+  return v;
+}
+
+ilf::Box parse_box(const std::string& s) {
+  std::vector<double> v;
+  size_t pos = 0;
+  while (pos <= s.size()) {
+    size_t e = s.find(',', pos);
+    std::string t = s.substr(pos, e == std::string::npos ? std::string::npos : e - pos);
+    try {
+      v.push_back(std::stod(t));
+    } catch (const std::exception&) {
+      fail(ErrorKind::Value, "--volume: \"{}\" is not a number", t);
+    }
+    if (e == std::string::npos) break;
+    pos = e + 1;
+  }
+  if (v.size() != 6) fail(ErrorKind::Value, "--volume: expected minx,miny,minz,maxx,maxy,maxz");
+  ilf::Box b{{v[0], v[1], v[2]}, {v[3], v[4], v[5]}};
+  for (int a = 0; a < 3; ++a)
+    if (!(b.max[a] > b.min[a])) fail(ErrorKind::Value, "--volume: max must exceed min on axis {}", "xyz"[a]);
+  return b;
+}
+
+size_t parse_bytes(const std::string& s) {
+  char* end = nullptr;
+  double v = std::strtod(s.c_str(), &end);
+  std::string unit = end ? std::string(end) : "";
+  double mul = unit.empty() || unit == "B" ? 1 : unit == "K" || unit == "KB" ? 1e3 * 1.024 : unit == "M" || unit == "MB" ? 1048576.0
+             : unit == "G" || unit == "GB" ? 1073741824.0 : -1;
+  if (!(v > 0) || mul < 0) fail(ErrorKind::Value, "--memory: \"{}\" is not a size (e.g. 2G, 512M)", s);
+  size_t bytes = size_t(v * mul);
+  if (bytes < (size_t(64) << 20)) fail(ErrorKind::Value, "--memory: {} is below the 64M minimum", s);
+  return bytes;
+}
+
+nlohmann::json report_json(const ilf::BuildReport& r) {
+  return {{"probes_in", r.probes_in}, {"probes_used", r.probes_used}, {"skipped", r.skipped},
+          {"buckets", r.buckets}, {"blocks", r.blocks}, {"octahedral", r.octahedral}, {"samples", r.samples},
+          {"fraction_uncovered", r.fraction_uncovered}, {"buckets_reused", r.buckets_reused},
+          {"seconds", {{"subsample", r.t_subsample}, {"sort", r.t_sort}, {"project", r.t_project},
+                       {"accumulate", r.t_accumulate}, {"total", r.t_total}}},
+          {"gemm_gflop", r.gemm_flops * 1e-9},
+          {"gemm_gflops_per_s", r.t_accumulate > 0 ? r.gemm_flops * 1e-9 / r.t_accumulate : 0.0},
+          {"samples_per_s", r.t_total > 0 ? r.samples / r.t_total : 0.0}};
+}
+
+void setup_build(CLI::App& app) {
+  struct Opts {
+    std::string seq, out, grid = "16", volume, repair = "pullpush", memory = "2G", buckets, vdb, directions = "auto";
+    int bands = 5;
+    double kernel = 3.0, subsample = -1, subsample_dist = 0.05;
+    bool skip_bad = false, sanitize = false, no_reuse = false;
+  };
+  auto* o = new Opts();
+  app.add_option("sequence", o->seq, "iblkit.sequence/1 manifest")->required();
+  app.add_option("-o,--out", o->out, "output .shgrid")->required();
+  app.add_option("--grid", o->grid, "grid points: N or NX,NY,NZ")->capture_default_str();
+  app.add_option("--bands", o->bands, "SH bands (5 = 25 coefficients)")->capture_default_str()->check(CLI::Range(1, 10));
+  app.add_option("--volume", o->volume, "grid volume minx,miny,minz,maxx,maxy,maxz (default: the sequence's)");
+  app.add_option("--kernel", o->kernel, "Gaussian kernel support diameter in grid cells")->capture_default_str();
+  app.add_option("--repair", o->repair, "filling of grid points no ray reached: pullpush, mip (the paper's), none")->capture_default_str();
+  app.add_option("--memory", o->memory, "peak memory budget (e.g. 2G, 512M)")->capture_default_str();
+  app.add_option("--buckets", o->buckets, "folder for the direction buckets (default: OUT.buckets; reused by re-runs)");
+  app.add_option("--directions", o->directions, "direction buckets: auto, pixel (one per probe pixel, the paper's) or N (N×N octahedral cells)")->capture_default_str();
+  app.add_option("--subsample", o->subsample, "drop probes whose difference energy to both neighbours is below this (e.g. 0.05)");
+  app.add_option("--subsample-distance", o->subsample_dist, "… and whose neighbours lie within this many metres")->capture_default_str();
+  app.add_option("--vdb", o->vdb, "also write the grid as OpenVDB (one Vec3f grid per coefficient)");
+  app.add_flag("--skip-bad", o->skip_bad, "skip bad probes (missing/unreadable frames, wrong size, NaN, outside the volume, duplicates) and report how many");
+  app.add_flag("--sanitize", o->sanitize, "replace NaN/Inf/negative pixels by 0 instead of failing");
+  app.add_flag("--no-reuse", o->no_reuse, "rebuild the direction buckets even when an earlier run's match");
+  app.footer("Example:\n  iblkit ilf build captures/sequence.json --grid 32 --bands 5 --out room.shgrid");
+  app.callback([o] {
+    auto grid = parse_grid(o->grid);
+    ilf::BuildDesc bd;
+    bd.nx = grid[0]; bd.ny = grid[1]; bd.nz = grid[2];
+    bd.bands = o->bands;
+    if (!o->volume.empty()) bd.volume = parse_box(o->volume);
+    bd.project.kernel_cells = o->kernel;
+    bd.project.repair = ilf::parse_repair(o->repair);
+    bd.buckets.memory_bytes = parse_bytes(o->memory);
+    bd.buckets.dir = o->buckets.empty() ? o->out + ".buckets" : o->buckets;
+    bd.buckets.skip_bad = o->skip_bad;
+    bd.buckets.sanitize = o->sanitize;
+    bd.buckets.reuse = !o->no_reuse;
+    if (o->directions == "auto") bd.buckets.octahedral = -1;
+    else if (o->directions == "pixel") bd.buckets.octahedral = 0;
+    else {
+      auto v = iblcli::parse_int_list(o->directions, "--directions");
+      if (v.size() != 1 || v[0] < 2 || v[0] > 1024) fail(ErrorKind::Value, "--directions: expected auto, pixel or N in [2, 1024]");
+      bd.buckets.octahedral = v[0];
+    }
+    if (o->subsample >= 0) bd.subsample = ilf::SubsampleDesc{o->subsample, o->subsample_dist};
+    ilf::SequenceReadDesc rd;
+    rd.skip_bad = o->skip_bad;
+    ilf::SequenceReport srep;
+    auto seq = ilf::read_sequence(o->seq, rd, &srep);
+    ilf::BuildReport rep;
+    auto g = ilf::build_shgrid(seq, bd, iblcli::progress_bar(), &rep);
+    iblcli::progress_done();
+    ilf::write_shgrid(o->out, g);
+    if (!o->vdb.empty()) ilf::write_vdb(o->vdb, g);
+    rep.skipped += srep.skipped;
+    for (auto& r : srep.reasons) rep.skip_reasons.insert(rep.skip_reasons.begin(), r);
+    for (auto& r : rep.skip_reasons) iblcli::info("skipped: " + r);
+    auto j = report_json(rep);
+    j["out"] = o->out;
+    iblcli::emit(j, [&] {
+      fmt::print("wrote {} ({}x{}x{}, {} coefficients)\n", o->out, bd.nx, bd.ny, bd.nz, bd.bands * bd.bands);
+      fmt::print("probes    {} used of {}{}\n", rep.probes_used + srep.skipped - rep.skipped, rep.probes_in + srep.skipped,
+                 rep.skipped ? fmt::format(", {} skipped", rep.skipped) : "");
+      fmt::print("buckets   {} ({}), {} blocks{}\n", rep.buckets, rep.octahedral ? fmt::format("{0}x{0} octahedral", rep.octahedral) : "one per pixel",
+                 rep.blocks, rep.buckets_reused ? ", reused" : "");
+      fmt::print("samples   {} ({:.3g}/s), {:.2f}% of grid point × bucket pairs repaired\n", rep.samples,
+                 rep.samples / std::max(rep.t_total, 1e-9), 100 * rep.fraction_uncovered);
+      fmt::print("time      sort {:.1f}s, project+repair {:.1f}s, SH products {:.1f}s ({:.1f} GFLOP/s), total {:.1f}s\n", rep.t_sort,
+                 rep.t_project, rep.t_accumulate, rep.gemm_flops * 1e-9 / std::max(rep.t_accumulate, 1e-9), rep.t_total);
+    });
+  });
+}
+
+void setup_query(CLI::App& app) {
+  struct Opts { std::string grid, at, normal, dir; double exponent = 4; };
+  auto* o = new Opts();
+  app.add_option("grid", o->grid, ".shgrid file")->required();
+  app.add_option("--at", o->at, "point x,y,z")->required();
+  app.add_option("--normal", o->normal, "irradiance for this normal x,y,z (default +Y)");
+  app.add_option("--dir", o->dir, "also radiance towards, and Phong-glossy response around, this direction");
+  app.add_option("--exponent", o->exponent, "Phong exponent for --dir")->capture_default_str();
+  app.footer("Example:\n  iblkit ilf query room.shgrid --at 0.1,0.5,0 --normal 0,1,0");
+  app.callback([o] {
+    auto g = ilf::read_shgrid(o->grid);
+    Vec3 p = iblcli::parse_vec3(o->at, "--at"), n = o->normal.empty() ? Vec3{0, 1, 0} : iblcli::parse_vec3(o->normal, "--normal");
+    if (!g.grid().volume.contains(p)) iblcli::info("note: the point lies outside the grid volume; values are clamped to its boundary");
+    auto c = g.coeffs_at(p);
+    Vec3 e = g.irradiance(p, n);
+    nlohmann::json coeffs = nlohmann::json::array();
+    for (auto& v : c.c) coeffs.push_back({v.x, v.y, v.z});
+    nlohmann::json j = {{"at", {p.x, p.y, p.z}}, {"normal", {n.x, n.y, n.z}}, {"irradiance", {e.x, e.y, e.z}}, {"coefficients", coeffs}};
+    Vec3 L, G;
+    if (!o->dir.empty()) {
+      Vec3 d = iblcli::parse_vec3(o->dir, "--dir");
+      L = g.radiance(p, d);
+      G = g.glossy(p, d, o->exponent);
+      j["radiance"] = {L.x, L.y, L.z};
+      j["glossy"] = {G.x, G.y, G.z};
+    }
+    iblcli::emit(j, [&] {
+      fmt::print("irradiance  {:.6g} {:.6g} {:.6g}  (normal {:.3g},{:.3g},{:.3g})\n", e.x, e.y, e.z, n.x, n.y, n.z);
+      if (!o->dir.empty()) {
+        fmt::print("radiance    {:.6g} {:.6g} {:.6g}\n", L.x, L.y, L.z);
+        fmt::print("glossy      {:.6g} {:.6g} {:.6g}  (Phong exponent {})\n", G.x, G.y, G.z, o->exponent);
+      }
+      fmt::print("c00         {:.6g} {:.6g} {:.6g}\n", c.c[0].x, c.c[0].y, c.c[0].z);
+    });
+  });
+}
+
+// Irradiance on an axis-aligned plane through the volume, normal along the plane's axis.
+Image irradiance_slice(const ilf::SHGrid& g, int axis, double value, int size, double normal_sign) {
+  const auto& v = g.grid().volume;
+  int a1 = axis == 0 ? 2 : 0, a2 = axis == 1 ? 2 : 1;  // image x, y axes
+  Vec3 ext = v.size();
+  int w = size, h = std::max(1, int(std::lround(size * ext[a2] / ext[a1])));
+  Image img(w, h, 3);
+  Vec3 n{0, 0, 0};
+  n[axis] = normal_sign;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      Vec3 p;
+      p[axis] = value;
+      p[a1] = v.min[a1] + ext[a1] * (x + 0.5) / w;
+      p[a2] = v.max[a2] - ext[a2] * (y + 0.5) / h;
+      Vec3 e = g.irradiance(p, n);
+      img.set_rgb(x, y, {std::max(0.0, e.x), std::max(0.0, e.y), std::max(0.0, e.z)});
+    }
+  return img;
+}
+
+void setup_slice(CLI::App& app) {
+  struct Opts { std::string grid, plane, out; int size = 256; bool down = false; double exposure = 0; };
+  auto* o = new Opts();
+  app.add_option("grid", o->grid, ".shgrid file")->required();
+  app.add_option("--plane", o->plane, "axis-aligned plane, e.g. y=0.3")->required();
+  app.add_option("-o,--out", o->out, "output image (.png tone mapped, .exr linear W/m²)")->required();
+  app.add_option("--size", o->size, "image width in pixels")->capture_default_str()->check(CLI::Range(8, 8192));
+  app.add_flag("--down", o->down, "normal along the negative axis (default: positive)");
+  app.footer("Example:\n  iblkit ilf slice room.shgrid --plane y=0.3 --out slice.png");
+  app.callback([o] {
+    auto g = ilf::read_shgrid(o->grid);
+    auto eq = o->plane.find('=');
+    std::string ax = eq == std::string::npos ? "" : o->plane.substr(0, eq);
+    int axis = ax == "x" ? 0 : ax == "y" ? 1 : ax == "z" ? 2 : -1;
+    if (axis < 0) fail(ErrorKind::Value, "--plane: expected x=V, y=V or z=V, got \"{}\"", o->plane);
+    double val;
+    try { val = std::stod(o->plane.substr(eq + 1)); } catch (const std::exception&) {
+      fail(ErrorKind::Value, "--plane: \"{}\" is not a number", o->plane.substr(eq + 1));
+    }
+    Image img = irradiance_slice(g, axis, val, o->size, o->down ? -1 : 1);
+    std::string ext = fs::path(o->out).extension().string();
+    if (ext == ".png" || ext == ".jpg") io::write_image(o->out, io::tonemap(img));
+    else io::write_image(o->out, img);
+    double mx = 0;
+    for (size_t i = 0; i < img.size(); ++i) mx = std::max<double>(mx, img.data()[i]);
+    iblcli::emit({{"out", o->out}, {"width", img.width()}, {"height", img.height()}, {"max_irradiance", mx}},
+                 [&] { fmt::print("wrote {} ({}x{}), max irradiance {:.4g} W/m²\n", o->out, img.width(), img.height(), mx); });
+  });
+}
+
+void setup_info(CLI::App& app) {
+  auto* path = new std::string();
+  app.add_option("grid", *path, ".shgrid file")->required();
+  app.callback([path] {
+    auto g = ilf::read_shgrid(*path);
+    const auto& gd = g.grid();
+    double lo = 1e300, hi = -1e300;
+    int K = g.coeff_count();
+    for (int64_t i = 0; i < gd.count(); ++i)
+      for (int c = 0; c < 3; ++c) {
+        double v = g.data()[size_t(i) * K * 3 + c];
+        lo = std::min(lo, v);
+        hi = std::max(hi, v);
+      }
+    nlohmann::json j = {{"file", *path}, {"bands", g.bands()}, {"coefficients", K}, {"resolution", {gd.nx, gd.ny, gd.nz}},
+                        {"min", {gd.volume.min.x, gd.volume.min.y, gd.volume.min.z}},
+                        {"max", {gd.volume.max.x, gd.volume.max.y, gd.volume.max.z}},
+                        {"bytes", g.data().size() * 4}, {"c00_range", {lo, hi}}};
+    iblcli::emit(j, [&] {
+      fmt::print("file        {}\n", *path);
+      fmt::print("grid        {}x{}x{}, {} bands ({} coefficients), {:.1f} MB\n", gd.nx, gd.ny, gd.nz, g.bands(), K, g.data().size() * 4 / 1048576.0);
+      fmt::print("volume      ({:.4g}, {:.4g}, {:.4g}) .. ({:.4g}, {:.4g}, {:.4g})\n", gd.volume.min.x, gd.volume.min.y, gd.volume.min.z,
+                 gd.volume.max.x, gd.volume.max.y, gd.volume.max.z);
+      fmt::print("c00 range   {:.6g} .. {:.6g}\n", lo, hi);
+    });
+  });
+}
+
+void setup_synth(CLI::App& app) {
+  auto* d = new ilf::SynthDesc();
+  bool* pfm = new bool(false);
+  app.add_option("-o,--out", d->out_dir, "output folder (frames/ and sequence.json)")->required();
+  app.add_option("--probes", d->probes, "number of probes")->capture_default_str()->check(CLI::Range(1, 1000000));
+  app.add_option("--size", d->size, "mirror-ball frame size in pixels")->capture_default_str()->check(CLI::Range(8, 4096));
+  app.add_option("--supersample", d->supersample, "sub-samples per pixel axis")->capture_default_str()->check(CLI::Range(1, 16));
+  app.add_option("--seed", d->seed, "random positions seed")->capture_default_str();
+  app.add_flag("--pfm", *pfm, "float PFM frames instead of half-float EXR");
+  app.footer("A closed-form light field (three emitting spheres outside a 1 m cube and a sky) captured by\n"
+             "mirror balls at random positions in the cube: for tests, benchmarks and trying the pipeline.\n"
+             "Example:\n  iblkit ilf synth --out /tmp/seq --probes 500 --size 64");
+  app.callback([d, pfm] {
+    d->half = !*pfm;
+    auto m = ilf::write_synthetic_sequence(ilf::AnalyticField::three_spheres(), *d, iblcli::progress_bar());
+    iblcli::progress_done();
+    iblcli::emit({{"manifest", m}, {"probes", d->probes}}, [&] { fmt::print("wrote {} ({} probes)\n", m, d->probes); });
+  });
+}
+
+void setup(CLI::App& app) {
+  app.require_subcommand(1);
+  setup_build(*app.add_subcommand("build", "Resample a probe sequence into an SH grid (.shgrid)"));
+  setup_query(*app.add_subcommand("query", "SH, irradiance, radiance and glossy response at a point of a grid"));
+  setup_slice(*app.add_subcommand("slice", "Irradiance on a plane through the grid, as a picture"));
+  setup_info(*app.add_subcommand("info", "Describe an .shgrid"));
+  setup_synth(*app.add_subcommand("synth", "Write a synthetic probe sequence of a closed-form light field"));
+}
+
+iblcli::Command reg("ilf", "Incident light fields: probe sequences -> SH grids, queries, slices", setup, 50);
+
+}  // namespace

@@ -1,0 +1,259 @@
+#include "iblkit/ilf/buckets.h"
+
+#include <Imath/half.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <numeric>
+
+#include <nlohmann/json.hpp>
+
+#include "iblkit/core/error.h"
+#include "iblkit/core/parallel.h"
+#include "iblkit/io/image_io.h"
+
+namespace ibl::ilf {
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+void halves_to_floats(const uint16_t* in, float* out, size_t n) {
+  for (size_t i = 0; i < n; ++i) {
+    Imath::half h;
+    h.setBits(in[i]);
+    out[i] = float(h);
+  }
+}
+void floats_to_halves(const float* in, uint16_t* out, size_t n) {
+  for (size_t i = 0; i < n; ++i) out[i] = Imath::half(in[i]).bits();
+}
+
+DirectionTable make_direction_table(const Sequence& seq, int width, int height, const BucketDesc& desc,
+                                    int64_t probe_count) {
+  sphere::Mapping m(seq.mapping, width, height, seq.dead_angle_deg);
+  int n = desc.octahedral;
+  if (n < 0 || n > 4096) fail(ErrorKind::Value, "direction buckets: octahedral resolution {} outside [0, 4096]", n);
+  sphere::Mapping oct(sphere::MappingKind::Octahedral, std::max(n, 1), std::max(n, 1));
+  struct Slot { int64_t bucket; int32_t pixel; Vec3 d; double w; };
+  std::vector<Slot> slots;
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      Vec3 d;
+      if (!m.to_direction(x + 0.5, y + 0.5, &d)) continue;
+      double w = m.solid_angle(x, y);
+      if (!(w > 0)) continue;
+      d = normalize(seq.rotation * d);
+      int64_t b = int64_t(y) * width + x;
+      if (n > 0) {
+        double px, py;
+        oct.to_pixel(d, &px, &py);
+        b = std::clamp(int(py), 0, n - 1) * int64_t(n) + std::clamp(int(px), 0, n - 1);
+      }
+      slots.push_back({b, int32_t(int64_t(y) * width + x), d, w});
+    }
+  if (slots.empty()) fail(ErrorKind::Value, "{}: frames of {}x{} in mapping {} carry no directions", seq.manifest, width, height, sphere::mapping_name(seq.mapping));
+  std::stable_sort(slots.begin(), slots.end(), [](const Slot& a, const Slot& b) { return a.bucket < b.bucket; });
+  DirectionTable t;
+  t.width = width;
+  t.height = height;
+  t.pixel.reserve(slots.size());
+  for (size_t i = 0; i < slots.size(); ++i) {
+    if (i == 0 || slots[i].bucket != slots[i - 1].bucket) t.bucket_begin.push_back(int64_t(i));
+    t.pixel.push_back(slots[i].pixel);
+    t.dir.insert(t.dir.end(), {float(slots[i].d.x), float(slots[i].d.y), float(slots[i].d.z)});
+    t.weight.push_back(slots[i].w);
+  }
+  t.bucket_begin.push_back(int64_t(slots.size()));
+  // Blocks: at most max_block_buckets buckets and at most 1/8 of the memory budget of samples.
+  size_t block_bytes_cap = std::max<size_t>(desc.memory_bytes / 8, 1 << 20);
+  t.block_begin.push_back(0);
+  int64_t in_block = 0;
+  for (int b = 0; b < t.buckets(); ++b) {
+    int64_t nb = t.bucket_begin[b + 1] - t.bucket_begin[b];
+    bool full = b - t.block_begin.back() >= desc.max_block_buckets ||
+                (in_block > 0 && size_t(in_block + nb) * probe_count * 6 > block_bytes_cap);
+    if (full) {
+      t.block_begin.push_back(b);
+      in_block = 0;
+    }
+    in_block += nb;
+  }
+  t.block_begin.push_back(t.buckets());
+  return t;
+}
+
+namespace {
+
+std::string block_path(const std::string& dir, int k) { return (fs::path(dir) / fmt::format("block_{:05d}.bin", k)).string(); }
+
+// FNV-1a over the inputs that determine the block files' contents.
+std::string cache_key(const Sequence& seq, const BucketDesc& desc, int w, int h) {
+  uint64_t hsh = 1469598103934665603ull;
+  auto mix = [&](const std::string& s) {
+    for (unsigned char c : s) { hsh ^= c; hsh *= 1099511628211ull; }
+  };
+  mix(fmt::format("v1 {} {} {} {} {} {} {} {} {}", sphere::mapping_name(seq.mapping), seq.dead_angle_deg, w, h,
+                  desc.octahedral, desc.max_block_buckets, desc.memory_bytes, desc.skip_bad, desc.sanitize));
+  for (int a = 0; a < 3; ++a) mix(fmt::format("{} {} {}", seq.rotation.m[a][0], seq.rotation.m[a][1], seq.rotation.m[a][2]));
+  for (const auto& p : seq.probes) {
+    std::error_code ec;
+    auto sz = fs::file_size(p.image, ec);
+    auto mt = fs::last_write_time(p.image, ec).time_since_epoch().count();
+    mix(fmt::format("{}|{}|{}", p.image, ec ? 0 : sz, ec ? 0 : mt));
+  }
+  return fmt::format("{:016x}-{}", hsh, seq.probes.size());
+}
+
+}  // namespace
+
+void BucketStore::load_block(int k, std::vector<uint16_t>& buf) const {
+  const auto& t = table_;
+  int64_t s0 = t.bucket_begin[t.block_begin[k]], s1 = t.bucket_begin[t.block_begin[k + 1]];
+  size_t n = size_t(s1 - s0) * probe_count_ * 3;
+  buf.resize(n);
+  std::string path = block_path(dir_, k);
+  FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) fail(ErrorKind::Io, "{}: cannot open bucket block", path);
+  size_t got = std::fread(buf.data(), 2, n, f);
+  std::fclose(f);
+  if (got != n) fail(ErrorKind::Format, "{}: bucket block truncated ({} of {} values)", path, got, n);
+}
+
+const uint16_t* BucketStore::samples(const std::vector<uint16_t>& buf, int k, int b, int p) const {
+  const auto& t = table_;
+  int64_t s0 = t.bucket_begin[t.block_begin[k]], s1 = t.bucket_begin[t.block_begin[k + 1]];
+  int64_t c = p / chunk_, pc = std::min<int64_t>(chunk_, probe_count_ - c * chunk_);
+  size_t seg = size_t(c) * chunk_ * size_t(s1 - s0) * 3;
+  int64_t nb = t.bucket_begin[b + 1] - t.bucket_begin[b];
+  return buf.data() + seg + size_t(pc) * size_t(t.bucket_begin[b] - s0) * 3 + size_t(p - c * chunk_) * nb * 3;
+}
+
+BucketStore BucketStore::sort(const Sequence& seq, const BucketDesc& desc, const ProgressFn& progress,
+                              BucketReport* report) {
+  if (desc.dir.empty()) fail(ErrorKind::Value, "direction buckets: no folder given for the block files");
+  std::error_code ec;
+  fs::create_directories(desc.dir, ec);
+  if (ec) fail(ErrorKind::Io, "{}: cannot create the bucket folder ({})", desc.dir, ec.message());
+  BucketReport local;
+  BucketReport& rep = report ? *report : local;
+  // The first readable frame fixes the size.
+  int w = 0, h = 0;
+  for (size_t i = 0; i < seq.probes.size() && w == 0; ++i) {
+    try {
+      Image img = io::read_image(seq.probes[i].image, {desc.sanitize, 3});
+      w = img.width();
+      h = img.height();
+    } catch (const Error& e) {
+      if (!desc.skip_bad) fail(e.kind(), "probe {}: field \"image\": {}", i, e.what());
+    }
+  }
+  if (w == 0) fail(ErrorKind::Io, "{}: no probe frame could be read", seq.manifest);
+  BucketStore st;
+  st.dir_ = desc.dir;
+  st.probe_count_ = int(seq.probes.size());
+  st.table_ = make_direction_table(seq, w, h, desc, st.probe_count_);
+  const auto& t = st.table_;
+  size_t per_probe = size_t(t.slots()) * 3 * 2;
+  st.chunk_ = int(std::clamp<size_t>(desc.memory_bytes / 4 / per_probe, 1, size_t(st.probe_count_)));
+  std::string key = cache_key(seq, desc, w, h);
+  fs::path index = fs::path(desc.dir) / "index.json";
+  if (desc.reuse && fs::exists(index)) {
+    try {
+      std::ifstream in(index);
+      json j = json::parse(in);
+      bool ok = j.value("key", "") == key && j.value("chunk", 0) == st.chunk_;
+      for (int k = 0; ok && k < t.blocks(); ++k) {
+        size_t expect = size_t(t.bucket_begin[t.block_begin[k + 1]] - t.bucket_begin[t.block_begin[k]]) * st.probe_count_ * 6;
+        ok = fs::exists(block_path(desc.dir, k)) && fs::file_size(block_path(desc.dir, k)) == expect;
+      }
+      if (ok) {
+        st.valid_ = j["valid"].get<std::vector<uint8_t>>();
+        rep.reused = true;
+        rep.skipped = j.value("skipped", 0);
+        rep.reasons = j.value("reasons", std::vector<std::string>{});
+        ibl::report(progress, "sort", 1.0);
+        return st;
+      }
+    } catch (const std::exception&) {
+      // An unreadable index means the files are rebuilt.
+    }
+  }
+  fs::remove(index, ec);
+  for (int k = 0; k < t.blocks(); ++k) {
+    FILE* f = std::fopen(block_path(desc.dir, k).c_str(), "wb");
+    if (!f) fail(ErrorKind::Io, "{}: cannot create bucket block", block_path(desc.dir, k));
+    std::fclose(f);
+  }
+  st.valid_.assign(st.probe_count_, 1);
+  std::vector<uint16_t> chunk(size_t(st.chunk_) * t.slots() * 3);
+  std::mutex mu;
+  std::atomic<int64_t> done{0};
+  double read_s = 0;
+  for (int c0 = 0; c0 < st.probe_count_; c0 += st.chunk_) {
+    int pc = std::min(st.chunk_, st.probe_count_ - c0);
+    auto t0 = std::chrono::steady_clock::now();
+    parallel_for(0, pc, [&](int64_t i) {
+      int p = c0 + int(i);
+      const auto& pe = seq.probes[p];
+      std::string bad;
+      Image img;
+      try {
+        img = io::read_image(pe.image, {desc.sanitize, 3});
+        if (img.width() != w || img.height() != h)
+          bad = fmt::format("field \"image\": {} is {}x{}, the sequence's frames are {}x{}", pe.image, img.width(), img.height(), w, h);
+      } catch (const Error& e) {
+        bad = fmt::format("field \"image\": {}", e.what());
+      }
+      std::vector<float> rgb(size_t(t.slots()) * 3);
+      if (bad.empty()) {
+        double sum = 0;
+        for (int64_t s = 0; s < t.slots(); ++s) {
+          const float* px = img.data() + size_t(t.pixel[s]) * img.channels();
+          for (int ch = 0; ch < 3; ++ch) rgb[s * 3 + ch] = img.channels() >= 3 ? px[ch] : px[0];
+          sum += rgb[s * 3] + rgb[s * 3 + 1] + rgb[s * 3 + 2];
+        }
+        if (!(sum > 0)) bad = fmt::format("field \"image\": {} is all black inside the mapping", pe.image);
+      }
+      if (!bad.empty()) {
+        std::string msg = fmt::format("{}: probe {}: {}", seq.manifest, p, bad);
+        if (!desc.skip_bad) fail(ErrorKind::Value, "{} (use --skip-bad to skip such probes)", msg);
+        std::fill(rgb.begin(), rgb.end(), 0.0f);
+        std::lock_guard lk(mu);
+        st.valid_[p] = 0;
+        ++rep.skipped;
+        rep.reasons.push_back(msg);
+      }
+      // Scatter into the chunk buffer: bucket b's region holds [probe in chunk][sample][rgb].
+      for (int b = 0; b < t.buckets(); ++b) {
+        int64_t s0 = t.bucket_begin[b], nb = t.bucket_begin[b + 1] - s0;
+        floats_to_halves(rgb.data() + s0 * 3, chunk.data() + (size_t(pc) * s0 + size_t(i) * nb) * 3, size_t(nb) * 3);
+      }
+      ibl::report(progress, "sort", 0.9 * double(++done) / st.probe_count_);
+    });
+    read_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    for (int k = 0; k < t.blocks(); ++k) {
+      int64_t s0 = t.bucket_begin[t.block_begin[k]], s1 = t.bucket_begin[t.block_begin[k + 1]];
+      FILE* f = std::fopen(block_path(desc.dir, k).c_str(), "ab");
+      size_t n = size_t(pc) * size_t(s1 - s0) * 3;
+      if (!f || std::fwrite(chunk.data() + size_t(pc) * s0 * 3, 2, n, f) != n) {
+        if (f) std::fclose(f);
+        fail(ErrorKind::Io, "{}: write failed (disk full?)", block_path(desc.dir, k));
+      }
+      std::fclose(f);
+      rep.bytes_written += int64_t(n) * 2;
+    }
+  }
+  rep.read_seconds = read_s;
+  if (rep.skipped == st.probe_count_) fail(ErrorKind::Value, "{}: every probe was skipped", seq.manifest);
+  json j = {{"key", key}, {"chunk", st.chunk_}, {"valid", st.valid_}, {"skipped", rep.skipped}, {"reasons", rep.reasons},
+            {"width", w}, {"height", h}, {"buckets", t.buckets()}, {"blocks", t.blocks()}};
+  std::ofstream out(index);
+  out << j.dump() << "\n";
+  ibl::report(progress, "sort", 1.0);
+  return st;
+}
+
+}  // namespace ibl::ilf

@@ -1,0 +1,153 @@
+#include "iblkit/ilf/build.h"
+
+#include <Eigen/Core>
+#include <tbb/enumerable_thread_specific.h>
+
+#include <atomic>
+#include <chrono>
+
+#include "iblkit/core/error.h"
+#include "iblkit/core/parallel.h"
+#include "iblkit/io/image_io.h"
+#include "iblkit/sh/basis.h"
+
+namespace ibl::ilf {
+
+namespace {
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+}  // namespace
+
+double accumulate_block(const float* R, int64_t rows, int D, const float* B, int K, float* C) {
+  using MatF = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor>;
+  Eigen::Map<const MatF, 0, Eigen::OuterStride<>> Rm(R, rows, D, Eigen::OuterStride<>(rows));
+  Eigen::Map<const MatF> Bm(B, D, K);
+  Eigen::Map<MatF, 0, Eigen::OuterStride<>> Cm(C, rows, K, Eigen::OuterStride<>(rows));
+  constexpr int64_t kChunk = 2048;  // rows per task: (2048 × D + 2048 × K) floats stay in L2
+  parallel_for(0, (rows + kChunk - 1) / kChunk, [&](int64_t c) {
+    int64_t r0 = c * kChunk, n = std::min(kChunk, rows - r0);
+    Cm.middleRows(r0, n).noalias() += Rm.middleRows(r0, n) * Bm;
+  });
+  return 2.0 * double(rows) * D * K;
+}
+
+std::vector<float> bucket_basis(const DirectionTable& t, int b0, int b1, int bands) {
+  int K = bands * bands, D = b1 - b0;
+  std::vector<float> B(size_t(D) * K, 0.0f);
+  std::vector<double> y(static_cast<size_t>(K));
+  for (int j = 0; j < D; ++j) {
+    std::vector<double> acc(size_t(K), 0.0);
+    for (int64_t s = t.bucket_begin[b0 + j]; s < t.bucket_begin[b0 + j + 1]; ++s) {
+      Vec3 d{t.dir[3 * s], t.dir[3 * s + 1], t.dir[3 * s + 2]};
+      sh::eval_basis(bands, normalize(d), y.data());
+      for (int k = 0; k < K; ++k) acc[k] += t.weight[s] * y[k];
+    }
+    for (int k = 0; k < K; ++k) B[size_t(k) * D + j] = float(acc[k]);
+  }
+  return B;
+}
+
+SHGrid build_shgrid(const Sequence& seq_in, const BuildDesc& desc, const ProgressFn& progress, BuildReport* report) {
+  auto t_all = Clock::now();
+  BuildReport local;
+  BuildReport& rep = report ? *report : local;
+  if (desc.bands < 1 || desc.bands > 10) fail(ErrorKind::Value, "--bands {} outside [1, 10]", desc.bands);
+  if (!(desc.project.kernel_cells > 0)) fail(ErrorKind::Value, "--kernel {} must be > 0 cells", desc.project.kernel_cells);
+  GridDesc grid{desc.nx, desc.ny, desc.nz, desc.volume ? *desc.volume : seq_in.volume};
+  SHGrid out(grid, desc.bands);  // validates resolution, bands and volume
+  rep.probes_in = int(seq_in.probes.size());
+  Sequence seq = seq_in;
+  if (desc.subsample) {
+    auto t0 = Clock::now();
+    auto keep = subsample(seq_in, *desc.subsample, progress);
+    seq.probes.clear();
+    for (int i : keep) seq.probes.push_back(seq_in.probes[i]);
+    rep.t_subsample = since(t0);
+  }
+  // Sort.
+  auto t0 = Clock::now();
+  BucketDesc bd = desc.buckets;
+  if (bd.octahedral < 0) {
+    // Auto: pixel buckets for small frames, else octahedral cells (see docs/ilf.md for the trade-off).
+    int64_t pixels = 0;
+    for (const auto& p : seq.probes) {
+      try {
+        Image img = io::read_image(p.image, {bd.sanitize, 3});
+        pixels = int64_t(img.width()) * img.height();
+        break;
+      } catch (const Error&) {
+        if (!bd.skip_bad) throw;
+      }
+    }
+    bd.octahedral = pixels > desc.auto_pixel_buckets ? desc.auto_octahedral : 0;
+  }
+  BucketReport br;
+  BucketStore store = BucketStore::sort(seq, bd, progress, &br);
+  rep.t_sort = since(t0);
+  rep.skipped = br.skipped;
+  rep.skip_reasons = br.reasons;
+  rep.buckets_reused = br.reused;
+  const DirectionTable& t = store.table();
+  rep.octahedral = bd.octahedral;
+  rep.buckets = t.buckets();
+  rep.blocks = t.blocks();
+  int P = store.probe_count();
+  rep.probes_used = P - br.skipped;
+  std::vector<Vec3> origins(static_cast<size_t>(P));
+  for (int p = 0; p < P; ++p) origins[p] = seq.probes[p].position;
+  // Resample, block by block.
+  int K = desc.bands * desc.bands;
+  int64_t G = grid.count(), rows = 3 * G;
+  std::vector<float> C(size_t(rows) * K, 0.0f), R;
+  std::vector<uint16_t> buf;
+  tbb::enumerable_thread_specific<ProjectScratch> scratch;
+  struct Ctx { const float* data; int64_t stride; };
+  std::atomic<int64_t> samples{0}, uncovered{0};
+  for (int k = 0; k < t.blocks(); ++k) {
+    auto tp = Clock::now();
+    store.load_block(k, buf);
+    int b0 = t.block_begin[k], b1 = t.block_begin[k + 1], D = b1 - b0;
+    R.assign(size_t(rows) * D, 0.0f);
+    parallel_for(0, D, [&](int64_t j) {
+      int b = b0 + int(j);
+      int nb = int(t.bucket_begin[b + 1] - t.bucket_begin[b]);
+      std::vector<float> rad(size_t(P) * nb * 3);
+      for (int p = 0; p < P; ++p) halves_to_floats(store.samples(buf, k, b, p), rad.data() + size_t(p) * nb * 3, size_t(nb) * 3);
+      Ctx ctx{rad.data(), int64_t(nb) * 3};
+      BucketRays rays;
+      rays.dirs = t.dir.data() + t.bucket_begin[b] * 3;
+      rays.weights = t.weight.data() + t.bucket_begin[b];
+      rays.n_dirs = nb;
+      rays.origins = origins.data();
+      rays.valid = store.valid().data();
+      rays.n_probes = P;
+      rays.ctx = &ctx;
+      rays.radiance = [](const void* c, int p) {
+        auto* x = static_cast<const Ctx*>(c);
+        return x->data + p * x->stride;
+      };
+      auto st = project_bucket(grid, rays, desc.project, R.data() + size_t(j) * rows, G, scratch.local());
+      samples += st.rays;
+      uncovered += st.uncovered;
+    });
+    rep.t_project += since(tp);
+    auto ta = Clock::now();
+    auto B = bucket_basis(t, b0, b1, desc.bands);
+    rep.gemm_flops += accumulate_block(R.data(), rows, D, B.data(), K, C.data());
+    rep.t_accumulate += since(ta);
+    ibl::report(progress, "resample", double(k + 1) / t.blocks());
+  }
+  // C(c·G + g, k) → data[(g·K + k)·3 + c].
+  auto& data = out.data();
+  parallel_for(0, G, [&](int64_t g) {
+    for (int kk = 0; kk < K; ++kk)
+      for (int c = 0; c < 3; ++c) data[(size_t(g) * K + kk) * 3 + c] = C[size_t(kk) * rows + size_t(c) * G + g];
+  }, 1024);
+  rep.samples = samples;
+  rep.uncovered = uncovered;
+  rep.fraction_uncovered = double(uncovered) / (double(G) * t.buckets());
+  rep.t_total = since(t_all);
+  return out;
+}
+
+}  // namespace ibl::ilf

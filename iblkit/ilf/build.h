@@ -1,0 +1,53 @@
+// `ilf build`: probe sequence → SH grid, the pipeline of [1] §3 as batched kernels over blocks of
+// direction buckets: (1) optional sub-sampling, (2) out-of-core bucket sort, then per block
+// (3) radiance projection of every bucket onto the grid, (4) repair, (5) SH accumulation as one matrix
+// product (grid points × buckets)·(buckets × coefficients). A GPU backend or a distributed driver
+// replaces the per-block loop (project_block / accumulate_block) without touching the maths.
+#pragma once
+#include <optional>
+#include <string>
+
+#include "iblkit/core/progress.h"
+#include "iblkit/ilf/buckets.h"
+#include "iblkit/ilf/project.h"
+#include "iblkit/ilf/shgrid.h"
+#include "iblkit/ilf/subsample.h"
+
+namespace ibl::ilf {
+
+struct BuildDesc {
+  int nx = 16, ny = 16, nz = 16;      // grid resolution (points per axis)
+  std::optional<Box> volume;          // grid volume; default the sequence's volume
+  int bands = 5;                      // SH bands (5 = 25 coefficients)
+  ProjectDesc project;                // kernel, raster, repair
+  BucketDesc buckets;                 // bucket folder, memory budget, skip-bad; octahedral = −1 for auto
+  int auto_pixel_buckets = 4096;      // auto: one bucket per pixel when a frame has at most this many
+  int auto_octahedral = 24;           // auto: otherwise n×n octahedral buckets with this n
+  std::optional<SubsampleDesc> subsample;  // sub-sample first when set
+};
+
+struct BuildReport {
+  int probes_in = 0, probes_used = 0;  // before and after sub-sampling / skipping
+  int skipped = 0;                     // frames skipped (--skip-bad), manifest and frames together
+  std::vector<std::string> skip_reasons;
+  int buckets = 0, blocks = 0;         // direction buckets and blocks
+  int octahedral = 0;                  // 0 = pixel buckets
+  int64_t samples = 0;                 // radiance samples (rays) used
+  int64_t uncovered = 0;               // (grid point, bucket) pairs filled by the repair
+  double fraction_uncovered = 0;       // uncovered / (grid points · buckets)
+  bool buckets_reused = false;         // an earlier run's bucket files were reused
+  double t_subsample = 0, t_sort = 0, t_project = 0, t_accumulate = 0, t_total = 0;  // seconds
+  double gemm_flops = 0;               // floating-point operations of the SH matrix products
+};
+
+// SH accumulation of one block: C (rows × K, column-major) += R (rows × D, column-major) · B (D × K,
+// column-major), in parallel over row chunks (Eigen for the products). Returns the flop count.
+double accumulate_block(const float* R, int64_t rows, int D, const float* B, int K, float* C);
+
+// Basis rows of buckets [b0, b1): B(j, k) = Σ_{q ∈ bucket b0+j} Ω_q·Y_k(ω_q), column-major (D × K).
+std::vector<float> bucket_basis(const DirectionTable& t, int b0, int b1, int bands);
+
+SHGrid build_shgrid(const Sequence& seq, const BuildDesc& desc, const ProgressFn& progress = {},
+                    BuildReport* report = nullptr);
+
+}  // namespace ibl::ilf

@@ -1,0 +1,262 @@
+#include "iblkit/ilf/project.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "iblkit/core/error.h"
+
+namespace ibl::ilf {
+
+const char* repair_name(Repair r) {
+  switch (r) {
+    case Repair::None: return "none";
+    case Repair::Mip: return "mip";
+    case Repair::PullPush: return "pullpush";
+  }
+  return "?";
+}
+
+Repair parse_repair(const std::string& s) {
+  if (s == "none") return Repair::None;
+  if (s == "mip") return Repair::Mip;
+  if (s == "pullpush" || s == "pull-push") return Repair::PullPush;
+  fail(ErrorKind::Value, "--repair: unknown method \"{}\" (none, mip, pullpush)", s);
+}
+
+namespace {
+
+// Pull–push on a W×H raster of RGB values with binary coverage (Gortler et al. 1996, "The Lumigraph",
+// §3.4): pull builds coarser levels as coverage-weighted box averages with weight min(1, Σw); push
+// replaces each value by w·v + (1 − w)·(bilinear of the coarser level). Pixels with data keep theirs.
+void pull_push(std::vector<float>& v, std::vector<float>& w, int W, int H, std::vector<float>& tmp) {
+  struct Level { size_t off; int w, h; };
+  std::vector<Level> lv{{0, W, H}};
+  size_t total = size_t(W) * H;
+  while (lv.back().w > 1 || lv.back().h > 1) {
+    int nw = (lv.back().w + 1) / 2, nh = (lv.back().h + 1) / 2;
+    lv.push_back({total, nw, nh});
+    total += size_t(nw) * nh;
+  }
+  tmp.assign(total * 4, 0.0f);  // per pixel: r, g, b, w
+  for (size_t i = 0; i < size_t(W) * H; ++i) {
+    tmp[i * 4 + 0] = v[i * 3 + 0];
+    tmp[i * 4 + 1] = v[i * 3 + 1];
+    tmp[i * 4 + 2] = v[i * 3 + 2];
+    tmp[i * 4 + 3] = w[i];
+  }
+  for (size_t l = 1; l < lv.size(); ++l) {
+    const Level &f = lv[l - 1], &c = lv[l];
+    for (int y = 0; y < c.h; ++y)
+      for (int x = 0; x < c.w; ++x) {
+        float acc[4] = {0, 0, 0, 0};
+        for (int dy = 0; dy < 2; ++dy)
+          for (int dx = 0; dx < 2; ++dx) {
+            int fx = 2 * x + dx, fy = 2 * y + dy;
+            if (fx >= f.w || fy >= f.h) continue;
+            const float* p = &tmp[(f.off + size_t(fy) * f.w + fx) * 4];
+            for (int ch = 0; ch < 3; ++ch) acc[ch] += p[3] * p[ch];
+            acc[3] += p[3];
+          }
+        float* q = &tmp[(c.off + size_t(y) * c.w + x) * 4];
+        for (int ch = 0; ch < 3; ++ch) q[ch] = acc[3] > 0 ? acc[ch] / acc[3] : 0.0f;
+        q[3] = std::min(1.0f, acc[3]);
+      }
+  }
+  for (size_t l = lv.size() - 1; l-- > 0;) {
+    const Level &f = lv[l], &c = lv[l + 1];
+    for (int y = 0; y < f.h; ++y)
+      for (int x = 0; x < f.w; ++x) {
+        float* p = &tmp[(f.off + size_t(y) * f.w + x) * 4];
+        if (p[3] >= 1.0f) continue;
+        double cx = std::clamp((x + 0.5) / 2 - 0.5, 0.0, double(c.w - 1)), cy = std::clamp((y + 0.5) / 2 - 0.5, 0.0, double(c.h - 1));
+        int x0 = int(cx), y0 = int(cy), x1 = std::min(x0 + 1, c.w - 1), y1 = std::min(y0 + 1, c.h - 1);
+        float fx = float(cx - x0), fy = float(cy - y0);
+        for (int ch = 0; ch < 3; ++ch) {
+          auto at = [&](int xx, int yy) { return tmp[(c.off + size_t(yy) * c.w + xx) * 4 + ch]; };
+          float up = (1 - fy) * ((1 - fx) * at(x0, y0) + fx * at(x1, y0)) + fy * ((1 - fx) * at(x0, y1) + fx * at(x1, y1));
+          p[ch] = p[3] * p[ch] + (1 - p[3]) * up;
+        }
+        p[3] = 1.0f;
+      }
+  }
+  for (size_t i = 0; i < size_t(W) * H; ++i)
+    for (int ch = 0; ch < 3; ++ch) v[i * 3 + ch] = tmp[i * 4 + ch];
+}
+
+}  // namespace
+
+// Derivation (radiance projection of one bucket, [1] §3.2 done on a plane):
+//   A bucket holds rays R_pq(s) = x_p + s·ω_q, q over the bucket's directions (one in pixel buckets),
+//   p over the probes. Let ω_b be the solid-angle-weighted mean of the ω_q and Π the plane through the
+//   volume centre c perpendicular to ω_b, with orthonormal axes (t, u). Ray pq meets Π at
+//     y_pq = x_p + λ·ω_q,  λ = (c − x_p)·ω_b / (ω_q·ω_b),
+//   and a grid point g projects (along ω_b) to (g − c)·(t, u). For parallel rays (ω_q = ω_b) the 2D
+//   distance between the two is exactly the distance from g to the ray, for either sign of s: the
+//   sample is projected through the whole volume in both directions. The estimate is the normalised
+//   Gaussian-weighted mean of the rays passing g within the kernel's support R = kernel·h/2:
+//   ┌─────────────────────────────────────────────────────────────────────────────┐
+//   │ L_b(g) = Σ_pq K(d_pq(g)) L_pq / Σ_pq K(d_pq(g)),  K(d) = exp(−d²/2σ²)·[d < R], σ = R/2 │
+//   └─────────────────────────────────────────────────────────────────────────────┘
+//   Numerator and denominator are splatted onto a raster of Π (pixel Δ = raster_cells·h) and read
+//   back bilinearly at the projected grid points: O(rays·(2R/Δ)² + grid points) per bucket instead of
+//   O(rays·grid points along the ray). For non-parallel rays of an octahedral bucket, the 2D distance
+//   differs from the 3D one by at most |(g − c)·ω_b|·sin∠(ω_q, ω_b).
+ProjectStats project_bucket(const GridDesc& grid, const BucketRays& rays, const ProjectDesc& desc, float* out,
+                            int64_t out_stride, ProjectScratch& sc) {
+  ProjectStats st;
+  Vec3 sp = grid.spacing();
+  double h = std::max({sp.x, sp.y, sp.z});
+  double R = std::max(desc.kernel_cells, 1e-3) * h / 2, sigma = R / 2, delta = std::max(desc.raster_cells, 0.05) * h;
+  Vec3 wb{0, 0, 0};
+  for (int q = 0; q < rays.n_dirs; ++q)
+    wb += Vec3(rays.dirs[3 * q], rays.dirs[3 * q + 1], rays.dirs[3 * q + 2]) * rays.weights[q];
+  wb = normalize(wb);
+  Frame fr = Frame::from_normal(wb);
+  Vec3 c = grid.volume.centre();
+  // Raster extent: the projected volume corners plus the support.
+  double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
+  for (int k = 0; k < 8; ++k) {
+    Vec3 p{(k & 1) ? grid.volume.max.x : grid.volume.min.x, (k & 2) ? grid.volume.max.y : grid.volume.min.y,
+           (k & 4) ? grid.volume.max.z : grid.volume.min.z};
+    double a = dot(p - c, fr.t), b = dot(p - c, fr.b);
+    lo[0] = std::min(lo[0], a); hi[0] = std::max(hi[0], a);
+    lo[1] = std::min(lo[1], b); hi[1] = std::max(hi[1], b);
+  }
+  lo[0] -= R + delta; lo[1] -= R + delta; hi[0] += R + delta; hi[1] += R + delta;
+  int W = int(std::ceil((hi[0] - lo[0]) / delta)) + 1, H = int(std::ceil((hi[1] - lo[1]) / delta)) + 1;
+  size_t npx = size_t(W) * H;
+  sc.num.assign(npx * 3, 0.0f);
+  sc.den.assign(npx, 0.0f);
+  int rad_px = int(std::ceil(R / delta));
+  double inv2s2 = 1.0 / (2 * sigma * sigma), R2 = R * R;
+  for (int p = 0; p < rays.n_probes; ++p) {
+    if (rays.valid && !rays.valid[p]) continue;
+    const float* L = rays.radiance(rays.ctx, p);
+    Vec3 x = rays.origins[p];
+    double num_c = dot(c - x, wb);
+    for (int q = 0; q < rays.n_dirs; ++q) {
+      Vec3 wq{rays.dirs[3 * q], rays.dirs[3 * q + 1], rays.dirs[3 * q + 2]};
+      double cosq = dot(wq, wb);
+      if (cosq < 1e-3) continue;
+      Vec3 y = x + wq * (num_c / cosq) - c;
+      double px = (dot(y, fr.t) - lo[0]) / delta, py = (dot(y, fr.b) - lo[1]) / delta;  // raster coords
+      int cx = int(std::floor(px)), cy = int(std::floor(py));
+      if (cx < -rad_px || cy < -rad_px || cx >= W + rad_px || cy >= H + rad_px) continue;
+      ++st.rays;
+      float r = L[3 * q], g = L[3 * q + 1], b = L[3 * q + 2];
+      for (int yy = std::max(0, cy - rad_px); yy <= std::min(H - 1, cy + rad_px + 1); ++yy) {
+        double dy = (yy - py) * delta;
+        for (int xx = std::max(0, cx - rad_px); xx <= std::min(W - 1, cx + rad_px + 1); ++xx) {
+          double dx = (xx - px) * delta, d2 = dx * dx + dy * dy;
+          if (d2 >= R2) continue;
+          float k = float(std::exp(-d2 * inv2s2));
+          size_t i = size_t(yy) * W + xx;
+          sc.num[i * 3] += k * r;
+          sc.num[i * 3 + 1] += k * g;
+          sc.num[i * 3 + 2] += k * b;
+          sc.den[i] += k;
+        }
+      }
+    }
+  }
+  // Raster pixel (xx, yy) is the plane point lo + (xx, yy)·Δ (the splat above evaluates K there).
+  bool plane_fill = desc.repair == Repair::PullPush;
+  if (plane_fill) {
+    sc.rad.assign(npx * 3, 0.0f);
+    std::vector<float> w(npx);
+    for (size_t i = 0; i < npx; ++i) {
+      w[i] = sc.den[i] > 0 ? 1.0f : 0.0f;
+      for (int ch = 0; ch < 3; ++ch) sc.rad[i * 3 + ch] = sc.den[i] > 0 ? sc.num[i * 3 + ch] / sc.den[i] : 0.0f;
+    }
+    pull_push(sc.rad, w, W, H, sc.tmp);
+  }
+  int64_t G = grid.count();
+  sc.covered.assign(size_t(G), 0);
+  for (int64_t gi = 0; gi < G; ++gi) {
+    Vec3 d = grid.point(gi) - c;
+    double px = std::clamp((dot(d, fr.t) - lo[0]) / delta, 0.0, W - 1.001), py = std::clamp((dot(d, fr.b) - lo[1]) / delta, 0.0, H - 1.001);
+    int x0 = int(px), y0 = int(py);
+    float fx = float(px - x0), fy = float(py - y0);
+    size_t i00 = size_t(y0) * W + x0, i10 = i00 + 1, i01 = i00 + W, i11 = i01 + 1;
+    float w00 = (1 - fx) * (1 - fy), w10 = fx * (1 - fy), w01 = (1 - fx) * fy, w11 = fx * fy;
+    float den = w00 * sc.den[i00] + w10 * sc.den[i10] + w01 * sc.den[i01] + w11 * sc.den[i11];
+    if (den > 0) {
+      sc.covered[gi] = 1;
+      for (int ch = 0; ch < 3; ++ch)
+        out[ch * out_stride + gi] = (w00 * sc.num[i00 * 3 + ch] + w10 * sc.num[i10 * 3 + ch] + w01 * sc.num[i01 * 3 + ch] +
+                                     w11 * sc.num[i11 * 3 + ch]) / den;
+    } else {
+      ++st.uncovered;
+      for (int ch = 0; ch < 3; ++ch)
+        out[ch * out_stride + gi] = plane_fill ? w00 * sc.rad[i00 * 3 + ch] + w10 * sc.rad[i10 * 3 + ch] +
+                                                     w01 * sc.rad[i01 * 3 + ch] + w11 * sc.rad[i11 * 3 + ch]
+                                               : 0.0f;
+    }
+  }
+  if (desc.repair == Repair::Mip && st.uncovered > 0) repair_mip(grid, out, out_stride, sc.covered.data());
+  return st;
+}
+
+int64_t repair_mip(const GridDesc& grid, float* values, int64_t stride, const uint8_t* covered) {
+  struct Level { int nx, ny, nz; std::vector<float> v; std::vector<float> w; };  // v: rgb, w: data count
+  std::vector<Level> lv;
+  Level l0{grid.nx, grid.ny, grid.nz, {}, {}};
+  int64_t G = grid.count(), filled = 0;
+  l0.v.resize(size_t(G) * 3);
+  l0.w.resize(size_t(G));
+  for (int64_t g = 0; g < G; ++g) {
+    l0.w[g] = covered[g] ? 1.0f : 0.0f;
+    for (int ch = 0; ch < 3; ++ch) l0.v[g * 3 + ch] = covered[g] ? values[ch * stride + g] : 0.0f;
+  }
+  lv.push_back(std::move(l0));
+  auto lookup = [&](const Level& L, double x, double y, double z, float* rgb) {
+    x = std::clamp(x, 0.0, double(L.nx - 1)); y = std::clamp(y, 0.0, double(L.ny - 1)); z = std::clamp(z, 0.0, double(L.nz - 1));
+    int x0 = int(x), y0 = int(y), z0 = int(z);
+    double fx = x - x0, fy = y - y0, fz = z - z0, ws = 0, acc[3] = {0, 0, 0};
+    for (int c = 0; c < 8; ++c) {
+      int xi = std::min(x0 + (c & 1), L.nx - 1), yi = std::min(y0 + ((c >> 1) & 1), L.ny - 1), zi = std::min(z0 + (c >> 2), L.nz - 1);
+      size_t i = (size_t(zi) * L.ny + yi) * L.nx + xi;
+      if (L.w[i] <= 0) continue;
+      double w = ((c & 1) ? fx : 1 - fx) * ((c & 2) ? fy : 1 - fy) * ((c & 4) ? fz : 1 - fz);
+      ws += w;
+      for (int ch = 0; ch < 3; ++ch) acc[ch] += w * L.v[i * 3 + ch];
+    }
+    if (ws <= 1e-12) return false;
+    for (int ch = 0; ch < 3; ++ch) rgb[ch] = float(acc[ch] / ws);
+    return true;
+  };
+  for (int64_t g = 0; g < G; ++g) {
+    if (covered[g]) continue;
+    int i = int(g % grid.nx), j = int((g / grid.nx) % grid.ny), k = int(g / (int64_t(grid.nx) * grid.ny));
+    float rgb[3] = {0, 0, 0};
+    for (size_t l = 1;; ++l) {
+      if (l >= lv.size()) {
+        const Level& f = lv.back();
+        if (f.nx == 1 && f.ny == 1 && f.nz == 1) break;  // nothing anywhere: stays 0
+        Level c{(f.nx + 1) / 2, (f.ny + 1) / 2, (f.nz + 1) / 2, {}, {}};
+        c.v.assign(size_t(c.nx) * c.ny * c.nz * 3, 0.0f);
+        c.w.assign(size_t(c.nx) * c.ny * c.nz, 0.0f);
+        for (int z = 0; z < f.nz; ++z)
+          for (int y = 0; y < f.ny; ++y)
+            for (int x = 0; x < f.nx; ++x) {
+              size_t fi = (size_t(z) * f.ny + y) * f.nx + x, ci = (size_t(z / 2) * c.ny + y / 2) * c.nx + x / 2;
+              if (f.w[fi] <= 0) continue;
+              c.w[ci] += 1.0f;
+              for (int ch = 0; ch < 3; ++ch) c.v[ci * 3 + ch] += f.v[fi * 3 + ch];
+            }
+        for (size_t ci = 0; ci < c.w.size(); ++ci)
+          if (c.w[ci] > 0)
+            for (int ch = 0; ch < 3; ++ch) c.v[ci * 3 + ch] /= c.w[ci];
+        lv.push_back(std::move(c));
+      }
+      double s = double(1 << l);
+      if (lookup(lv[l], (i + 0.5) / s - 0.5, (j + 0.5) / s - 0.5, (k + 0.5) / s - 0.5, rgb)) break;
+    }
+    for (int ch = 0; ch < 3; ++ch) values[ch * stride + g] = rgb[ch];
+    ++filled;
+  }
+  return filled;
+}
+
+}  // namespace ibl::ilf

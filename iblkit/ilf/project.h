@@ -1,0 +1,60 @@
+// Step 3 and 4 of `ilf build`: radiance projection of one direction bucket onto every grid point
+// ([1] §3.2), done on the plane perpendicular to the bucket's direction instead of by marching rays,
+// and the repair of grid points that no ray reached ([1] §3.3, and a pull–push on the plane).
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "iblkit/ilf/grid.h"
+
+namespace ibl::ilf {
+
+enum class Repair {
+  None,     // leave uncovered grid points at zero radiance
+  Mip,      // [1] §3.3: box-filtered 3D mip levels, trilinear lookup in the finest level with data
+  PullPush, // normalised-convolution pull–push on the 2D plane of the rays (Gortler et al. 1996)
+};
+const char* repair_name(Repair r);
+Repair parse_repair(const std::string& s);
+
+struct ProjectDesc {
+  double kernel_cells = 3.0;  // Gaussian kernel support diameter in grid cells ([1] §5.2 uses 3)
+  double raster_cells = 0.5;  // pixel size of the plane raster in grid cells (smaller = exacter, slower)
+  Repair repair = Repair::PullPush;  // how grid points without a ray are filled
+};
+
+// The rays of one bucket: n_dirs directions × n_probes origins, radiance per (probe, direction).
+struct BucketRays {
+  const float* dirs = nullptr;      // n_dirs world directions (3 floats each)
+  const double* weights = nullptr;  // n_dirs solid angles (to form the mean direction)
+  int n_dirs = 0;
+  const Vec3* origins = nullptr;    // n_probes capture positions
+  const uint8_t* valid = nullptr;   // n_probes flags (0 = skipped probe)
+  int n_probes = 0;
+  // radiance(p) returns the 3·n_dirs floats of probe p (RGB per direction of the bucket).
+  const float* (*radiance)(const void* ctx, int p) = nullptr;
+  const void* ctx = nullptr;
+};
+
+struct ProjectStats {
+  int64_t rays = 0;       // rays splatted
+  int64_t uncovered = 0;  // grid points no ray reached (repaired)
+};
+
+// Per-thread scratch, reused across buckets.
+struct ProjectScratch {
+  std::vector<float> num, den, tmp;  // plane rasters and pyramid storage
+  std::vector<float> rad;            // per-grid-point radiance before the 3D repair
+  std::vector<uint8_t> covered;
+};
+
+// Writes the bucket's radiance at grid point g, channel c into out[c·out_stride + g].
+ProjectStats project_bucket(const GridDesc& grid, const BucketRays& rays, const ProjectDesc& desc, float* out,
+                            int64_t out_stride, ProjectScratch& scratch);
+
+// [1] §3.3 on one channel set: values (3 channels, stride `stride`) at the grid's points, covered[g]
+// says which hold data. Fills every uncovered point from the finest box-filtered mip level whose
+// trilinear neighbourhood holds data. Returns the number of points filled.
+int64_t repair_mip(const GridDesc& grid, float* values, int64_t stride, const uint8_t* covered);
+
+}  // namespace ibl::ilf

@@ -1,0 +1,158 @@
+#include "iblkit/ilf/sequence.h"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <tuple>
+
+#include <nlohmann/json.hpp>
+
+#include "iblkit/core/error.h"
+
+namespace ibl::ilf {
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+Vec3 vec3_field(const json& j, const std::string& what) {
+  if (!j.is_array() || j.size() != 3) fail(ErrorKind::Format, "{}: expected an array of 3 numbers", what);
+  Vec3 v;
+  for (int i = 0; i < 3; ++i) {
+    if (!j[i].is_number()) fail(ErrorKind::Format, "{}: element {} is not a number", what, i);
+    v[i] = j[i].get<double>();
+    if (!std::isfinite(v[i])) fail(ErrorKind::Value, "{}: element {} is not finite", what, i);
+  }
+  return v;
+}
+
+}  // namespace
+
+Sequence read_sequence(const std::string& path, const SequenceReadDesc& desc, SequenceReport* report) {
+  std::ifstream in(path);
+  if (!in) fail(ErrorKind::Io, "{}: cannot open the sequence manifest", path);
+  json j;
+  try {
+    j = json::parse(in);
+  } catch (const json::exception& e) {
+    fail(ErrorKind::Format, "{}: the manifest does not parse as JSON ({})", path, e.what());
+  }
+  if (!j.is_object() || j.value("format", "") != "iblkit.sequence/1")
+    fail(ErrorKind::Format, "{}: field \"format\" must be \"iblkit.sequence/1\"", path);
+  Sequence seq;
+  seq.manifest = path;
+  std::string mapping = j.value("mapping", "mirrorball");
+  auto kind = sphere::parse_mapping_kind(mapping);
+  if (!kind) fail(ErrorKind::Format, "{}: field \"mapping\": unknown mapping \"{}\"", path, mapping);
+  seq.mapping = *kind;
+  if (j.contains("dead_angle_deg")) {
+    if (!j["dead_angle_deg"].is_number()) fail(ErrorKind::Format, "{}: field \"dead_angle_deg\" is not a number", path);
+    seq.dead_angle_deg = j["dead_angle_deg"].get<double>();
+    if (!(seq.dead_angle_deg >= 0 && seq.dead_angle_deg < 90))
+      fail(ErrorKind::Value, "{}: field \"dead_angle_deg\" = {} is outside [0, 90)", path, seq.dead_angle_deg);
+  }
+  if (j.contains("rotation")) {
+    const auto& r = j["rotation"];
+    if (!r.is_array() || r.size() != 3) fail(ErrorKind::Format, "{}: field \"rotation\" must be 3 rows of 3", path);
+    seq.rotation = Mat3::rows(vec3_field(r[0], path + ": rotation[0]"), vec3_field(r[1], path + ": rotation[1]"),
+                              vec3_field(r[2], path + ": rotation[2]"));
+    Mat3 rr = seq.rotation * seq.rotation.transposed();
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b)
+        if (std::abs(rr.m[a][b] - (a == b ? 1.0 : 0.0)) > 1e-4)
+          fail(ErrorKind::Value, "{}: field \"rotation\" is not a rotation matrix (R·Rᵀ ≠ I)", path);
+  }
+  if (!j.contains("probes") || !j["probes"].is_array())
+    fail(ErrorKind::Format, "{}: field \"probes\" is missing or not an array", path);
+  fs::path base = fs::path(path).parent_path();
+  for (size_t i = 0; i < j["probes"].size(); ++i) {
+    const auto& p = j["probes"][i];
+    std::string where = fmt::format("{}: probe {}", path, i);
+    if (!p.is_object()) fail(ErrorKind::Format, "{}: not an object", where);
+    if (!p.contains("image") || !p["image"].is_string()) fail(ErrorKind::Format, "{}: field \"image\" is missing", where);
+    if (!p.contains("position")) fail(ErrorKind::Format, "{}: field \"position\" is missing", where);
+    ProbeEntry e;
+    fs::path img = p["image"].get<std::string>();
+    e.image = (img.is_absolute() ? img : base / img).lexically_normal().string();
+    try {
+      e.position = vec3_field(p["position"], where + ": field \"position\"");
+    } catch (const Error&) {
+      if (!desc.skip_bad) throw;
+      if (report) { ++report->skipped; report->reasons.push_back(where + ": bad \"position\""); }
+      continue;
+    }
+    seq.probes.push_back(e);
+  }
+  if (seq.probes.empty()) fail(ErrorKind::Value, "{}: the sequence has no probes", path);
+  if (j.contains("volume")) {
+    seq.volume = {vec3_field(j["volume"].value("min", json()), path + ": volume.min"),
+                  vec3_field(j["volume"].value("max", json()), path + ": volume.max")};
+    seq.volume_given = true;
+    for (int a = 0; a < 3; ++a)
+      if (!(seq.volume.max[a] > seq.volume.min[a]))
+        fail(ErrorKind::Value, "{}: field \"volume\": max must exceed min on every axis", path);
+  }
+  // Probes outside the volume and duplicated positions.
+  std::map<std::tuple<double, double, double>, size_t> seen;
+  std::vector<ProbeEntry> kept;
+  for (size_t i = 0; i < seq.probes.size(); ++i) {
+    const auto& e = seq.probes[i];
+    std::string problem;
+    if (seq.volume_given && !seq.volume.contains(e.position, desc.position_slack))
+      problem = fmt::format("field \"position\" ({}, {}, {}) lies outside the volume", e.position.x, e.position.y, e.position.z);
+    auto key = std::make_tuple(e.position.x, e.position.y, e.position.z);
+    if (problem.empty()) {
+      auto it = seen.find(key);
+      if (it != seen.end()) problem = fmt::format("field \"position\" duplicates probe {}", it->second);
+    }
+    if (!problem.empty()) {
+      std::string msg = fmt::format("{}: probe {} ({}): {}", path, i, e.image, problem);
+      if (!desc.skip_bad) fail(ErrorKind::Value, "{} (use --skip-bad to drop such probes)", msg);
+      if (report) { ++report->skipped; report->reasons.push_back(msg); }
+      continue;
+    }
+    seen.emplace(key, i);
+    kept.push_back(e);
+  }
+  seq.probes = std::move(kept);
+  if (seq.probes.empty()) fail(ErrorKind::Value, "{}: no probes left after dropping bad ones", path);
+  if (!seq.volume_given) {
+    Box b{seq.probes[0].position, seq.probes[0].position};
+    for (const auto& e : seq.probes)
+      for (int a = 0; a < 3; ++a) {
+        b.min[a] = std::min(b.min[a], e.position[a]);
+        b.max[a] = std::max(b.max[a], e.position[a]);
+      }
+    for (int a = 0; a < 3; ++a)
+      if (b.max[a] - b.min[a] <= 0) fail(ErrorKind::Value, "{}: the probe positions are flat on axis {}; give a \"volume\"", path, "xyz"[a]);
+    seq.volume = b;
+  }
+  return seq;
+}
+
+void write_sequence(const std::string& path, const Sequence& seq) {
+  fs::path base = fs::absolute(fs::path(path)).parent_path();
+  json probes = json::array();
+  for (const auto& e : seq.probes) {
+    fs::path img = fs::absolute(e.image);
+    auto rel = img.lexically_relative(base);
+    std::string s = (!rel.empty() && *rel.begin() != "..") ? rel.generic_string() : img.generic_string();
+    probes.push_back({{"image", s}, {"position", {e.position.x, e.position.y, e.position.z}}});
+  }
+  json rot = json::array();
+  for (int r = 0; r < 3; ++r) rot.push_back({seq.rotation.m[r][0], seq.rotation.m[r][1], seq.rotation.m[r][2]});
+  json j = {{"format", "iblkit.sequence/1"},
+            {"mapping", sphere::mapping_name(seq.mapping)},
+            {"dead_angle_deg", seq.dead_angle_deg},
+            {"rotation", rot},
+            {"volume", {{"min", {seq.volume.min.x, seq.volume.min.y, seq.volume.min.z}},
+                        {"max", {seq.volume.max.x, seq.volume.max.y, seq.volume.max.z}}}},
+            {"probes", probes}};
+  std::ofstream out(path);
+  if (!out) fail(ErrorKind::Io, "{}: cannot write the sequence manifest", path);
+  out << j.dump(1) << "\n";
+  if (!out) fail(ErrorKind::Io, "{}: write failed", path);
+}
+
+}  // namespace ibl::ilf

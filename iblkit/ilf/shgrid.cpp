@@ -1,0 +1,137 @@
+#include "iblkit/ilf/shgrid.h"
+
+#include <cmath>
+#include <cstring>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+
+#include "iblkit/core/error.h"
+#include "iblkit/sh/basis.h"
+#include "iblkit/sh/convolve.h"
+
+namespace ibl::ilf {
+using nlohmann::json;
+
+SHGrid::SHGrid(const GridDesc& grid, int bands) : grid_(grid), bands_(bands) {
+  if (grid.nx < 2 || grid.ny < 2 || grid.nz < 2) fail(ErrorKind::Value, "SH grid: resolution {}x{}x{} must be at least 2 per axis", grid.nx, grid.ny, grid.nz);
+  if (bands < 1 || bands > 16) fail(ErrorKind::Value, "SH grid: bands = {} outside [1, 16]", bands);
+  for (int a = 0; a < 3; ++a)
+    if (!(grid.volume.max[a] > grid.volume.min[a])) fail(ErrorKind::Value, "SH grid: volume max must exceed min on axis {}", "xyz"[a]);
+  data_.assign(size_t(grid.count()) * coeff_count() * 3, 0.0f);
+}
+
+sh::Coeffs SHGrid::coeffs_at(Vec3 p) const {
+  int K = coeff_count();
+  sh::Coeffs out;
+  out.bands = bands_;
+  out.c.assign(size_t(K), Vec3{0, 0, 0});
+  Vec3 s = grid_.volume.size();
+  double f[3] = {(p.x - grid_.volume.min.x) / s.x * (grid_.nx - 1), (p.y - grid_.volume.min.y) / s.y * (grid_.ny - 1),
+                 (p.z - grid_.volume.min.z) / s.z * (grid_.nz - 1)};
+  int n[3] = {grid_.nx, grid_.ny, grid_.nz}, i0[3];
+  double t[3];
+  for (int a = 0; a < 3; ++a) {
+    f[a] = std::clamp(f[a], 0.0, double(n[a] - 1));
+    i0[a] = std::min(int(f[a]), n[a] - 2);
+    t[a] = f[a] - i0[a];
+  }
+  for (int c = 0; c < 8; ++c) {
+    double w = ((c & 1) ? t[0] : 1 - t[0]) * ((c & 2) ? t[1] : 1 - t[1]) * ((c & 4) ? t[2] : 1 - t[2]);
+    if (w == 0) continue;
+    const float* src = at(i0[0] + (c & 1), i0[1] + ((c >> 1) & 1), i0[2] + (c >> 2));
+    for (int k = 0; k < K; ++k) out.c[k] += Vec3(src[3 * k], src[3 * k + 1], src[3 * k + 2]) * w;
+  }
+  return out;
+}
+
+Vec3 SHGrid::irradiance(Vec3 p, Vec3 n) const { return sh::irradiance_at(coeffs_at(p), normalize(n)); }
+
+Vec3 SHGrid::radiance(Vec3 p, Vec3 w) const {
+  auto c = coeffs_at(p);
+  std::vector<double> y(static_cast<size_t>(coeff_count()));
+  sh::eval_basis(bands_, normalize(w), y.data());
+  Vec3 r{0, 0, 0};
+  for (int k = 0; k < coeff_count(); ++k) r += c.c[k] * y[k];
+  return r;
+}
+
+// ∫ L(ω) h(ω·r) dω for a zonal kernel h with convolution factors Λ_l (sh/convolve.h, Funk–Hecke):
+// Σ_lm Λ_l·c_lm·Y_lm(r) — the zonal harmonic rotated to r (Sloan et al. 2005, eq. 1).
+Vec3 SHGrid::glossy(Vec3 p, Vec3 r, double exponent) const {
+  if (!(exponent >= 0)) fail(ErrorKind::Value, "glossy: Phong exponent {} must be ≥ 0", exponent);
+  auto c = coeffs_at(p);
+  auto z = sh::phong_zh(bands_, exponent);
+  std::vector<double> y(static_cast<size_t>(coeff_count()));
+  sh::eval_basis(bands_, normalize(r), y.data());
+  Vec3 out{0, 0, 0};
+  for (int l = 0; l < bands_; ++l) {
+    double s = z[l];
+    for (int m = -l; m <= l; ++m) out += c.c[sh::index(l, m)] * (s * y[sh::index(l, m)]);
+  }
+  return out;
+}
+
+void write_shgrid(const std::string& path, const SHGrid& g) {
+  const auto& gd = g.grid();
+  json hdr = {{"bands", g.bands()},
+              {"resolution", {gd.nx, gd.ny, gd.nz}},
+              {"min", {gd.volume.min.x, gd.volume.min.y, gd.volume.min.z}},
+              {"max", {gd.volume.max.x, gd.volume.max.y, gd.volume.max.z}},
+              {"dtype", "float32"},
+              {"layout", "z,y,x,coefficient,channel"}};
+  std::string head = "IBLKIT-SHGRID 1\n" + hdr.dump();
+  size_t total = ((head.size() + 1 + 63) / 64) * 64;
+  head.append(total - head.size() - 1, ' ');
+  head.push_back('\n');
+  std::ofstream out(path, std::ios::binary);
+  if (!out) fail(ErrorKind::Io, "{}: cannot write", path);
+  out.write(head.data(), std::streamsize(head.size()));
+  static_assert(sizeof(float) == 4);
+  out.write(reinterpret_cast<const char*>(g.data().data()), std::streamsize(g.data().size() * 4));  // x86: little-endian
+  if (!out) fail(ErrorKind::Io, "{}: write failed", path);
+}
+
+SHGrid read_shgrid(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) fail(ErrorKind::Io, "{}: cannot open", path);
+  std::string magic, header;
+  std::getline(in, magic);
+  if (magic != "IBLKIT-SHGRID 1") fail(ErrorKind::Format, "{}: not an .shgrid file (line 1 is not \"IBLKIT-SHGRID 1\")", path);
+  std::getline(in, header);
+  json h;
+  try {
+    h = json::parse(header);
+  } catch (const json::exception& e) {
+    fail(ErrorKind::Format, "{}: header (line 2) does not parse ({})", path, e.what());
+  }
+  auto need = [&](const char* f) {
+    if (!h.contains(f)) fail(ErrorKind::Format, "{}: header field \"{}\" is missing", path, f);
+    return h[f];
+  };
+  if (need("dtype") != "float32") fail(ErrorKind::Format, "{}: header field \"dtype\" must be \"float32\"", path);
+  if (need("layout") != "z,y,x,coefficient,channel") fail(ErrorKind::Format, "{}: header field \"layout\" is not \"z,y,x,coefficient,channel\"", path);
+  GridDesc gd;
+  int bands = 0;
+  try {
+    bands = need("bands").get<int>();
+    auto r = need("resolution").get<std::vector<int>>();
+    auto mn = need("min").get<std::vector<double>>(), mx = need("max").get<std::vector<double>>();
+    if (r.size() != 3 || mn.size() != 3 || mx.size() != 3) fail(ErrorKind::Format, "{}: \"resolution\", \"min\", \"max\" need 3 values", path);
+    gd.nx = r[0]; gd.ny = r[1]; gd.nz = r[2];
+    gd.volume = {{mn[0], mn[1], mn[2]}, {mx[0], mx[1], mx[2]}};
+  } catch (const json::exception& e) {
+    fail(ErrorKind::Format, "{}: header field of the wrong type ({})", path, e.what());
+  }
+  SHGrid g(gd, bands);
+  size_t off = magic.size() + 1 + header.size() + 1;
+  if (off % 64 != 0) fail(ErrorKind::Format, "{}: data does not start at a multiple of 64 bytes", path);
+  size_t n = g.data().size();
+  in.read(reinterpret_cast<char*>(g.data().data()), std::streamsize(n * 4));
+  if (size_t(in.gcount()) != n * 4) fail(ErrorKind::Format, "{}: truncated: {} of {} data bytes", path, in.gcount(), n * 4);
+  for (size_t i = 0; i < n; ++i)
+    if (!std::isfinite(g.data()[i])) fail(ErrorKind::Value, "{}: value {} is not finite", path, i);
+  return g;
+}
+
+}  // namespace ibl::ilf

@@ -1,0 +1,63 @@
+#include "iblkit/ilf/subsample.h"
+
+#include <atomic>
+#include <cmath>
+
+#include "iblkit/core/error.h"
+#include "iblkit/core/parallel.h"
+#include "iblkit/io/image_io.h"
+
+namespace ibl::ilf {
+
+double difference_energy(const Image& a, const Image& b, const sphere::Mapping& m) {
+  if (a.width() != b.width() || a.height() != b.height())
+    fail(ErrorKind::Value, "difference energy: frames of {}x{} and {}x{}", a.width(), a.height(), b.width(), b.height());
+  double diff = 0, sum = 0;
+  for (int y = 0; y < a.height(); ++y)
+    for (int x = 0; x < a.width(); ++x) {
+      double w = m.solid_angle(x, y);
+      if (w <= 0) continue;
+      double ya = luminance(a.rgb(x, y)), yb = luminance(b.rgb(x, y));
+      diff += std::abs(ya - yb) * w;
+      sum += 0.5 * (ya + yb) * w;
+    }
+  return sum > 0 ? diff / sum : 0.0;
+}
+
+std::vector<int> subsample(const Sequence& seq, const SubsampleDesc& desc, const ProgressFn& progress,
+                           SubsampleReport* report) {
+  int n = int(seq.probes.size());
+  std::vector<int> keep;
+  if (n <= 2) {
+    for (int i = 0; i < n; ++i) keep.push_back(i);
+    if (report) *report = {n, 0};
+    return keep;
+  }
+  // E between consecutive probes, in parallel (each frame is read twice, by its two pairs).
+  std::vector<double> e(size_t(n - 1), 1e300);
+  std::atomic<int> done{0};
+  parallel_for(0, n - 1, [&](int64_t i) {
+    const auto &pa = seq.probes[i], &pb = seq.probes[i + 1];
+    if (length(pa.position - pb.position) <= desc.max_distance) {
+      Image a = io::read_image(pa.image, {false, 3}), b = io::read_image(pb.image, {false, 3});
+      if (a.width() != b.width() || a.height() != b.height())
+        fail(ErrorKind::Value, "{}: probe {}: field \"image\": {}x{} differs from probe {}'s {}x{}", seq.manifest, i + 1,
+             b.width(), b.height(), i, a.width(), a.height());
+      sphere::Mapping m(seq.mapping, a.width(), a.height(), seq.dead_angle_deg);
+      e[i] = difference_energy(a, b, m);
+    }
+    ibl::report(progress, "subsample", double(++done) / (n - 1));
+  });
+  bool prev_dropped = false;
+  keep.push_back(0);
+  for (int i = 1; i < n - 1; ++i) {
+    bool drop = !prev_dropped && e[i - 1] < desc.threshold && e[i] < desc.threshold;
+    if (!drop) keep.push_back(i);
+    prev_dropped = drop;
+  }
+  keep.push_back(n - 1);
+  if (report) *report = {int(keep.size()), n - int(keep.size())};
+  return keep;
+}
+
+}  // namespace ibl::ilf

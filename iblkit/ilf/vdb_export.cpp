@@ -1,0 +1,69 @@
+// OpenVDB export of an SH grid (`ilf build --vdb`), for Houdini and Blender users: one Vec3f grid per
+// coefficient, voxel (i, j, k) = grid point (i, j, k), a scale+translate transform to world metres.
+#include "iblkit/core/error.h"
+#include "iblkit/ilf/shgrid.h"
+
+#ifdef IBLKIT_HAVE_OPENVDB
+#include <openvdb/openvdb.h>
+#include <openvdb/tools/Dense.h>
+#endif
+
+namespace ibl::ilf {
+
+#ifdef IBLKIT_HAVE_OPENVDB
+
+bool have_vdb() { return true; }
+
+void write_vdb(const std::string& path, const SHGrid& g) {
+  openvdb::initialize();
+  const auto& gd = g.grid();
+  Vec3 sp = gd.spacing();
+  int K = g.coeff_count();
+  openvdb::GridPtrVec grids;
+  auto xf = openvdb::math::Transform::createLinearTransform(openvdb::math::Mat4d(
+      sp.x, 0, 0, 0, 0, sp.y, 0, 0, 0, 0, sp.z, 0, gd.volume.min.x, gd.volume.min.y, gd.volume.min.z, 1));
+  for (int l = 0, k = 0; l < g.bands(); ++l)
+    for (int m = -l; m <= l; ++m, ++k) {
+      auto grid = openvdb::Vec3fGrid::create(openvdb::Vec3f(0.0f));
+      grid->setName(fmt::format("sh_l{}_m{}", l, m));
+      grid->setTransform(xf->copy());
+      grid->setGridClass(openvdb::GRID_UNKNOWN);
+      auto acc = grid->getAccessor();
+      for (int z = 0; z < gd.nz; ++z)
+        for (int y = 0; y < gd.ny; ++y)
+          for (int x = 0; x < gd.nx; ++x) {
+            const float* v = g.at(x, y, z) + 3 * k;
+            acc.setValue(openvdb::Coord(x, y, z), openvdb::Vec3f(v[0], v[1], v[2]));
+          }
+      grid->insertMeta("iblkit_l", openvdb::Int32Metadata(l));
+      grid->insertMeta("iblkit_m", openvdb::Int32Metadata(m));
+      grids.push_back(grid);
+    }
+  openvdb::MetaMap meta;
+  meta.insertMeta("iblkit_format", openvdb::StringMetadata("iblkit.shgrid/1"));
+  meta.insertMeta("iblkit_bands", openvdb::Int32Metadata(g.bands()));
+  meta.insertMeta("iblkit_coefficients", openvdb::Int32Metadata(K));
+  meta.insertMeta("iblkit_min", openvdb::Vec3DMetadata(openvdb::Vec3d(gd.volume.min.x, gd.volume.min.y, gd.volume.min.z)));
+  meta.insertMeta("iblkit_max", openvdb::Vec3DMetadata(openvdb::Vec3d(gd.volume.max.x, gd.volume.max.y, gd.volume.max.z)));
+  meta.insertMeta("iblkit_resolution", openvdb::Vec3IMetadata(openvdb::Vec3i(gd.nx, gd.ny, gd.nz)));
+  meta.insertMeta("iblkit_sh_convention", openvdb::StringMetadata("real orthonormal, no Condon-Shortley phase, k = l(l+1)+m"));
+  try {
+    openvdb::io::File file(path);
+    file.write(grids, meta);
+    file.close();
+  } catch (const openvdb::Exception& e) {
+    fail(ErrorKind::Io, "{}: cannot write OpenVDB file ({})", path, e.what());
+  }
+}
+
+#else
+
+bool have_vdb() { return false; }
+
+void write_vdb(const std::string& path, const SHGrid&) {
+  fail(ErrorKind::Unsupported, "{}: this build has no OpenVDB (configure with OpenVDB found to enable --vdb)", path);
+}
+
+#endif
+
+}  // namespace ibl::ilf
