@@ -64,7 +64,8 @@ void setup(CLI::App& app) {
   auto* o = new Opts();
   app.add_option("-o,--out", o->out, "folder for the pictures and numbers")->capture_default_str();
   app.add_option("--probe", o->probe, "probe to start from (default: blender-data's forest.exr)");
-  app.add_option("--only", o->only, "run only these steps (names as listed by the demo)");
+  app.add_option("--only", o->only, "run only these steps, comma-separated (mappings, sh, lights, lab, ilf, render, …)")
+      ->delimiter(',');
   app.footer("Example:\n  iblkit demo --out demo-out\n  iblkit demo --out /tmp/d --probe ../shared/probes/ict/uffizi_latlong_256.hdr --only mappings,sh");
   app.callback([o] {
     iblcli::DemoContext ctx;
@@ -73,6 +74,12 @@ void setup(CLI::App& app) {
     fs::create_directories(ctx.out_dir);
     auto& steps = iblcli::demo_registry();
     std::stable_sort(steps.begin(), steps.end(), [](const auto& a, const auto& b) { return a.order < b.order; });
+    for (const auto& name : o->only)
+      if (std::none_of(steps.begin(), steps.end(), [&](const auto& s) { return s.name == name; })) {
+        std::string known;
+        for (const auto& s : steps) known += (known.empty() ? "" : ", ") + s.name;
+        ibl::fail(ibl::ErrorKind::Value, "--only: no demo step '{}' (steps: {})", name, known);
+      }
     nlohmann::json timings = nlohmann::json::object();
     for (auto& s : steps) {
       if (!o->only.empty() && std::find(o->only.begin(), o->only.end(), s.name) == o->only.end()) continue;

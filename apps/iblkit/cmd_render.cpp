@@ -160,6 +160,57 @@ void setup(CLI::App& app) {
   });
 }
 
+// Demo step: the blob lit by the demo probe's 5-band SH, on the CPU and (where GL exists) on GL,
+// with the per-pixel difference between the two.
+void demo_step(iblcli::DemoContext& ctx) {
+  fs::create_directories(fs::path(ctx.out_dir) / "render");
+  FrameDesc d;
+  d.camera.width = 480;
+  d.camera.height = 360;
+  d.camera.eye = {0, 0.5, 1.6};
+  Mesh object = make_blob(60000, 0.8), floor = make_floor(6, -0.42);
+  d.objects = {{&object, Material{{0.75, 0.75, 0.75}, {0.15, 0.15, 0.15}, 20}}, {&floor, Material{{0.5, 0.5, 0.5}, {0, 0, 0}, 1}}};
+  d.lighting.environment = sh::project(io::read_envmap(ctx.probe), 5);
+  auto t0 = std::chrono::steady_clock::now();
+  RenderResult cpu = render_cpu(d);
+  double cpu_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  double scale = io::auto_exposure_scale(cpu.color);
+  io::ToneMapDesc td;
+  td.auto_exposure = false;
+  td.exposure_stops = std::log2(scale);
+  std::string base = (fs::path(ctx.out_dir) / "render").string();
+  io::write_image(base + "/blob_cpu.png", io::tonemap(cpu.color, td));
+  io::write_image(base + "/blob_cpu.exr", cpu.color);
+  ctx.pictures.push_back({"render: CPU reference", base + "/blob_cpu.png"});
+  nlohmann::json j = {{"cpu_ms", cpu_ms}, {"size", "480x360"}, {"triangles", object.triangle_count()}};
+#ifdef IBLKIT_HAVE_GL
+  try {
+    gl::Context glctx;
+    gl::Renderer r;
+    gl::GpuTiming t;
+    RenderResult g = r.render(d, 5, &t);
+    io::write_image(base + "/blob_gl.png", io::tonemap(g.color, td));
+    ctx.pictures.push_back({"render: OpenGL (" + glctx.renderer().substr(0, 16) + ")", base + "/blob_gl.png"});
+    std::vector<double> rel;
+    for (int y = 0; y < g.color.height(); ++y)
+      for (int x = 0; x < g.color.width(); ++x)
+        if (cpu.coverage.at(x, y, 0) > 0 && g.coverage.at(x, y, 0) > 0) {
+          double a = luminance(cpu.color.rgb(x, y)), b = luminance(g.color.rgb(x, y));
+          rel.push_back(std::abs(a - b) / std::max(a, 1e-3));
+        }
+    std::sort(rel.begin(), rel.end());
+    j["gl_renderer"] = glctx.renderer();
+    j["gl_vs_cpu_median_rel_error"] = rel.empty() ? 0.0 : rel[rel.size() / 2];
+    j["gl_vs_cpu_p99_rel_error"] = rel.empty() ? 0.0 : rel[rel.size() * 99 / 100];
+  } catch (const Error& e) {
+    j["gl"] = std::string("not available: ") + e.what();
+  }
+#endif
+  ctx.summary["render"] = j;
+}
+
+iblcli::DemoStep demo("render", 80, demo_step);
+
 iblcli::Command reg("render", "Render a scene lit by a probe, SH or lights (CPU reference or OpenGL)", setup, 80);
 
 }  // namespace

@@ -66,6 +66,67 @@ struct Hit {
   float b1 = 0, b2 = 0;  // perspective-correct barycentrics of vertices 1 and 2
 };
 
+struct ClipVertex {
+  double c[4];  // clip-space position
+  Vec3 b;       // barycentric coordinates in the original triangle
+};
+
+// Clips a triangle against z ≥ −w (GL's near plane); returns 0, 3 or 4 vertices.
+int clip_near(const ClipVertex in[3], ClipVertex out[4]) {
+  int n = 0;
+  for (int i = 0; i < 3; ++i) {
+    const ClipVertex& a = in[i];
+    const ClipVertex& b = in[(i + 1) % 3];
+    double da = a.c[2] + a.c[3], db = b.c[2] + b.c[3];
+    if (da >= 0) out[n++] = a;
+    if ((da >= 0) != (db >= 0)) {
+      double t = da / (da - db);
+      ClipVertex v;
+      for (int r = 0; r < 4; ++r) v.c[r] = a.c[r] + t * (b.c[r] - a.c[r]);
+      v.b = a.b + (b.b - a.b) * t;
+      out[n++] = v;
+    }
+  }
+  return n;
+}
+
+// Rasterises one (clipped) triangle into rows [y_lo, y_hi): pixel centres inside, depth test,
+// perspective-correct barycentrics of the original triangle.
+void raster_triangle(const ClipVertex& v0, const ClipVertex& v1, const ClipVertex& v2, int W, int H, int y_lo, int y_hi,
+                     int object, uint32_t tri, std::vector<Hit>& hits) {
+  const ClipVertex* v[3] = {&v0, &v1, &v2};
+  double sx[3], sy[3], sz[3], iw[3];
+  for (int k = 0; k < 3; ++k) {
+    double w = v[k]->c[3];
+    if (w <= 0) return;  // only possible for degenerate clips at the eye
+    iw[k] = 1.0 / w;
+    sx[k] = (v[k]->c[0] * iw[k] + 1) * 0.5 * W;
+    sy[k] = (1 - v[k]->c[1] * iw[k]) * 0.5 * H;
+    sz[k] = v[k]->c[2] * iw[k];
+  }
+  double area = (sx[1] - sx[0]) * (sy[2] - sy[0]) - (sx[2] - sx[0]) * (sy[1] - sy[0]);
+  if (area >= 0) return;  // back-facing (counter-clockwise in world is clockwise in y-down screen)
+  double minx = std::min({sx[0], sx[1], sx[2]}), maxx = std::max({sx[0], sx[1], sx[2]});
+  double miny = std::min({sy[0], sy[1], sy[2]}), maxy = std::max({sy[0], sy[1], sy[2]});
+  int x0 = std::max(0, static_cast<int>(std::ceil(minx - 0.5))), x1 = std::min(W - 1, static_cast<int>(std::floor(maxx - 0.5)));
+  int y0 = std::max(y_lo, static_cast<int>(std::ceil(miny - 0.5))), y1 = std::min(y_hi - 1, static_cast<int>(std::floor(maxy - 0.5)));
+  for (int y = y0; y <= y1; ++y)
+    for (int x = x0; x <= x1; ++x) {
+      double px = x + 0.5, py = y + 0.5;
+      double w0 = (sx[1] - px) * (sy[2] - py) - (sx[2] - px) * (sy[1] - py);
+      double w1 = (sx[2] - px) * (sy[0] - py) - (sx[0] - px) * (sy[2] - py);
+      double w2 = (sx[0] - px) * (sy[1] - py) - (sx[1] - px) * (sy[0] - py);
+      if (w0 > 0 || w1 > 0 || w2 > 0) continue;
+      double s0 = w0 / area, s1 = w1 / area, s2 = w2 / area;
+      double z = s0 * sz[0] + s1 * sz[1] + s2 * sz[2];
+      Hit& h = hits[static_cast<size_t>(y) * W + x];
+      if (z >= h.depth || z < -1 || z > 1) continue;
+      double q0 = s0 * iw[0], q1 = s1 * iw[1], q2 = s2 * iw[2], qs = q0 + q1 + q2;
+      Vec3 b = (v0.b * q0 + v1.b * q1 + v2.b * q2) / qs;
+      h = {static_cast<float>(z), object, tri, static_cast<float>(b.y), static_cast<float>(b.z)};
+    }
+}
+
 }  // namespace
 
 RenderResult render_cpu(const FrameDesc& d, const ProgressFn& progress) {
@@ -82,40 +143,18 @@ RenderResult render_cpu(const FrameDesc& d, const ProgressFn& progress) {
     for (size_t oi = 0; oi < d.objects.size(); ++oi) {
       const Mesh& m = *d.objects[oi].mesh;
       for (size_t t = 0; t < m.triangle_count(); ++t) {
-        double sx[3], sy[3], sz[3], sw[3];
-        bool behind = false;
+        // Clip space, then clip against GL's near plane z ≥ −w, carrying each vertex's barycentric
+        // coordinates in the original triangle.
+        ClipVertex tri[3];
         for (int k = 0; k < 3; ++k) {
           Vec3 p = m.position(m.indices[3 * t + k]);
-          double c[4];
-          for (int r = 0; r < 4; ++r) c[r] = vp[r] * p.x + vp[4 + r] * p.y + vp[8 + r] * p.z + vp[12 + r];
-          if (c[3] <= cam.znear * 0.5) { behind = true; break; }
-          sx[k] = (c[0] / c[3] + 1) * 0.5 * W;
-          sy[k] = (1 - c[1] / c[3]) * 0.5 * H;
-          sz[k] = c[2] / c[3];
-          sw[k] = c[3];
+          for (int r = 0; r < 4; ++r) tri[k].c[r] = vp[r] * p.x + vp[4 + r] * p.y + vp[8 + r] * p.z + vp[12 + r];
+          tri[k].b = {k == 0 ? 1.0 : 0.0, k == 1 ? 1.0 : 0.0, k == 2 ? 1.0 : 0.0};
         }
-        if (behind) continue;  // the test scenes keep the camera outside every object
-        double area = (sx[1] - sx[0]) * (sy[2] - sy[0]) - (sx[2] - sx[0]) * (sy[1] - sy[0]);
-        if (area >= 0) continue;  // back-facing (counter-clockwise in world is clockwise in y-down screen)
-        double minx = std::min({sx[0], sx[1], sx[2]}), maxx = std::max({sx[0], sx[1], sx[2]});
-        double miny = std::min({sy[0], sy[1], sy[2]}), maxy = std::max({sy[0], sy[1], sy[2]});
-        int x0 = std::max(0, static_cast<int>(std::ceil(minx - 0.5))), x1 = std::min(W - 1, static_cast<int>(std::floor(maxx - 0.5)));
-        int y0 = std::max(y_lo, static_cast<int>(std::ceil(miny - 0.5))), y1 = std::min(y_hi - 1, static_cast<int>(std::floor(maxy - 0.5)));
-        for (int y = y0; y <= y1; ++y)
-          for (int x = x0; x <= x1; ++x) {
-            double px = x + 0.5, py = y + 0.5;
-            double w0 = (sx[1] - px) * (sy[2] - py) - (sx[2] - px) * (sy[1] - py);
-            double w1 = (sx[2] - px) * (sy[0] - py) - (sx[0] - px) * (sy[2] - py);
-            double w2 = (sx[0] - px) * (sy[1] - py) - (sx[1] - px) * (sy[0] - py);
-            if (w0 > 0 || w1 > 0 || w2 > 0) continue;
-            double b0 = w0 / area, b1 = w1 / area, b2 = w2 / area;
-            double z = b0 * sz[0] + b1 * sz[1] + b2 * sz[2];
-            Hit& h = hits[static_cast<size_t>(y) * W + x];
-            if (z >= h.depth || z < -1 || z > 1) continue;
-            double q0 = b0 / sw[0], q1 = b1 / sw[1], q2 = b2 / sw[2], qs = q0 + q1 + q2;
-            h = {static_cast<float>(z), static_cast<int>(oi), static_cast<uint32_t>(t), static_cast<float>(q1 / qs),
-                 static_cast<float>(q2 / qs)};
-          }
+        ClipVertex poly[4];
+        int n = clip_near(tri, poly);
+        for (int f = 1; f + 1 < n; ++f)
+          raster_triangle(poly[0], poly[f], poly[f + 1], W, H, y_lo, y_hi, static_cast<int>(oi), static_cast<uint32_t>(t), hits);
       }
     }
   });
