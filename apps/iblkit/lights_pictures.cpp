@@ -178,7 +178,7 @@ Image irradiance_comparison(const ibl::sphere::EnvMap& env, const ibl::lights::L
     for (int y = 0; y < 8; ++y) out.set_rgb(lx + x, ly + y, c);
   }
   ibl::io::draw_text(out, lx, ly + 22, "0%", 12, {0.9, 0.9, 0.9});
-  ibl::io::draw_text(out, lx + width - 40, ly + 22, "≥50%", 12, {0.9, 0.9, 0.9});
+  ibl::io::draw_text(out, lx + width - 40, ly + 22, ">50%", 12, {0.9, 0.9, 0.9});
   return out;
 }
 

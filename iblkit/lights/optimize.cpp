@@ -240,6 +240,7 @@ LightSet optimize_lights_from(const sphere::EnvMap& env, const std::vector<Vec3>
   std::vector<Light> lights = initial;
   // Coarse to fine: levels 3 and 4 (1280 and 5120 normals) before the full set, each stage starting
   // from the last; a stage is kept only if it lowers the cost on the full set.
+  bool coarse_ran = false;
   if (desc.coarse_to_fine) {
     for (int level : {3, 4}) {
       auto coarse = sphere::icosphere_face_centres(level);
@@ -247,13 +248,14 @@ LightSet optimize_lights_from(const sphere::EnvMap& env, const std::vector<Vec3>
       auto coarse_gt = irradiance_ground_truth(env, coarse);
       auto s = solve_stage(coarse, coarse_gt, lights, desc, desc.max_iterations);
       rep.iterations += s.iterations;
+      coarse_ran = true;
       if (cost_of(final_data, s.lights) < cost_of(final_data, lights)) lights = s.lights;
       report(desc.progress, "optimise", level == 3 ? 0.3 : 0.6);
     }
   }
   StageResult fin;
   for (int round = 0; round < 4; ++round) {
-    fin = solve_stage(normals, ground_truth, lights, desc, desc.coarse_to_fine ? desc.final_iterations : desc.max_iterations);
+    fin = solve_stage(normals, ground_truth, lights, desc, coarse_ran ? desc.final_iterations : desc.max_iterations);
     rep.iterations += fin.iterations;
     lights = fin.lights;
     if (desc.min_separation_deg <= 0) break;
