@@ -231,10 +231,15 @@ TEST(LabTruth, UniformEnvironmentGivesPiLIrradiance) {
   TruthDesc td;
   td.size = 32;
   td.samples = 1;
-  td.bands = 0;
+  td.bands = 3;
   td.normals = {{0, 1, 0}, {1, 1, 1}};
   Truth t = ground_truth(s, {0, 0, 0}, td);
   for (Vec3 e : t.irradiance) EXPECT_NEAR(e.y, kPi * 1.5, kQuadTol * kPi * 1.5);
+  // A constant L projects to c00 = L·√(4π) and nothing else.
+  constexpr double kShTol = 1e-6;  // exact lat-long projection of a constant image, up to float rounding
+  ASSERT_EQ(t.sh.c.size(), 9u);
+  EXPECT_NEAR(t.sh.c[0].x, 1.5 * std::sqrt(kFourPi), kShTol);
+  for (int k = 1; k < 9; ++k) EXPECT_NEAR(t.sh.c[k].x, 0, kShTol);
 }
 
 }  // namespace

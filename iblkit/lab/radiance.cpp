@@ -38,14 +38,6 @@ Vec3 cosine_direction(Vec3 n, double u1, double u2) {
 Vec3 area_irradiance(const Scene& s, const Emitter& e, Vec3 p, Vec3 n, Rng& rng, int count) {
   auto m = static_cast<int>(std::lround(std::sqrt(static_cast<double>(count))));
   bool strat = m * m == count;
-  Frame f = Frame::from_normal(e.normal);
-  Vec3 qu, qv;
-  if (!e.disc) {
-    Vec3 up = e.up - e.normal * dot(e.up, e.normal);
-    if (length(up) < 1e-9) up = f.b;
-    qv = normalize(up);
-    qu = cross(qv, e.normal);
-  }
   Vec3 sum;
   for (int i = 0; i < count; ++i) {
     double u1 = rng.uniform(), u2 = rng.uniform();
@@ -56,9 +48,9 @@ Vec3 area_irradiance(const Scene& s, const Emitter& e, Vec3 p, Vec3 n, Rng& rng,
     Vec3 q;
     if (e.disc) {
       Vec2 c = concentric(u1, u2);
-      q = e.center + (f.t * c.x + f.b * c.y) * e.radius;
+      q = e.center + (e.edge_u * c.x + e.edge_v * c.y) * e.radius;
     } else {
-      q = e.center + qu * ((u1 - 0.5) * e.size.x) + qv * ((u2 - 0.5) * e.size.y);
+      q = e.center + e.edge_u * ((u1 - 0.5) * e.size.x) + e.edge_v * ((u2 - 0.5) * e.size.y);
     }
     Vec3 w = q - p;
     double d2 = dot(w, w), dist = std::sqrt(d2);

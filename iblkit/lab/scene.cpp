@@ -54,19 +54,33 @@ Vec3 builtin_pattern(Pattern p, double x, double y) {
 }
 }  // namespace
 
+void Emitter::prepare() {
+  direction = normalize(direction);
+  normal = normalize(normal);
+  frame = beam_frame();
+  cos_cone = std::cos(cone_deg * kPi / 180);
+  cos_falloff = std::cos(falloff_deg * kPi / 180);
+  tan_x = std::tan(fov_deg.x * kPi / 360);
+  tan_y = std::tan(fov_deg.y * kPi / 360);
+  Vec3 v = up - normal * dot(up, normal);
+  if (length(v) < 1e-9) v = Frame::from_normal(normal).b;
+  edge_v = normalize(v);
+  edge_u = cross(edge_v, normal);  // the same frame as geometry::make_quad
+  if (disc) {
+    Frame f = Frame::from_normal(normal);
+    edge_u = f.t;
+    edge_v = f.b;
+  }
+}
+
 Vec3 Emitter::intensity_towards(Vec3 w) const {
   switch (type) {
     case EmitterType::Point: return intensity;
-    case EmitterType::Spot: {
-      double c = dot(w, normalize(direction));
-      double cos_cone = std::cos(cone_deg * kPi / 180), cos_fall = std::cos(falloff_deg * kPi / 180);
-      return intensity * smoothstep(cos_cone, cos_fall, c);
-    }
+    case EmitterType::Spot: return intensity * smoothstep(cos_cone, cos_falloff, dot(w, direction));
     case EmitterType::Projector: {
-      Frame f = beam_frame();
-      Vec3 l = f.to_local(w);
+      Vec3 l = frame.to_local(w);
       if (l.z <= 0) return {0, 0, 0};
-      double sx = l.x / l.z / std::tan(fov_deg.x * kPi / 360), sy = l.y / l.z / std::tan(fov_deg.y * kPi / 360);
+      double sx = l.x / (l.z * tan_x), sy = l.y / (l.z * tan_y);
       if (std::abs(sx) > 1 || std::abs(sy) > 1) return {0, 0, 0};
       if (pattern == Pattern::Image && image)
         return intensity * image->view().sample_rgb_uv(0.5 * (sx + 1), 0.5 * (1 - sy), Wrap::Clamp);
@@ -87,6 +101,7 @@ void Scene::build() {
   env_index_ = -1;
   for (size_t i = 0; i < emitters.size(); ++i) {
     Emitter& e = emitters[i];
+    e.prepare();
     Surface s;
     s.name = e.name;
     s.emitter = static_cast<int>(i);
@@ -97,13 +112,11 @@ void Scene::build() {
         s.role = SurfaceRole::AreaLight;
         s.mesh = e.disc ? geometry::make_disc(e.center, e.normal, e.radius)
                         : geometry::make_quad(e.center, e.normal, e.up, e.size.x, e.size.y);
-        e.normal = normalize(e.normal);
         e.emit_area = e.disc ? kPi * e.radius * e.radius : e.size.x * e.size.y;
         surfaces.push_back(std::move(s));
         break;
       case EmitterType::Spot:
       case EmitterType::Projector:
-        e.direction = normalize(e.direction);
         if (e.aperture_radius > 0) {
           s.role = SurfaceRole::Aperture;
           s.mesh = geometry::make_disc(e.position, e.direction, e.aperture_radius, 32);

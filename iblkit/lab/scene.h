@@ -80,6 +80,13 @@ struct Emitter {
   Vec3 environment(Vec3 d) const;
   // Right/up/forward frame of a spot or projector.
   Frame beam_frame() const;
+  // Normalises the placement and caches what every light query needs (Scene::build calls it).
+  void prepare();
+
+  // Cached by prepare(): beam frame, cone cosines, projector tangents, area light edge directions.
+  Frame frame;
+  double cos_cone = 0, cos_falloff = 1, tan_x = 1, tan_y = 1;
+  Vec3 edge_u, edge_v;
 };
 
 // How light is estimated; a scene file's "settings" fill it, the CLI can override.

@@ -181,7 +181,7 @@ Emitter emitter(const json& j, const Ctx& c) {
   } else if (type == "spot" || type == "projector" || type == "point") {
     e.type = type == "spot" ? EmitterType::Spot : type == "projector" ? EmitterType::Projector : EmitterType::Point;
     e.position = vec3(j, "position", c);
-    e.intensity = vec3(j, "color", c, Vec3{1, 1, 1}) * num(j, "intensity", c);
+    e.intensity = vec3(j, "color", c, Vec3{1, 1, 1}) * vec3(j, "intensity", c);  // W/sr: a number or [r,g,b]
     nonneg(e.intensity, "intensity", c);
     if (e.type != EmitterType::Point) {
       e.direction = vec3(j, "direction", c);

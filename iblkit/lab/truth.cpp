@@ -5,10 +5,7 @@
 #include "iblkit/core/error.h"
 #include "iblkit/core/parallel.h"
 #include "iblkit/lab/capture.h"
-#if __has_include("iblkit/sh/basis.h")
-#include "iblkit/sh/basis.h"
-#define IBLKIT_LAB_HAVE_SH 1
-#endif
+#include "iblkit/sh/project.h"
 
 namespace ibl::lab {
 
@@ -39,26 +36,6 @@ Vec3 irradiance(const sphere::EnvMap& map, Vec3 n) {
   })[0];
 }
 
-std::vector<Vec3> project_sh(const sphere::EnvMap& map, int bands) {
-  if (bands < 1 || bands > 16) fail(ErrorKind::Value, "SH bands {} out of range [1, 16]", bands);
-#ifdef IBLKIT_LAB_HAVE_SH
-  size_t K = static_cast<size_t>(bands) * bands;
-  return row_sums(map, K, [&](int y, std::vector<Vec3>& acc) {
-    std::vector<double> basis(K);
-    for (int x = 0; x < map.image.width(); ++x) {
-      Vec3 d;
-      double sa = map.mapping.solid_angle(x, y);
-      if (sa <= 0 || !map.mapping.to_direction(x + 0.5, y + 0.5, &d)) continue;
-      sh::eval_basis(bands, d, basis.data());
-      Vec3 L = map.image.rgb(x, y) * sa;
-      for (size_t k = 0; k < K; ++k) acc[k] += L * basis[k];
-    }
-  });
-#else
-  fail(ErrorKind::Unsupported, "SH projection needs iblkit/sh (not in this build)");
-#endif
-}
-
 Truth ground_truth(const Scene& scene, Vec3 position, const TruthDesc& desc, const ProgressFn& progress) {
   if (desc.area_samples < 1) fail(ErrorKind::Value, "area samples {} must be ≥ 1", desc.area_samples);
   CaptureDesc cd;
@@ -72,7 +49,7 @@ Truth ground_truth(const Scene& scene, Vec3 position, const TruthDesc& desc, con
   Capture cap = capture_probe(scene, position, cd, 0, progress);
   Truth t;
   t.radiance = sphere::EnvMap(std::move(cap.radiance), cap.mapping);
-  if (desc.bands > 0) t.sh = project_sh(t.radiance, desc.bands);
+  if (desc.bands > 0) t.sh = sh::project(t.radiance, desc.bands);
   for (Vec3 n : desc.normals) {
     if (length(n) == 0) fail(ErrorKind::Value, "irradiance normal (0,0,0) has no direction");
     t.normals.push_back(normalize(n));

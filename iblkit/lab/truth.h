@@ -5,6 +5,7 @@
 
 #include "iblkit/core/progress.h"
 #include "iblkit/lab/scene.h"
+#include "iblkit/sh/coeffs.h"
 #include "iblkit/sphere/envmap.h"
 
 namespace ibl::lab {
@@ -20,16 +21,13 @@ struct TruthDesc {
 
 struct Truth {
   sphere::EnvMap radiance{Image(2, 1, 3), sphere::Mapping(sphere::MappingKind::LatLong, 2, 1)};  // lat-long map
-  std::vector<Vec3> sh;          // bands² RGB coefficients (DESIGN.md's real orthonormal basis)
+  sh::Coeffs sh;                 // SH projection of `radiance` (sh::project; empty when bands = 0)
   std::vector<Vec3> normals;     // the unit normals of `irradiance`
   std::vector<Vec3> irradiance;  // E(n) = ∫ L(ω) max(0, n·ω) dω, W/m²
 };
 
 // Irradiance of a radiance map for normal n by quadrature over its pixels with exact solid angles.
 Vec3 irradiance(const sphere::EnvMap& map, Vec3 n);
-
-// SH projection of a radiance map with exact pixel solid angles: c_k = Σ L(ω_p) Y_k(ω_p) Ω_p.
-std::vector<Vec3> project_sh(const sphere::EnvMap& map, int bands);
 
 Truth ground_truth(const Scene& scene, Vec3 position, const TruthDesc& desc, const ProgressFn& progress = {});
 

@@ -1,0 +1,119 @@
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+
+#include "iblkit/core/error.h"
+#include "iblkit/lab/capture.h"
+#include "iblkit/lab/scene_io.h"
+#include "iblkit/lab/sequence.h"
+
+namespace ibl::lab {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path temp_dir(const std::string& name) {
+  fs::path p = fs::temp_directory_path() / ("iblkit_lab_" + name);
+  fs::remove_all(p);
+  fs::create_directories(p);
+  return p;
+}
+
+TEST(LabScene, BuiltInScenesLoadAndAreLitInsideTheirVolume) {
+  for (const char* name : {"low-scene1", "low-scene2", "t-corridor", "crypt"}) {
+    Scene s = load_scene(name);
+    EXPECT_EQ(s.name, name);
+    EXPECT_FALSE(s.emitters.empty()) << name;
+    CaptureDesc cd;
+    cd.size = 16;
+    Capture c = capture_probe(s, (s.volume_min + s.volume_max) * 0.5, cd);
+    double lum = 0;
+    for (int y = 0; y < c.radiance.height(); ++y)
+      for (int x = 0; x < c.radiance.width(); ++x) {
+        Vec3 v = c.radiance.rgb(x, y);
+        ASSERT_TRUE(std::isfinite(v.x + v.y + v.z) && v.x >= 0 && v.y >= 0 && v.z >= 0) << name;
+        lum += luminance(v);
+      }
+    EXPECT_GT(lum, 0) << name;
+  }
+  // The crypt is "about 500 triangles" (Granier et al.).
+  Scene crypt = load_scene("crypt");
+  EXPECT_GT(crypt.surfaces[0].mesh.triangle_count(), 400u);
+  EXPECT_LT(crypt.surfaces[0].mesh.triangle_count(), 600u);
+  // The T-corridor comes with its proxy mesh.
+  Scene t = load_scene("t-corridor");
+  EXPECT_GT(t.proxy_mesh().triangle_count(), 10u);
+}
+
+TEST(LabScene, BadFilesNameTheFieldAtFault) {
+  fs::path dir = temp_dir("bad");
+  auto expect_error = [&](const std::string& text, const std::string& needle) {
+    fs::path f = dir / "s.json";
+    std::ofstream(f) << text;
+    try {
+      load_scene(f.string());
+      ADD_FAILURE() << "no error for " << text;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+    }
+  };
+  expect_error("{", "not valid JSON");
+  expect_error(R"({"format":"iblkit.scene/2","surfaces":[]})", "format");
+  expect_error(R"({"format":"iblkit.scene/1","surfaces":[{"type":"teapot"}]})", "surfaces[0].type");
+  expect_error(R"({"format":"iblkit.scene/1","surfaces":[{"type":"quad","center":[0,0],"normal":[0,1,0],"size":1}]})", "center");
+  expect_error(R"({"format":"iblkit.scene/1","surfaces":[],"emitters":[{"type":"area","center":[0,1,0],"normal":[0,-1,0],"size":1,"radiance":-1}]})", "emitters[0].radiance");
+  expect_error(R"({"format":"iblkit.scene/1","surfaces":[{"type":"mesh","file":"nope.obj"}]})", "nope.obj");
+  expect_error(R"({"format":"iblkit.scene/1","surfaces":[{"type":"room","min":[0,0,0],"max":[1,1,1],"albedo":1.5}]})", "albedo");
+  EXPECT_THROW(load_scene("no-such-scene"), Error);
+  fs::remove_all(dir);
+}
+
+TEST(LabSequence, PositionsFollowGridPathAndVolume) {
+  auto g = grid_positions({0, 0, 0}, {1, 2, 3}, 2, 3, 1);
+  ASSERT_EQ(g.size(), 6u);
+  EXPECT_EQ(g[1].x, 1);
+  EXPECT_EQ(g[2].y, 1);
+  EXPECT_EQ(g[0].z, 1.5);  // one point along z sits in the middle
+  auto p = path_positions({{0, 0, 0}, {1, 0, 0}, {1, 1, 0}}, 5);
+  ASSERT_EQ(p.size(), 5u);
+  EXPECT_NEAR(p[2].x, 1, 1e-12);
+  EXPECT_NEAR(p[3].y, 0.5, 1e-12);
+  auto r = random_positions({-1, 0, 2}, {1, 1, 3}, 100, 9);
+  for (Vec3 v : r) EXPECT_TRUE(v.x >= -1 && v.x <= 1 && v.y >= 0 && v.y <= 1 && v.z >= 2 && v.z <= 3);
+  EXPECT_EQ(random_positions({-1, 0, 2}, {1, 1, 3}, 100, 9)[42].z, r[42].z);
+}
+
+TEST(LabSequence, ManifestsListEveryFrameAndTheProxy) {
+  Scene s = load_scene("low-scene1");
+  fs::path dir = temp_dir("seq");
+  SequenceDesc d;
+  d.capture.mapping = sphere::MappingKind::MirrorBall;
+  d.capture.camera = Camera::MirrorBall;
+  d.capture.size = 24;
+  d.out_dir = (dir / "seq").string();
+  auto pos = grid_positions(s.volume_min, s.volume_max, 2, 1, 2);
+  SequenceResult r = write_sequence(s, pos, d);
+  auto m = nlohmann::json::parse(std::ifstream(r.manifest));
+  EXPECT_EQ(m["format"], "iblkit.sequence/1");
+  EXPECT_EQ(m["mapping"], "mirrorball");
+  ASSERT_EQ(m["probes"].size(), 4u);
+  for (auto& p : m["probes"]) EXPECT_TRUE(fs::exists(fs::path(d.out_dir) / p["image"].get<std::string>()));
+  EXPECT_EQ(m["probes"][3]["position"][2].get<double>(), s.volume_max.z);
+  EXPECT_TRUE(fs::exists(r.contact_sheet));
+
+  d.capture = CaptureDesc{};
+  d.capture.size = 16;
+  d.out_dir = (dir / "fusion").string();
+  SequenceResult f = write_probe_set(s, {{0, 1, 0}, {0.3, 1.2, 0.1}}, d);
+  auto pm = nlohmann::json::parse(std::ifstream(f.manifest));
+  EXPECT_EQ(pm["format"], "iblkit.probes/1");
+  EXPECT_TRUE(fs::exists(fs::path(d.out_dir) / pm["proxy"].get<std::string>()));
+  for (auto& p : pm["probes"]) EXPECT_TRUE(fs::exists(fs::path(d.out_dir) / p["depth"].get<std::string>()));
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace ibl::lab
