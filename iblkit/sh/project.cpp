@@ -75,22 +75,24 @@ Coeffs project_latlong(const sphere::EnvMap& env, int bands, const ProgressFn& p
   const int Wp = (W + kLanes - 1) / kLanes * kLanes;
   const int J = 2 * bands - 1;            // tables: cos 0, then (Re, Im) w^m for m = 1..L
   const int Jp = (J + 3) / 4 * 4;          // padded to groups of 4 (extra tables are zero)
-  // Column tables, with the exact pixel integral Δ sinc(mΔ/2) folded in.
+  // Column tables {Re, Im} w(a_x)^m in float (unit magnitude).
   const double delta = kTwoPi / W;
   std::vector<float> tab(static_cast<size_t>(Jp) * Wp, 0.0f);
   for (int x = 0; x < W; ++x) {
     double a = kTwoPi * (x + 0.5) / W;
     double wr = -std::sin(a), wi = -std::cos(a), cr = 1.0, ci = 0.0;
-    tab[x] = static_cast<float>(delta);
+    tab[x] = 1.0f;
     for (int m = 1; m < bands; ++m) {
       double nr = cr * wr - ci * wi;
       ci = cr * wi + ci * wr;
       cr = nr;
-      double h = 0.5 * m * delta, sinc = std::sin(h) / h;
-      tab[static_cast<size_t>(2 * m - 1) * Wp + x] = static_cast<float>(delta * sinc * cr);
-      tab[static_cast<size_t>(2 * m) * Wp + x] = static_cast<float>(delta * sinc * ci);
+      tab[static_cast<size_t>(2 * m - 1) * Wp + x] = static_cast<float>(cr);
+      tab[static_cast<size_t>(2 * m) * Wp + x] = static_cast<float>(ci);
     }
   }
+  // Column factor of order m: the exact pixel integral Δ sinc(mΔ/2), applied in double.
+  std::vector<double> colf(bands);
+  for (int m = 0; m < bands; ++m) colf[m] = m == 0 ? delta : delta * std::sin(0.5 * m * delta) / (0.5 * m * delta);
   std::vector<double> gz, gw;
   gauss_legendre(4, &gz, &gw);
   std::vector<double> norm(bands * bands, 0.0);
@@ -117,7 +119,7 @@ Coeffs project_latlong(const sphere::EnvMap& env, int bands, const ProgressFn& p
             legendre_table(bands, z, P.data());
             double sm = 1.0;
             for (int m = 0; m < bands; ++m) {
-              for (int l = m; l < bands; ++l) G[l * bands + m] += w * norm[l * bands + m] * P[l * bands + m] * sm;
+              for (int l = m; l < bands; ++l) G[l * bands + m] += w * colf[m] * norm[l * bands + m] * P[l * bands + m] * sm;
               sm *= s;
             }
           }
@@ -156,6 +158,49 @@ Coeffs project_latlong(const sphere::EnvMap& env, int bands, const ProgressFn& p
   return rotate(primed, P.transposed());
 }
 
+// The basis averaged over pixel (x, y). Pixels whose corners see directions less than kSpread
+// apart use the centre; others (mirror-ball and angular rims, pixels cut by the disc edge) average
+// n×n sub-pixel directions, n = ⌈spread / kSpread⌉ ≤ kMaxSub, over the sub-points that carry data,
+// each weighted by the mapping's local Jacobian so that the average is over solid angle.
+// False when no point of the pixel has a direction.
+constexpr double kSpread = 0.02;  // rad: the basis of band l changes by ~l·0.02 across such a pixel
+constexpr int kMaxSub = 8;
+bool pixel_basis(const sphere::Mapping& m, int bands, int x, int y, double* out, double* tmp) {
+  const int K = coeff_count(bands);
+  Vec3 c, corner[4];
+  bool centre_ok = m.to_direction(x + 0.5, y + 0.5, &c);
+  bool corners_ok = true;
+  double spread = 0;
+  for (int i = 0; i < 4; ++i) {
+    corners_ok = m.to_direction(x + (i & 1), y + (i >> 1), &corner[i]) && corners_ok;
+    if (centre_ok && corners_ok) spread = std::max(spread, std::acos(std::clamp(dot(c, corner[i]), -1.0, 1.0)));
+  }
+  if (centre_ok && corners_ok && spread <= kSpread) {
+    eval_basis(bands, c, out);
+    return true;
+  }
+  int n = centre_ok && corners_ok ? std::min(kMaxSub, static_cast<int>(std::ceil(spread / kSpread))) : kMaxSub;
+  std::fill(out, out + K, 0.0);
+  double wsum = 0;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      // Sub-point weighted by the local Jacobian |∂d/∂x × ∂d/∂y| (one-sided differences).
+      const double px = x + (i + 0.5) / n, py = y + (j + 0.5) / n, e = 1e-3 / n;
+      Vec3 d, dx, dy;
+      if (!m.to_direction(px, py, &d)) continue;
+      bool okx = m.to_direction(px + e, py, &dx) || m.to_direction(px - e, py, &dx);
+      bool oky = m.to_direction(px, py + e, &dy) || m.to_direction(px, py - e, &dy);
+      double w = okx && oky ? length(cross(dx - d, dy - d)) : 0.0;
+      if (w <= 0) continue;
+      eval_basis(bands, d, tmp);
+      for (int k = 0; k < K; ++k) out[k] += w * tmp[k];
+      wsum += w;
+    }
+  if (wsum <= 0) return false;
+  for (int k = 0; k < K; ++k) out[k] /= wsum;
+  return true;
+}
+
 }  // namespace
 
 Coeffs project_generic(const sphere::EnvMap& env, int bands, const ProgressFn& progress) {
@@ -169,15 +214,13 @@ Coeffs project_generic(const sphere::EnvMap& env, int bands, const ProgressFn& p
       [&](int64_t y0, int64_t y1) {
         Partial p;
         p.v.assign(3 * K, 0.0);
-        std::vector<double> yb(K);
+        std::vector<double> yb(K), tmp(K);
         for (int64_t y = y0; y < y1; ++y) {
           for (int x = 0; x < W; ++x) {
             double w = m.solid_angle(x, static_cast<int>(y));
             if (w <= 0) continue;
-            Vec3 d;
-            if (!m.to_direction(x + 0.5, y + 0.5, &d)) continue;
+            if (!pixel_basis(m, bands, x, static_cast<int>(y), yb.data(), tmp.data())) continue;
             Vec3 L = pixel_rgb(img.pixel(x, static_cast<int>(y)), C) * w;
-            eval_basis(bands, d, yb.data());
             for (int k = 0; k < K; ++k) {
               p.v[3 * k] += L.x * yb[k];
               p.v[3 * k + 1] += L.y * yb[k];
