@@ -45,28 +45,35 @@ Partial add(Partial a, const Partial& b) {
 // against the 2L+1 column tables (vectorised dot products), then multiplied by G. The result is
 // in the d' frame; rotating by Pᵀ brings it back to world axes.
 
-constexpr int kLanes = 8;  // floats per vector lane group the row loops are written for
+constexpr int kLanes = 8;  // floats per vector (GCC/Clang vector extension; AVX2 with -march=x86-64-v3)
+typedef float v8f __attribute__((vector_size(32)));
+inline v8f load8(const float* p) {
+  v8f v;
+  __builtin_memcpy(&v, p, sizeof v);
+  return v;
+}
+inline double hsum(v8f v) {
+  double s = 0;
+  for (int k = 0; k < kLanes; ++k) s += v[k];
+  return s;
+}
 
-// acc[j] = Σ_x a[x] · t_j[x] for 4 tables at once; n a multiple of kLanes.
-inline void dot4(const float* a, const float* t0, const float* t1, const float* t2, const float* t3, int n, double* out) {
-  float s0[kLanes] = {}, s1[kLanes] = {}, s2[kLanes] = {}, s3[kLanes] = {};
+// out[c * ld + j] = Σ_x ch_c[x] · t_j[x] for the 3 channels and G consecutive tables; n a multiple
+// of kLanes. 3G accumulators + 4 operands fit the 16 vector registers for G ≤ 4.
+template <int G>
+void row_dots(const float* ch, const float* tab, int n, int ld, double* out) {
+  v8f acc[3][G] = {};
   for (int x = 0; x < n; x += kLanes) {
-    for (int k = 0; k < kLanes; ++k) {
-      float v = a[x + k];
-      s0[k] += v * t0[x + k];
-      s1[k] += v * t1[x + k];
-      s2[k] += v * t2[x + k];
-      s3[k] += v * t3[x + k];
+    v8f r = load8(ch + x), g = load8(ch + n + x), b = load8(ch + 2 * n + x);
+    for (int j = 0; j < G; ++j) {
+      v8f t = load8(tab + static_cast<size_t>(j) * n + x);
+      acc[0][j] += r * t;
+      acc[1][j] += g * t;
+      acc[2][j] += b * t;
     }
   }
-  double r[4] = {0, 0, 0, 0};
-  for (int k = 0; k < kLanes; ++k) {
-    r[0] += s0[k];
-    r[1] += s1[k];
-    r[2] += s2[k];
-    r[3] += s3[k];
-  }
-  for (int j = 0; j < 4; ++j) out[j] = r[j];
+  for (int c = 0; c < 3; ++c)
+    for (int j = 0; j < G; ++j) out[c * ld + j] = hsum(acc[c][j]);
 }
 
 Coeffs project_latlong(const sphere::EnvMap& env, int bands, const ProgressFn& progress) {
@@ -74,7 +81,7 @@ Coeffs project_latlong(const sphere::EnvMap& env, int bands, const ProgressFn& p
   const int W = img.width(), H = img.height(), C = img.channels(), K = coeff_count(bands);
   const int Wp = (W + kLanes - 1) / kLanes * kLanes;
   const int J = 2 * bands - 1;            // tables: cos 0, then (Re, Im) w^m for m = 1..L
-  const int Jp = (J + 3) / 4 * 4;          // padded to groups of 4 (extra tables are zero)
+  const int Jp = J;
   // Column tables {Re, Im} w(a_x)^m in float (unit magnitude).
   const double delta = kTwoPi / W;
   std::vector<float> tab(static_cast<size_t>(Jp) * Wp, 0.0f);
@@ -131,10 +138,9 @@ Coeffs project_latlong(const sphere::EnvMap& env, int bands, const ProgressFn& p
             ch[Wp + x] = C >= 3 ? px[1] : px[0];
             ch[2 * Wp + x] = C >= 3 ? px[2] : px[0];
           }
-          for (int c = 0; c < 3; ++c)
-            for (int j = 0; j < Jp; j += 4)
-              dot4(ch.data() + static_cast<size_t>(c) * Wp, &tab[static_cast<size_t>(j) * Wp], &tab[static_cast<size_t>(j + 1) * Wp],
-                   &tab[static_cast<size_t>(j + 2) * Wp], &tab[static_cast<size_t>(j + 3) * Wp], Wp, &sums[c * Jp + j]);
+          int j = 0;
+          for (; j + 4 <= J; j += 4) row_dots<4>(ch.data(), &tab[static_cast<size_t>(j) * Wp], Wp, Jp, &sums[j]);
+          for (; j < J; ++j) row_dots<1>(ch.data(), &tab[static_cast<size_t>(j) * Wp], Wp, Jp, &sums[j]);
           for (int l = 0; l < bands; ++l) {
             for (int c = 0; c < 3; ++c) {
               p.v[3 * index(l, 0) + c] += G[l * bands] * sums[c * Jp];
