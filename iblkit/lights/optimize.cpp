@@ -6,6 +6,8 @@
 #include <cmath>
 #include <memory>
 
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
 #include <ceres/ceres.h>
 
 #include "iblkit/core/parallel.h"
@@ -66,49 +68,149 @@ LightEval eval_light(const double* p, const LightFrame& fr) {
   return le;
 }
 
-class IrradianceCost final : public ceres::CostFunction {
+/*
+ * Square-root compression of the 3M residuals
+ * --------------------------------------------
+ * Ceres' Levenberg–Marquardt uses r and J only through JᵀJ, Jᵀr and ‖r‖² (with Jacobi scaling from the
+ * column norms of J, i.e. diag JᵀJ). Let G = [J r]ᵀ[J r], size (5N+1)², and S any square matrix with
+ * SᵀS = G. With r̃ = S's last column and J̃ = its first 5N columns,
+ *
+ *     ┌───────────────────────────────────────────────────────────────────┐
+ *     │ J̃ᵀJ̃ = JᵀJ,  J̃ᵀr̃ = Jᵀr,  ‖r̃‖² = ‖r‖²,  ‖J̃δ + r̃‖ = ‖Jδ + r‖ ∀δ    │
+ *     └───────────────────────────────────────────────────────────────────┘
+ *
+ * so LM takes exactly the steps it would take on the 3M residuals, while Ceres' own dense linear algebra
+ * works on 5N+1 rows instead of 61440. G is built here from the sparsity of J: a row (k, c) touches only
+ * the two angles and channel c's q of the lights in front of n_k, so each channel's rows form a dense
+ * (3N+1)-column block whose Gram matrix Eigen accumulates (rank updates on chunks of 64 normals, threads
+ * over four fixed ranges of normals, summed in a fixed order). S comes from the Cholesky factor of the
+ * JᵀJ block (a 10⁻¹² relative ridge keeps it definite: a negligible extra damping) and the last column
+ * from one triangular solve: S = [[Lᵀ, l], [0, s]], L l = Jᵀr, s = √max(0, ‖r‖² − ‖l‖²).
+ * Evaluations without a Jacobian return (‖r‖, 0, …, 0): only the cost is used there.
+ */
+class CompressedIrradianceCost final : public ceres::CostFunction {
  public:
-  IrradianceCost(const Data* data, size_t lo, size_t hi, int nlights) : data_(data), lo_(lo), hi_(hi), n_(nlights) {
-    set_num_residuals(static_cast<int>(3 * (hi - lo)));
+  CompressedIrradianceCost(const Data* data, int nlights) : data_(data), n_(nlights) {
+    set_num_residuals(5 * nlights + 1);
     for (int i = 0; i < nlights; ++i) mutable_parameter_block_sizes()->push_back(5);
   }
 
   bool Evaluate(double const* const* params, double* residuals, double** jac) const override {
     std::vector<LightEval> le(n_);
     for (int i = 0; i < n_; ++i) le[i] = eval_light(params[i], data_->frames[i]);
-    int rows = num_residuals();
-    if (jac)
-      for (int i = 0; i < n_; ++i)
-        if (jac[i]) std::fill(jac[i], jac[i] + rows * 5, 0.0);
-    const auto& normals = *data_->normals;
-    for (size_t k = lo_; k < hi_; ++k) {
-      const Vec3& n = normals[k];
-      const Vec3& w = data_->weight[k];
-      Vec3 e;
-      int row = static_cast<int>(3 * (k - lo_));
+    const int P = 5 * n_, R = P + 1;
+    if (!jac) {
+      std::fill(residuals, residuals + R, 0.0);
+      residuals[0] = std::sqrt(sum_squares(le));
+      return std::isfinite(residuals[0]);
+    }
+    Eigen::MatrixXd G = gram(le);  // lower triangle, Ceres' parameter order, r last
+    Eigen::MatrixXd A = G.topLeftCorner(P, P).selfadjointView<Eigen::Lower>();
+    double maxd = A.diagonal().maxCoeff();
+    constexpr double kRidge = 1e-12;  // relative to the largest diagonal entry of JᵀJ
+    A.diagonal().array() += kRidge * maxd + 1e-300;
+    Eigen::LLT<Eigen::MatrixXd> llt(A);
+    if (llt.info() != Eigen::Success) return false;
+    Eigen::MatrixXd L = llt.matrixL();
+    Eigen::VectorXd g = G.block(P, 0, 1, P).transpose();  // Jᵀr
+    Eigen::VectorXd l = llt.matrixL().solve(g);
+    double s = std::sqrt(std::max(0.0, G(P, P) - l.squaredNorm()));
+    // S = [[Lᵀ, l], [0, s]]: row `row` of J̃ is row `row` of Lᵀ, i.e. column `row` of L.
+    for (int row = 0; row < R; ++row) {
+      residuals[row] = row < P ? l(row) : s;
       for (int i = 0; i < n_; ++i) {
-        double c = dot(n, le[i].d);
-        if (c <= 0) continue;
-        e += le[i].e * c;
-        if (jac && jac[i]) {
-          double ga = dot(n, le[i].da), gb = dot(n, le[i].db);
-          for (int ch = 0; ch < 3; ++ch) {
-            double s = w[ch] * le[i].e[ch];
-            double* J = jac[i] + (row + ch) * 5;
-            J[ch] = s * c;
-            J[3] = s * ga;
-            J[4] = s * gb;
-          }
+        if (!jac[i]) continue;
+        for (int j = 0; j < 5; ++j) {
+          int col = 5 * i + j;
+          jac[i][row * 5 + j] = (row < P && col >= row) ? L(col, row) : 0.0;
         }
       }
-      for (int ch = 0; ch < 3; ++ch) residuals[row + ch] = w[ch] * (e[ch] - data_->gt[k][ch]);
     }
     return true;
   }
 
  private:
+  static constexpr int kRanges = 4;   // fixed partition of the normals: deterministic sums
+  static constexpr int kChunk = 64;   // normals per rank update
+
+  double sum_squares(const std::vector<LightEval>& le) const {
+    const auto& normals = *data_->normals;
+    return parallel_reduce_fixed<double>(0, static_cast<int64_t>(normals.size()), 512, 0.0,
+      [&](int64_t lo, int64_t hi) {
+        double ss = 0;
+        for (int64_t k = lo; k < hi; ++k) {
+          Vec3 e;
+          for (const auto& l : le) {
+            double c = dot(normals[k], l.d);
+            if (c > 0) e += l.e * c;
+          }
+          for (int ch = 0; ch < 3; ++ch) {
+            double r = data_->weight[k][ch] * (e[ch] - data_->gt[k][ch]);
+            ss += r * r;
+          }
+        }
+        return ss;
+      },
+      [](double a, double b) { return a + b; });
+  }
+
+  // G = [J r]ᵀ[J r] (lower triangle) in Ceres' order: light i's q_r, q_g, q_b, a, b at 5i..5i+4; r last.
+  Eigen::MatrixXd gram(const std::vector<LightEval>& le) const {
+    const auto& normals = *data_->normals;
+    const int N = n_, C = 3 * N + 1;  // per-channel block: a,b of every light (2N), q_c (N), r
+    const int64_t M = static_cast<int64_t>(normals.size());
+    std::vector<std::array<Eigen::MatrixXd, 3>> part(kRanges);
+    parallel_for(0, kRanges, [&](int64_t p) {
+      for (auto& g : part[p]) g = Eigen::MatrixXd::Zero(C, C);
+      int64_t lo = M * p / kRanges, hi = M * (p + 1) / kRanges;
+      std::array<Eigen::MatrixXd, 3> B;
+      for (auto& b : B) b.resize(kChunk, C);
+      for (int64_t k0 = lo; k0 < hi; k0 += kChunk) {
+        int rows = static_cast<int>(std::min<int64_t>(kChunk, hi - k0));
+        for (auto& b : B) b.setZero();
+        for (int rr = 0; rr < rows; ++rr) {
+          int64_t k = k0 + rr;
+          const Vec3& n = normals[k];
+          const Vec3& w = data_->weight[k];
+          Vec3 e;
+          for (int i = 0; i < N; ++i) {
+            double c = dot(n, le[i].d);
+            if (c <= 0) continue;
+            e += le[i].e * c;
+            double ga = dot(n, le[i].da), gb = dot(n, le[i].db);
+            for (int ch = 0; ch < 3; ++ch) {
+              double sc = w[ch] * le[i].e[ch];
+              B[ch](rr, 2 * i) = sc * ga;
+              B[ch](rr, 2 * i + 1) = sc * gb;
+              B[ch](rr, 2 * N + i) = sc * c;
+            }
+          }
+          for (int ch = 0; ch < 3; ++ch) B[ch](rr, 3 * N) = w[ch] * (e[ch] - data_->gt[k][ch]);
+        }
+        for (int ch = 0; ch < 3; ++ch)
+          part[p][ch].selfadjointView<Eigen::Lower>().rankUpdate(B[ch].topRows(rows).transpose());
+      }
+    });
+    // Map a per-channel column to Ceres' order.
+    auto global = [&](int ch, int col) {
+      if (col < 2 * N) return 5 * (col / 2) + 3 + (col % 2);
+      if (col < 3 * N) return 5 * (col - 2 * N) + ch;
+      return 5 * N;
+    };
+    Eigen::MatrixXd G = Eigen::MatrixXd::Zero(5 * N + 1, 5 * N + 1);
+    for (int p = 0; p < kRanges; ++p)
+      for (int ch = 0; ch < 3; ++ch) {
+        const auto& g = part[p][ch];
+        for (int cj = 0; cj < C; ++cj)
+          for (int ci = cj; ci < C; ++ci) {
+            int a = global(ch, ci), b = global(ch, cj);
+            if (a >= b) G(a, b) += g(ci, cj); else G(b, a) += g(ci, cj);
+          }
+      }
+    return G;
+  }
+
   const Data* data_;
-  size_t lo_, hi_;
   int n_;
 };
 
@@ -167,16 +269,13 @@ StageResult solve_stage(const std::vector<Vec3>& normals, const std::vector<Vec3
   ceres::Problem problem;
   std::vector<double*> blocks(n);
   for (int i = 0; i < n; ++i) blocks[i] = p[i].data();
-  // Residual blocks of 128 normals: Ceres evaluates them in parallel.
-  constexpr size_t kChunk = 128;
-  for (size_t lo = 0; lo < normals.size(); lo += kChunk)
-    problem.AddResidualBlock(new IrradianceCost(&data, lo, std::min(normals.size(), lo + kChunk), n), nullptr, blocks);
+  problem.AddResidualBlock(new CompressedIrradianceCost(&data, n), nullptr, blocks);
   ceres::Solver::Options opt;
   opt.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
   opt.minimizer_type = ceres::TRUST_REGION;
   opt.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
   opt.max_num_iterations = max_iterations;
-  opt.num_threads = desc.threads > 0 ? desc.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  opt.num_threads = 1;  // one residual block; the Gram matrix is built with oneTBB threads
   opt.function_tolerance = desc.function_tolerance;
   opt.parameter_tolerance = 1e-8;
   opt.gradient_tolerance = 1e-10;
@@ -246,7 +345,7 @@ LightSet optimize_lights_from(const sphere::EnvMap& env, const std::vector<Vec3>
       auto coarse = sphere::icosphere_face_centres(level);
       if (2 * coarse.size() > normals.size()) break;
       auto coarse_gt = irradiance_ground_truth(env, coarse);
-      auto s = solve_stage(coarse, coarse_gt, lights, desc, desc.max_iterations);
+      auto s = solve_stage(coarse, coarse_gt, lights, desc, level == 3 ? desc.max_iterations : desc.mid_iterations);
       rep.iterations += s.iterations;
       coarse_ran = true;
       if (cost_of(final_data, s.lights) < cost_of(final_data, lights)) lights = s.lights;

@@ -27,12 +27,12 @@ struct OptimizeDesc {
   int normals_level = 5;           // icosphere level of the M normals (5: the 20480 of Madsen & Laursen)
   std::string init = "variance-cut";  // initial lights: "variance-cut" or "median-cut"
   double floor_fraction = 0.01;    // residual weight 1/max(E_gt, floor_fraction·mean E_gt), per channel
-  int max_iterations = 40;         // Levenberg–Marquardt iterations per coarse stage (or in all, without)
-  int final_iterations = 5;        // iterations on the full normal set after the coarse stages
+  int max_iterations = 40;         // Levenberg–Marquardt iterations on the level-3 normals (or in all, without coarse stages)
+  int mid_iterations = 20;         // iterations on the level-4 normals
+  int final_iterations = 30;       // iterations on the full normal set after the coarse stages
   double function_tolerance = 1e-5;  // Ceres: converged when the cost changes by less than this fraction
   bool coarse_to_fine = true;      // warm starts on level-3 and level-4 normals before the full set
   double min_separation_deg = 0;   // merge lights that end closer than this and re-solve (0: off)
-  int threads = 0;                 // Ceres threads (0: all hardware threads)
   ProgressFn progress;             // optional progress callback
 };
 
