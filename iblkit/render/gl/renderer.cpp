@@ -3,6 +3,7 @@
 #include <epoxy/gl.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <map>
 
@@ -275,6 +276,8 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing)
   std::vector<GLuint> queries(nframes);
   glGenQueries(nframes, queries.data());
   std::vector<double> times;
+  glFinish();
+  auto wall0 = std::chrono::steady_clock::now();
   for (int f = 0; f < nframes; ++f) {
     glBeginQuery(GL_TIME_ELAPSED, queries[f]);
     // Shadow passes.
@@ -335,12 +338,17 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing)
     }
     glEndQuery(GL_TIME_ELAPSED);
   }
+  glFinish();
+  double wall_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - wall0).count();
   for (int f = 0; f < nframes; ++f) {
     GLuint64 ns = 0;
     glGetQueryObjectui64v(queries[f], GL_QUERY_RESULT, &ns);
     times.push_back(ns * 1e-6);
   }
-  if (timing) timing->frame_ms = times;
+  if (timing) {
+    timing->frame_ms = times;
+    timing->wall_ms_per_frame = wall_ms / nframes;
+  }
 
   RenderResult out{Image(W, H, 3), Image(W, H, 1)};
   std::vector<float> rgba(static_cast<size_t>(W) * H * 4);

@@ -13,6 +13,9 @@ namespace ibl::render::gl {
 
 struct GpuTiming {
   std::vector<double> frame_ms;  // GPU time per frame (GL_TIME_ELAPSED), shadow passes included
+  double wall_ms_per_frame = 0;  // CPU wall clock over all frames until glFinish, divided by frames
+                                 // (the meaningful figure on software renderers such as llvmpipe,
+                                 // whose timer queries are not)
 };
 
 struct RendererDesc {
