@@ -123,7 +123,9 @@ SequenceResult write_sequence(const Scene& scene, const std::vector<Vec3>& posit
   Vec3 lo = positions.empty() ? Vec3{} : positions[0], hi = lo;
   bool inside = true;
   for (Vec3 p : positions) {
-    probes.push_back({{"image", fmt::format("frames/{:06d}{}", probes.size(), desc.frame_ext)}, {"position", vec_json(p)}});
+    json e = {{"image", fmt::format("frames/{:06d}{}", probes.size(), desc.frame_ext)}, {"position", vec_json(p)}};
+    if (desc.capture.depth) e["depth"] = fmt::format("frames/{:06d}_depth{}", probes.size(), desc.frame_ext);
+    probes.push_back(e);
     for (int k = 0; k < 3; ++k) {
       lo[k] = std::min(lo[k], p[k]);
       hi[k] = std::max(hi[k], p[k]);

@@ -32,8 +32,9 @@ struct SequenceResult {
   double seconds = 0;            // wall time of capture + writing
 };
 
-// Writes OUT/frames/000000.EXT … and OUT/sequence.json (iblkit.sequence/1, volume = the scene's
-// capture volume when every position lies in it, else the positions' bounds).
+// Writes OUT/frames/000000.EXT … (with 000000_depth.EXT when capture.depth) and OUT/sequence.json
+// (iblkit.sequence/1 plus "scene" and per-probe "depth"; volume = the scene's capture volume when
+// every position lies in it, else the positions' bounds).
 SequenceResult write_sequence(const Scene& scene, const std::vector<Vec3>& positions, const SequenceDesc& desc,
                               const ProgressFn& progress = {});
 
