@@ -44,6 +44,11 @@ Capture capture_probe(const Scene& scene, Vec3 position, const CaptureDesc& desc
   if (ball && desc.mapping != MappingKind::MirrorBall)
     fail(ErrorKind::Value, "the mirror-ball camera makes mirrorball images, not {}", sphere::mapping_name(desc.mapping));
   if (ball && !(desc.ball_radius >= 0)) fail(ErrorKind::Value, "ball radius {} must be ≥ 0", desc.ball_radius);
+  if (ball && !(desc.ball_reflectance >= 0 && desc.ball_reflectance <= 1))
+    fail(ErrorKind::Value, "ball reflectance {} must lie in [0, 1]", desc.ball_reflectance);
+  if (desc.render.area_samples < 1 || desc.render.env_samples < 1 || desc.render.bounces < 0 || desc.render.bounces > 64)
+    fail(ErrorKind::Value, "need area samples ≥ 1, environment samples ≥ 1 and 0 ≤ bounces ≤ 64 (got {}, {}, {})",
+         desc.render.area_samples, desc.render.env_samples, desc.render.bounces);
   Capture cap;
   cap.mapping = capture_mapping(desc.mapping, desc.size, ball ? 0.0 : desc.dead_angle_deg);
   const sphere::Mapping& m = cap.mapping;
