@@ -3,6 +3,8 @@
 #include <cmath>
 #include <fstream>
 
+#include <fmt/format.h>
+
 #include "iblkit/core/error.h"
 #include "iblkit/sh/basis.h"
 
@@ -43,6 +45,13 @@ nlohmann::json to_json(const Coeffs& c) {
   return {{"format", "iblkit.sh/1"}, {"bands", c.bands}, {"coefficients", arr}};
 }
 
+std::string to_json_text(const Coeffs& c) {
+  std::string s = fmt::format("{{\n  \"format\": \"iblkit.sh/1\",\n  \"bands\": {},\n  \"coefficients\": [\n", c.bands);
+  for (size_t k = 0; k < c.c.size(); ++k)
+    s += fmt::format("    [{}, {}, {}]{}\n", c.c[k].x, c.c[k].y, c.c[k].z, k + 1 < c.c.size() ? "," : "");
+  return s + "  ]\n}\n";
+}
+
 Coeffs coeffs_from_json(const nlohmann::json& j, const std::string& what) {
   if (!j.is_object()) fail(ErrorKind::Format, "{}: expected a JSON object", what);
   if (!j.contains("format") || j["format"] != "iblkit.sh/1")
@@ -72,7 +81,7 @@ void write_coeffs(const std::string& path, const Coeffs& c) {
   c.validate(path);
   std::ofstream f(path);
   if (!f) fail(ErrorKind::Io, "{}: cannot open for writing", path);
-  f << to_json(c).dump(2) << "\n";
+  f << to_json_text(c);
   if (!f) fail(ErrorKind::Io, "{}: write failed", path);
 }
 

@@ -27,6 +27,8 @@ struct Coeffs {
 };
 
 nlohmann::json to_json(const Coeffs& c);
+// The file text: one coefficient per line, shortest round-trip decimals.
+std::string to_json_text(const Coeffs& c);
 // Parses iblkit.sh/1; `what` names the source in error messages.
 Coeffs coeffs_from_json(const nlohmann::json& j, const std::string& what);
 void write_coeffs(const std::string& path, const Coeffs& c);

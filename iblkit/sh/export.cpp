@@ -80,7 +80,7 @@ Coeffs from_gltf(const Coeffs& g) {
 std::string export_text(const Coeffs& radiance, ExportFormat f) {
   radiance.validate("SH coefficients");
   switch (f) {
-    case ExportFormat::Iblkit: return to_json(radiance).dump(2) + "\n";
+    case ExportFormat::Iblkit: return to_json_text(radiance);
     case ExportFormat::ThreeJs: {
       Coeffs c = to_threejs(radiance);
       nlohmann::json arr = nlohmann::json::array();
