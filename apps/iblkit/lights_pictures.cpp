@@ -120,7 +120,7 @@ Image light_overlay(const ibl::sphere::EnvMap& env, const ibl::lights::LightSet&
         int rx = x * reg.width / width, ry = y * reg.height / height;
         int rx1 = std::min(reg.width - 1, (x + 1) * reg.width / width), ry1 = std::min(reg.height - 1, (y + 1) * reg.height / height);
         if (reg.at(rx, ry) != reg.at(rx1, ry) || reg.at(rx, ry) != reg.at(rx, ry1))
-          pic.set_rgb(x, y, pic.rgb(x, y) * 0.3 + Vec3{0.2, 0.9, 0.3} * 0.7);
+          pic.set_rgb(x, y, pic.rgb(x, y) * 0.15 + Vec3{0.1, 1.0, 0.2} * 0.85);
       }
   }
   for (size_t i = 0; i < set.lights.size(); ++i) {
@@ -131,8 +131,11 @@ Image light_overlay(const ibl::sphere::EnvMap& env, const ibl::lights::LightSet&
     double r = i < static_cast<size_t>(numbered) ? 5 : 3;
     ibl::io::draw_disc(pic, u * width, v * height, r + 1.5, {0, 0, 0});
     ibl::io::draw_disc(pic, u * width, v * height, r, {1.0, 0.15, 0.1});
-    if (static_cast<int>(i) < numbered)
-      ibl::io::draw_text(pic, static_cast<int>(u * width) + 7, static_cast<int>(v * height) - 5, std::to_string(i + 1), 14, {1, 1, 0.3});
+    if (static_cast<int>(i) < numbered) {
+      int tx = static_cast<int>(u * width) + 7, ty = static_cast<int>(v * height) - 5;
+      ibl::io::draw_text(pic, tx + 1, ty + 1, std::to_string(i + 1), 18, {0, 0, 0});
+      ibl::io::draw_text(pic, tx, ty, std::to_string(i + 1), 18, {1, 1, 0.2});
+    }
   }
   return pic;
 }
