@@ -6,7 +6,9 @@
 #include <nlohmann/json.hpp>
 
 #include "iblkit/core/error.h"
+#include "iblkit/io/image_io.h"
 #include "iblkit/lab/capture.h"
+#include "iblkit/lab/radiance.h"
 #include "iblkit/lab/scene_io.h"
 #include "iblkit/lab/sequence.h"
 
@@ -68,6 +70,31 @@ TEST(LabScene, BadFilesNameTheFieldAtFault) {
   expect_error(R"({"format":"iblkit.scene/1","surfaces":[{"type":"mesh","file":"nope.obj"}]})", "nope.obj");
   expect_error(R"({"format":"iblkit.scene/1","surfaces":[{"type":"room","min":[0,0,0],"max":[1,1,1],"albedo":1.5}]})", "albedo");
   EXPECT_THROW(load_scene("no-such-scene"), Error);
+  fs::remove_all(dir);
+}
+
+TEST(LabScene, TexturedAlbedoUnderAUniformSkyReflectsTheTexture) {
+  // Under a constant sky L a Lambertian floor gets E = πL and reflects ρ(uv)·L: the texture itself.
+  constexpr double kTexTol = 1e-5;  // float texture, texel centres hit exactly by nearest UVs
+  fs::path dir = temp_dir("tex");
+  Image tex(2, 2, 3);
+  tex.set_rgb(0, 0, {0.1, 0.2, 0.3});  // top-left: v near 1
+  tex.set_rgb(1, 0, {0.9, 0.8, 0.7});
+  tex.set_rgb(0, 1, {0.5, 0.5, 0.5});  // bottom-left: v near 0
+  tex.set_rgb(1, 1, {0.2, 0.6, 0.4});
+  io::write_image((dir / "t.exr").string(), tex);
+  std::ofstream(dir / "s.json") << R"({"format": "iblkit.scene/1",
+    "surfaces": [{"type": "quad", "center": [0, 0, 0], "normal": [0, 1, 0], "up": [0, 0, -1], "size": [2, 2],
+                  "albedo": {"texture": "t.exr"}}],
+    "emitters": [{"type": "environment", "radiance": 1}]})";
+  Scene s = load_scene((dir / "s.json").string());
+  // u runs along +x, v along `up` (−z): the texel (0,1) (bottom-left) lies at x < 0, z > 0.
+  Rng rng(1);
+  auto at = [&](double x, double z) { return radiance(s, {x, 1, z}, {0, -1, 0}, rng, s.render); };
+  Vec3 bl = at(-0.5, 0.5), tr = at(0.5, -0.5);
+  EXPECT_NEAR(bl.x, 0.5, kTexTol);
+  EXPECT_NEAR(tr.x, 0.9, kTexTol);
+  EXPECT_NEAR(tr.z, 0.7, kTexTol);
   fs::remove_all(dir);
 }
 
