@@ -50,6 +50,26 @@ TEST(LabScene, BuiltInScenesLoadAndAreLitInsideTheirVolume) {
   EXPECT_GT(t.proxy_mesh().triangle_count(), 10u);
 }
 
+TEST(LabScene, LowScene2RedSpotLightsAboutHalfTheVolume) {
+  // Löw et al., Fig. 8b: "one red spotlight that is blocked to illuminate roughly half of the scene".
+  constexpr double kHalfLo = 0.35, kHalfHi = 0.65;  // "roughly half"
+  Scene s = load_scene("low-scene2");
+  const Emitter* red = nullptr;
+  for (const Emitter& e : s.emitters)
+    if (e.type == EmitterType::Spot) red = &e;
+  ASSERT_NE(red, nullptr);
+  int lit = 0, n = 0;
+  for (Vec3 p : grid_positions(s.volume_min, s.volume_max, 6, 6, 6)) {
+    Vec3 w = red->position - p;
+    double d = length(w);
+    w = w / d;
+    ++n;
+    if (red->intensity_towards(-w).x > 0 && !s.tracer().occluded(p, w, 1e-4, d * (1 - 1e-4))) ++lit;
+  }
+  EXPECT_GT(static_cast<double>(lit) / n, kHalfLo);
+  EXPECT_LT(static_cast<double>(lit) / n, kHalfHi);
+}
+
 TEST(LabScene, BadFilesNameTheFieldAtFault) {
   fs::path dir = temp_dir("bad");
   auto expect_error = [&](const std::string& text, const std::string& needle) {
