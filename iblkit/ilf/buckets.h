@@ -21,7 +21,7 @@ namespace ibl::ilf {
 struct BucketDesc {
   std::string dir;                  // folder for the block files and index.json (created if missing)
   int octahedral = 0;               // 0: one bucket per probe pixel; n > 0: n×n octahedral direction cells
-  int max_block_buckets = 32;       // most buckets in one block (the unit later stages process at once)
+  int max_block_buckets = 64;       // most buckets in one block (the unit later stages process at once)
   size_t memory_bytes = size_t(2) << 30;  // peak memory budget of the whole build, bytes
   bool skip_bad = false;            // frames that fail (unreadable, wrong size, NaN/Inf, all black) are skipped
   bool sanitize = false;            // replace NaN/Inf/negative pixels by 0 instead of failing

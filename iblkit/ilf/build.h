@@ -21,8 +21,8 @@ struct BuildDesc {
   int bands = 5;                      // SH bands (5 = 25 coefficients)
   ProjectDesc project;                // kernel, raster, repair
   BucketDesc buckets;                 // bucket folder, memory budget, skip-bad; octahedral = −1 for auto
-  int auto_pixel_buckets = 4096;      // auto: one bucket per pixel when a frame has at most this many
-  int auto_octahedral = 24;           // auto: otherwise n×n octahedral buckets with this n
+  int auto_pixel_buckets = 1 << 20;   // auto: one bucket per pixel when a frame has at most this many pixels
+  int auto_octahedral = 256;          // auto: otherwise n×n octahedral buckets with this n
   std::optional<SubsampleDesc> subsample;  // sub-sample first when set
 };
 

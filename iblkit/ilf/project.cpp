@@ -130,6 +130,8 @@ ProjectStats project_bucket(const GridDesc& grid, const BucketRays& rays, const 
   sc.den.assign(npx, 0.0f);
   int rad_px = int(std::ceil(R / delta));
   double inv2s2 = 1.0 / (2 * sigma * sigma), R2 = R * R;
+  std::vector<double> dx2(size_t(2 * rad_px + 2));
+  std::vector<float> ex(size_t(2 * rad_px + 2));
   for (int p = 0; p < rays.n_probes; ++p) {
     if (rays.valid && !rays.valid[p]) continue;
     const float* L = rays.radiance(rays.ctx, p);
@@ -145,17 +147,27 @@ ProjectStats project_bucket(const GridDesc& grid, const BucketRays& rays, const 
       if (cx < -rad_px || cy < -rad_px || cx >= W + rad_px || cy >= H + rad_px) continue;
       ++st.rays;
       float r = L[3 * q], g = L[3 * q + 1], b = L[3 * q + 2];
-      for (int yy = std::max(0, cy - rad_px); yy <= std::min(H - 1, cy + rad_px + 1); ++yy) {
-        double dy = (yy - py) * delta;
-        for (int xx = std::max(0, cx - rad_px); xx <= std::min(W - 1, cx + rad_px + 1); ++xx) {
-          double dx = (xx - px) * delta, d2 = dx * dx + dy * dy;
-          if (d2 >= R2) continue;
-          float k = float(std::exp(-d2 * inv2s2));
-          size_t i = size_t(yy) * W + xx;
-          sc.num[i * 3] += k * r;
-          sc.num[i * 3 + 1] += k * g;
-          sc.num[i * 3 + 2] += k * b;
-          sc.den[i] += k;
+      // The Gaussian is separable: K = exp(−dx²/2σ²)·exp(−dy²/2σ²) inside the disc d² < R².
+      int x0 = std::max(0, cx - rad_px), x1 = std::min(W - 1, cx + rad_px + 1);
+      int y0 = std::max(0, cy - rad_px), y1 = std::min(H - 1, cy + rad_px + 1);
+      for (int xx = x0; xx <= x1; ++xx) {
+        double dx = (xx - px) * delta;
+        dx2[xx - x0] = dx * dx;
+        ex[xx - x0] = float(std::exp(-dx * dx * inv2s2));
+      }
+      for (int yy = y0; yy <= y1; ++yy) {
+        double dy = (yy - py) * delta, dy2 = dy * dy;
+        if (dy2 >= R2) continue;
+        float ey = float(std::exp(-dy2 * inv2s2));
+        float* nrow = sc.num.data() + (size_t(yy) * W) * 3;
+        float* drow = sc.den.data() + size_t(yy) * W;
+        for (int xx = x0; xx <= x1; ++xx) {
+          if (dx2[xx - x0] + dy2 >= R2) continue;
+          float k = ex[xx - x0] * ey;
+          nrow[xx * 3] += k * r;
+          nrow[xx * 3 + 1] += k * g;
+          nrow[xx * 3 + 2] += k * b;
+          drow[xx] += k;
         }
       }
     }
@@ -173,27 +185,39 @@ ProjectStats project_bucket(const GridDesc& grid, const BucketRays& rays, const 
   }
   int64_t G = grid.count();
   sc.covered.assign(size_t(G), 0);
-  for (int64_t gi = 0; gi < G; ++gi) {
-    Vec3 d = grid.point(gi) - c;
-    double px = std::clamp((dot(d, fr.t) - lo[0]) / delta, 0.0, W - 1.001), py = std::clamp((dot(d, fr.b) - lo[1]) / delta, 0.0, H - 1.001);
-    int x0 = int(px), y0 = int(py);
-    float fx = float(px - x0), fy = float(py - y0);
-    size_t i00 = size_t(y0) * W + x0, i10 = i00 + 1, i01 = i00 + W, i11 = i01 + 1;
-    float w00 = (1 - fx) * (1 - fy), w10 = fx * (1 - fy), w01 = (1 - fx) * fy, w11 = fx * fy;
-    float den = w00 * sc.den[i00] + w10 * sc.den[i10] + w01 * sc.den[i01] + w11 * sc.den[i11];
-    if (den > 0) {
-      sc.covered[gi] = 1;
-      for (int ch = 0; ch < 3; ++ch)
-        out[ch * out_stride + gi] = (w00 * sc.num[i00 * 3 + ch] + w10 * sc.num[i10 * 3 + ch] + w01 * sc.num[i01 * 3 + ch] +
-                                     w11 * sc.num[i11 * 3 + ch]) / den;
-    } else {
-      ++st.uncovered;
-      for (int ch = 0; ch < 3; ++ch)
-        out[ch * out_stride + gi] = plane_fill ? w00 * sc.rad[i00 * 3 + ch] + w10 * sc.rad[i10 * 3 + ch] +
-                                                     w01 * sc.rad[i01 * 3 + ch] + w11 * sc.rad[i11 * 3 + ch]
-                                               : 0.0f;
+  // Raster coordinates of grid point (i, j, k) are affine in (i, j, k): px = a0 + i·ai + j·aj + k·ak.
+  Vec3 sp3 = grid.spacing(), o = grid.volume.min - c;
+  double ax0 = (dot(o, fr.t) - lo[0]) / delta, ay0 = (dot(o, fr.b) - lo[1]) / delta;
+  double axi = sp3.x * fr.t.x / delta, axj = sp3.y * fr.t.y / delta, axk = sp3.z * fr.t.z / delta;
+  double ayi = sp3.x * fr.b.x / delta, ayj = sp3.y * fr.b.y / delta, ayk = sp3.z * fr.b.z / delta;
+  const float* num = sc.num.data();
+  const float* den_r = sc.den.data();
+  const float* fill = plane_fill ? sc.rad.data() : nullptr;
+  int64_t gi = 0;
+  for (int k = 0; k < grid.nz; ++k)
+    for (int j = 0; j < grid.ny; ++j) {
+      double rx = ax0 + j * axj + k * axk, ry = ay0 + j * ayj + k * ayk;
+      for (int i = 0; i < grid.nx; ++i, ++gi) {
+        double px = std::clamp(rx + i * axi, 0.0, W - 1.001), py = std::clamp(ry + i * ayi, 0.0, H - 1.001);
+        int x0 = int(px), y0 = int(py);
+        float fx = float(px - x0), fy = float(py - y0);
+        size_t i00 = size_t(y0) * W + x0, i10 = i00 + 1, i01 = i00 + W, i11 = i01 + 1;
+        float w00 = (1 - fx) * (1 - fy), w10 = fx * (1 - fy), w01 = (1 - fx) * fy, w11 = fx * fy;
+        float den = w00 * den_r[i00] + w10 * den_r[i10] + w01 * den_r[i01] + w11 * den_r[i11];
+        if (den > 0) {
+          sc.covered[gi] = 1;
+          float inv = 1.0f / den;
+          for (int ch = 0; ch < 3; ++ch)
+            out[ch * out_stride + gi] =
+                (w00 * num[i00 * 3 + ch] + w10 * num[i10 * 3 + ch] + w01 * num[i01 * 3 + ch] + w11 * num[i11 * 3 + ch]) * inv;
+        } else {
+          ++st.uncovered;
+          for (int ch = 0; ch < 3; ++ch)
+            out[ch * out_stride + gi] =
+                fill ? w00 * fill[i00 * 3 + ch] + w10 * fill[i10 * 3 + ch] + w01 * fill[i01 * 3 + ch] + w11 * fill[i11 * 3 + ch] : 0.0f;
+        }
+      }
     }
-  }
   if (desc.repair == Repair::Mip && st.uncovered > 0) repair_mip(grid, out, out_stride, sc.covered.data());
   return st;
 }
