@@ -29,23 +29,37 @@ void validate_probe(const sphere::EnvMap& env, int count) {
   const Image& img = env.image;
   if (img.empty()) fail(ErrorKind::Value, "the probe is empty (0 pixels)");
   if (count < 1) fail(ErrorKind::Value, "light count must be at least 1 (got {})", count);
-  int nc = img.channels();
-  size_t lit = 0;
-  for (int y = 0; y < img.height(); ++y)
-    for (int x = 0; x < img.width(); ++x) {
-      const float* p = img.pixel(x, y);
+  int nc = std::min(img.channels(), 3);
+  bool all_valid = env.mapping.kind() == sphere::MappingKind::LatLong;
+  // Per row: lit pixels, and the first bad value (x, channel) if any; rows in parallel.
+  struct Row { int64_t lit = 0; int bad_x = -1, bad_c = 0; };
+  std::vector<Row> rows(img.height());
+  parallel_for(0, img.height(), [&](int64_t y) {
+    Row r;
+    for (int x = 0; x < img.width() && r.bad_x < 0; ++x) {
+      const float* p = img.pixel(x, static_cast<int>(y));
       bool any = false;
-      for (int c = 0; c < std::min(nc, 3); ++c) {
+      for (int c = 0; c < nc; ++c) {
         float v = p[c];
-        if (!std::isfinite(v)) fail(ErrorKind::Value, "probe pixel ({}, {}) channel {} is {} (use --sanitize)", x, y, c, v);
-        if (v < 0) fail(ErrorKind::Value, "probe pixel ({}, {}) channel {} is negative ({}) (use --sanitize)", x, y, c, v);
+        if (!(v >= 0) || !std::isfinite(v)) { r.bad_x = x; r.bad_c = c; break; }
         any = any || v > 0;
       }
-      if (any && env.mapping.valid(x, y)) ++lit;
+      if (any && (all_valid || env.mapping.valid(x, static_cast<int>(y)))) ++r.lit;
     }
+    rows[y] = r;
+  }, 8);
+  int64_t lit = 0;
+  for (int y = 0; y < img.height(); ++y) {
+    const Row& r = rows[y];
+    if (r.bad_x >= 0) {
+      float v = img.pixel(r.bad_x, y)[r.bad_c];
+      fail(ErrorKind::Value, "probe pixel ({}, {}) channel {} is {} (use --sanitize)", r.bad_x, y, r.bad_c,
+           std::isfinite(v) ? fmt::format("negative ({})", v) : fmt::format("{}", v));
+    }
+    lit += r.lit;
+  }
   if (lit == 0) fail(ErrorKind::Value, "the probe is all black: there is no light to extract");
-  if (static_cast<size_t>(count) > lit)
-    fail(ErrorKind::Value, "light count {} is larger than the {} pixels that carry light", count, lit);
+  if (count > lit) fail(ErrorKind::Value, "light count {} is larger than the {} pixels that carry light", count, lit);
 }
 
 LatLongGrid to_latlong_grid(const sphere::EnvMap& env) {
