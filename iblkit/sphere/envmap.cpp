@@ -7,6 +7,8 @@
 #include "iblkit/core/fastmath.h"
 #include "iblkit/core/parallel.h"
 
+#include <tbb/enumerable_thread_specific.h>
+
 namespace ibl::sphere {
 
 EnvMap::EnvMap(Image img, Mapping m) : image(std::move(img)), mapping(m) {
@@ -131,14 +133,6 @@ double pixel_distance(const Mapping& m, double ax, double ay, double bx, double 
   return std::sqrt(dx * dx + dy * dy);
 }
 
-// The face a cube-layout pixel belongs to (the pixel must be inside a used cell).
-int cube_face_at(const Mapping& m, int x, int y) {
-  Vec3 d;
-  m.to_direction(x + 0.5, y + 0.5, &d);
-  double s, t;
-  return cube_face_of(d, &s, &t);
-}
-
 }  // namespace
 
 Image resample(const EnvMap& src, const Mapping& dst, const ResampleDesc& desc) {
@@ -151,21 +145,33 @@ Image resample(const EnvMap& src, const Mapping& dst, const ResampleDesc& desc) 
   bool fast = src.mapping.kind() == MappingKind::LatLong;
   bool cube_dst = dst.kind() == MappingKind::CubeHCross || dst.kind() == MappingKind::CubeVCross ||
                   dst.kind() == MappingKind::CubeStrip;
+  struct RowBuffers {
+    std::vector<float> dx, dy, dz, vals, ub, vb;
+    std::vector<int> owner;
+  };
+  tbb::enumerable_thread_specific<RowBuffers> buffers;
   parallel_for(0, dst.height(), [&](int64_t yy) {
     int y = static_cast<int>(yy);
     // Pass 1: the row's sub-sample directions; pass 2: look them all up; pass 3: average.
-    std::vector<float> dx, dy, dz;
-    std::vector<int> owner;
-    size_t guess = static_cast<size_t>(dst.width()) * 4;
-    dx.reserve(guess); dy.reserve(guess); dz.reserve(guess); owner.reserve(guess);
+    RowBuffers& rb = buffers.local();
+    std::vector<float>&dx = rb.dx, &dy = rb.dy, &dz = rb.dz;
+    std::vector<int>& owner = rb.owner;
+    dx.clear(); dy.clear(); dz.clear(); owner.clear();
     int nx = 1, ny = 1, footprint_at = -1000;
     for (int x = 0; x < dst.width(); ++x) {
       Vec3 c;
-      if (!dst.to_direction(x + 0.5, y + 0.5, &c)) continue;
+      int face = -1;
+      bool rot = false;
+      if (cube_dst) {
+        if (!dst.cube_cell(x, y, &face, &rot)) continue;
+      } else if (!dst.to_direction(x + 0.5, y + 0.5, &c)) {
+        continue;
+      }
       // The output pixel's footprint in the input: where its centre and its two neighbours land.
       // It changes slowly, so it is measured every kFootprintStride pixels.
-      constexpr int kFootprintStride = 4;
+      constexpr int kFootprintStride = 8;
       if (x - footprint_at >= kFootprintStride) {
+        if (cube_dst) dst.to_direction(x + 0.5, y + 0.5, &c);
         footprint_at = x;
         Vec3 cx, cy;
         bool okx = dst.to_direction(x + 1.5, y + 0.5, &cx) || dst.to_direction(x - 0.5, y + 0.5, &cx);
@@ -181,10 +187,8 @@ Image resample(const EnvMap& src, const Mapping& dst, const ResampleDesc& desc) 
       }
       if (cube_dst && !rotate) {
         // Cube faces: the sub-sample directions straight from the face's (s, t), in float.
-        int face = cube_face_at(dst, x, y);
         const int F = dst.face_size();
         const float fx = static_cast<float>(x % F), fy = static_cast<float>(y % F), inv_f = 2.0f / F;
-        const bool rot = dst.kind() == MappingKind::CubeVCross && face == 5;
         for (int j = 0; j < ny; ++j)
           for (int i = 0; i < nx; ++i) {
             float s = (fx + (i + 0.5f) / nx) * inv_f - 1.0f, t = (fy + (j + 0.5f) / ny) * inv_f - 1.0f;
@@ -218,7 +222,10 @@ Image resample(const EnvMap& src, const Mapping& dst, const ResampleDesc& desc) 
         }
     }
     int count = static_cast<int>(dx.size());
-    std::vector<float> vals(static_cast<size_t>(count) * nc), ub(count), vb(count);
+    std::vector<float>&vals = rb.vals, &ub = rb.ub, &vb = rb.vb;
+    vals.resize(static_cast<size_t>(count) * nc);
+    ub.resize(count);
+    vb.resize(count);
     if (fast) {
       if (nc == 3) latlong_lookup_batch<3>(src.image, dx.data(), dy.data(), dz.data(), count, ub.data(), vb.data(), vals.data());
       else latlong_lookup_batch<0>(src.image, dx.data(), dy.data(), dz.data(), count, ub.data(), vb.data(), vals.data());

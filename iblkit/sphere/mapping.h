@@ -64,6 +64,13 @@ class Mapping {
   // True where the pixel centre carries data (inside the disc, a used cell, outside the dead angle).
   bool valid(int x, int y) const;
 
+  // Cube layouts: the face under pixel (x, y) and whether its cell is turned 180° (vcross −Z);
+  // false for an unused cell or a non-cube mapping.
+  bool cube_cell(int x, int y, int* face, bool* rot180) const {
+    if (face_ == 0 || x < 0 || y < 0 || x >= width_ || y >= height_) return false;
+    return cell_face(x / face_, y / face_, face, rot180);
+  }
+
   // Expected aspect ratio (width/height) of a layout: 2, 1, 4/3, 3/4, 6.
   static double aspect(MappingKind k);
 
