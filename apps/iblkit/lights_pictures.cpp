@@ -27,11 +27,11 @@ void dashed_line(Image& img, double x0, double y0, double x1, double y1, Vec3 c,
   }
 }
 
-// A "nice" axis maximum: 1, 2 or 5 × 10^k above v.
+// A "nice" axis maximum: 1, 1.2, 1.5, 2, 2.5, 3, 4, 5, 6 or 8 × 10^k at or above v.
 double nice_ceiling(double v) {
   if (v <= 0) return 1;
   double p = std::pow(10.0, std::floor(std::log10(v)));
-  for (double m : {1.0, 2.0, 5.0, 10.0})
+  for (double m : {1.0, 1.2, 1.5, 2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0})
     if (m * p >= v) return m * p;
   return 10 * p;
 }
