@@ -176,15 +176,17 @@ bool pixel_basis(const sphere::Mapping& m, int bands, int x, int y, double* out,
   Vec3 c, corner[4];
   bool centre_ok = m.to_direction(x + 0.5, y + 0.5, &c);
   bool corners_ok = true;
-  double spread = 0;
+  double min_dot = 1.0;
   for (int i = 0; i < 4; ++i) {
     corners_ok = m.to_direction(x + (i & 1), y + (i >> 1), &corner[i]) && corners_ok;
-    if (centre_ok && corners_ok) spread = std::max(spread, std::acos(std::clamp(dot(c, corner[i]), -1.0, 1.0)));
+    if (centre_ok && corners_ok) min_dot = std::min(min_dot, dot(c, corner[i]));
   }
-  if (centre_ok && corners_ok && spread <= kSpread) {
+  static const double kCosSpread = std::cos(kSpread);
+  if (centre_ok && corners_ok && min_dot >= kCosSpread) {
     eval_basis(bands, c, out);
     return true;
   }
+  const double spread = std::acos(std::clamp(min_dot, -1.0, 1.0));
   int n = centre_ok && corners_ok ? std::min(kMaxSub, static_cast<int>(std::ceil(spread / kSpread))) : kMaxSub;
   std::fill(out, out + K, 0.0);
   double wsum = 0;
