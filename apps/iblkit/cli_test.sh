@@ -23,8 +23,14 @@ check() {
 }
 
 check help ok "Subcommands" -- "$BIN" --help
-for sub in $("$BIN" --help | awk '/^Subcommands:/{f=1;next} f&&NF{print $1}'); do
-  check "help-$sub" ok "Example" -- "$BIN" "$sub" --help
+subcommands() { "$@" --help | awk '/^Subcommands:/{f=1;next} f&&NF{print $1}'; }
+for sub in $(subcommands "$BIN"); do
+  nested=$(subcommands "$BIN" "$sub")
+  if [ -z "$nested" ]; then
+    check "help-$sub" ok "Example" -- "$BIN" "$sub" --help
+  else  # a group (lab, ilf): every member shows an example
+    for leaf in $nested; do check "help-$sub-$leaf" ok "Example" -- "$BIN" "$sub" "$leaf" --help; done
+  fi
 done
 check no-subcommand fail "" -- "$BIN"
 check unknown-subcommand fail "" -- "$BIN" frobnicate
@@ -46,6 +52,12 @@ if [ -f "$PROBE" ]; then
   check bad-extension fail "no image writer" -- "$BIN" convert "$PROBE" "$T/x.xyz" --size 8
   check preview ok "wrote" -- "$BIN" preview "$PROBE" "$T/p.png"
   check demo-mappings ok "contact sheet" -- "$BIN" demo --out "$T/demo" --only mappings
+  check demo-unknown-step fail "no demo step 'nope'" -- "$BIN" demo --out "$T/demo" --only nope
+  check lab-capture ok "" -- "$BIN" lab capture low-scene1 --probe 0,1,0 --size 16 --out "$T/lab"
+  check render-cpu ok "CPU time" -- "$BIN" render blob --light "$PROBE" --backend cpu --size 64x48 --triangles 2000 --out "$T/r.png"
+  check render-bad-size fail "--size" -- "$BIN" render blob --light "$PROBE" --size 64by48 --out "$T/r.png"
+  printf '{"format":"iblkit.lights/1","lights":[{"direction":[0,1,0]}]}' > "$T/bad_lights.json"
+  check render-bad-lights fail "lacks" -- "$BIN" render blob --light "$T/bad_lights.json" --backend cpu --out "$T/r.png"
   [ -s "$T/demo/contact_sheet.png" ] && pass=$((pass+1)) || { echo "FAIL demo wrote no contact sheet"; fail=$((fail+1)); }
 else
   skip=$((skip+1))
