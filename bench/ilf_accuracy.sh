@@ -39,8 +39,8 @@ def truth(p):
         tj = json.load(open(os.path.join(d, "truth.json")))
         truth_cache[key] = (sh, tj)
     return truth_cache[key]
-print("| scene | probes | grid | repair | rel. L2 SH (%d pts) | rel. irradiance error (+Y) | uncovered | build s |" % npts)
-print("| --- | --- | --- | --- | --- | --- | --- | --- |")
+print("| scene | probes | grid | repair | rel. L2 SH (%d pts) | median point rel. SH error | rel. irradiance error (+Y) | uncovered | build s |" % npts)
+print("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
 for n in grids:
     n = int(n)
     pts = [[lo[a] + (hi[a] - lo[a]) * rng.randrange(n) / (n - 1) for a in range(3)] for _ in range(npts)]
@@ -49,17 +49,21 @@ for n in grids:
         r = run("ilf", "build", os.path.join(cap, "sequence.json"), "--grid", str(n), "--repair", rep, "--out", out,
                 "--buckets", os.path.join(cap, "buckets"))
         num = den = en = ed = 0.0
+        per = []
         for p in pts:
+            pn = pd = 0.0
             sh, tj = truth(p)
             q = run("ilf", "query", out, "--at", ",".join("%.9g" % v for v in p), "--normal", "0,1,0")
             for k in range(25):
                 for c in range(3):
-                    num += (q["coefficients"][k][c] - sh[k][c]) ** 2
-                    den += sh[k][c] ** 2
+                    pn += (q["coefficients"][k][c] - sh[k][c]) ** 2
+                    pd += sh[k][c] ** 2
+            num += pn; den += pd; per.append(math.sqrt(pn / pd))
             E = tj["irradiance"][0]["irradiance"]
             for c in range(3):
                 en += (q["irradiance"][c] - E[c]) ** 2
                 ed += E[c] ** 2
-        print("| %s | %d | %d³ | %s | %.4f | %.4f | %.4f | %.1f |" % (scene, len(seq["probes"]), n, rep, math.sqrt(num / den),
+        per.sort()
+        print("| %s | %d | %d³ | %s | %.4f | %.4f | %.4f | %.4f | %.1f |" % (scene, len(seq["probes"]), n, rep, math.sqrt(num / den), per[len(per) // 2],
               math.sqrt(en / ed), r["fraction_uncovered"], r["seconds"]["total"]))
 PY

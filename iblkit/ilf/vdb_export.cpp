@@ -20,8 +20,11 @@ void write_vdb(const std::string& path, const SHGrid& g) {
   Vec3 sp = gd.spacing();
   int K = g.coeff_count();
   openvdb::GridPtrVec grids;
-  auto xf = openvdb::math::Transform::createLinearTransform(openvdb::math::Mat4d(
-      sp.x, 0, 0, 0, 0, sp.y, 0, 0, 0, 0, sp.z, 0, gd.volume.min.x, gd.volume.min.y, gd.volume.min.z, 1));
+  // Index (i, j, k) -> world min + spacing·(i, j, k): a row-vector matrix, translation in the last row.
+  openvdb::math::Mat4d m = openvdb::math::Mat4d::identity();
+  m.setToScale(openvdb::Vec3d(sp.x, sp.y, sp.z));
+  m.setTranslation(openvdb::Vec3d(gd.volume.min.x, gd.volume.min.y, gd.volume.min.z));
+  auto xf = openvdb::math::Transform::createLinearTransform(m);
   for (int l = 0, k = 0; l < g.bands(); ++l)
     for (int m = -l; m <= l; ++m, ++k) {
       auto grid = openvdb::Vec3fGrid::create(openvdb::Vec3f(0.0f));
