@@ -55,6 +55,10 @@ if [ -f "$PROBE" ]; then
   check demo-unknown-step fail "no demo step 'nope'" -- "$BIN" demo --out "$T/demo" --only nope
   check lab-capture ok "" -- "$BIN" lab capture low-scene1 --probe 0,1,0 --size 16 --out "$T/lab"
   check render-cpu ok "CPU time" -- "$BIN" render blob --light "$PROBE" --backend cpu --size 64x48 --triangles 2000 --out "$T/r.png"
+  check lights ok "" -- "$BIN" lights "$PROBE" --method median-cut --count 8 --out "$T/l.json" --overlay "$T/l.png"
+  check render-lights ok "8 directional lights" -- "$BIN" render blob --light "$T/l.json" --backend cpu --size 64x48 --triangles 2000 --out "$T/rl.png"
+  check lights-zero fail "" -- "$BIN" lights "$PROBE" --count 0
+  check eval-small ok "" -- "$BIN" eval "$PROBE" --methods median-cut,variance-cut --counts 1,4 --normals-level 2 --out "$T/ev"
   check render-bad-size fail "--size" -- "$BIN" render blob --light "$PROBE" --size 64by48 --out "$T/r.png"
   printf '{"format":"iblkit.lights/1","lights":[{"direction":[0,1,0]}]}' > "$T/bad_lights.json"
   check render-bad-lights fail "lacks" -- "$BIN" render blob --light "$T/bad_lights.json" --backend cpu --out "$T/r.png"
