@@ -148,7 +148,18 @@ void demo_step(iblcli::DemoContext& ctx) {
   sphere::Mapping ll(sphere::MappingKind::LatLong, 256, 128);
   picture("irradiance3", "SH irradiance E/pi, 3 bands", irradiance_image(c3, 128), true);
   picture("irradiance5", "SH irradiance E/pi, 5 bands", irradiance_image(c5, 128), true);
-  picture("radiance5", "SH radiance, 5 bands (clamped at 0)", sh::reconstruct(c5, ll), false);
+  // Raw 5-band radiance of a probe with a sun rings far below zero; a Hanning window gives a
+  // picture a person can read, exposed on its own (the sun's energy spreads over the whole sky).
+  sh::WindowDesc hann;
+  hann.kind = sh::Window::Hanning;
+  {
+    Image r = sh::reconstruct(sh::apply_window(c5, hann), ll);
+    for (size_t i = 0; i < r.size(); ++i) r.data()[i] = std::max(0.0f, r.data()[i]);
+    io::write_image((dir / "radiance5.exr").string(), r);
+    std::string png = (dir / "radiance5.png").string();
+    io::write_image(png, io::tonemap(r));
+    ctx.pictures.push_back({"SH radiance, 5 bands, Hanning window", png});
+  }
 
   // How far 3 bands are from 5 over the sphere, relative to the peak irradiance.
   double peak = 0, worst = 0;
