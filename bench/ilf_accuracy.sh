@@ -4,7 +4,7 @@
 # each repair, and compares the grid's coefficients at POINTS random grid points per resolution with
 # `iblkit lab truth` there (relative L2 over points × 25 coefficients × RGB), plus the irradiance
 # for the normal +Y at the same points.
-#   bench/ilf_accuracy.sh [IBLKIT] [WORKDIR]   environment: SCENE (low-scene2), PROBES (1000), SIZE (64),
+#   bench/ilf_accuracy.sh [IBLKIT] [WORKDIR]   environment: SCENE (low-scene2), PROBES (1000), SIZE (64), SAMPLES (2: n×n per pixel),
 #                                              GRIDS ("8 16 32"), POINTS (16), REPAIRS ("mip pullpush")
 set -euo pipefail
 BIN=${1:-build/iblkit}
@@ -12,13 +12,14 @@ WORK=${2:-/tmp/iblkit_ilf_accuracy}
 SCENE=${SCENE:-low-scene2}
 PROBES=${PROBES:-1000}
 SIZE=${SIZE:-64}
+SAMPLES=${SAMPLES:-2}
 GRIDS=${GRIDS:-8 16 32}
 POINTS=${POINTS:-16}
 REPAIRS=${REPAIRS:-mip pullpush}
-CAP="$WORK/$SCENE-p$PROBES-s$SIZE"
+CAP="$WORK/$SCENE-p$PROBES-s$SIZE-x$SAMPLES"
 mkdir -p "$WORK"
 if [ ! -f "$CAP/sequence.json" ]; then
-  "$BIN" --quiet lab capture "$SCENE" --random "$PROBES" --mapping mirrorball --size "$SIZE" --samples 2 \
+  "$BIN" --quiet lab capture "$SCENE" --random "$PROBES" --mapping mirrorball --size "$SIZE" --samples "$SAMPLES" \
     --dead-angle 4.2 --half --out "$CAP" > /dev/null
 fi
 python3 - "$BIN" "$CAP" "$SCENE" "$POINTS" "$GRIDS" "$REPAIRS" <<'PY'

@@ -71,7 +71,7 @@ nlohmann::json report_json(const ilf::BuildReport& r) {
 
 void setup_build(CLI::App& app) {
   struct Opts {
-    std::string seq, out, grid = "16", volume, repair = "pullpush", memory = "2G", buckets, vdb, directions = "auto";
+    std::string seq, out, grid = "16", volume, repair = "mip", memory = "2G", buckets, vdb, directions = "auto";
     int bands = 5;
     double kernel = 3.0, subsample = -1, subsample_dist = 0.05;
     bool skip_bad = false, sanitize = false, no_reuse = false;
@@ -83,7 +83,7 @@ void setup_build(CLI::App& app) {
   app.add_option("--bands", o->bands, "SH bands (5 = 25 coefficients)")->capture_default_str()->check(CLI::Range(1, 10));
   app.add_option("--volume", o->volume, "grid volume minx,miny,minz,maxx,maxy,maxz (default: the sequence's)");
   app.add_option("--kernel", o->kernel, "Gaussian kernel support diameter in grid cells")->capture_default_str();
-  app.add_option("--repair", o->repair, "filling of grid points no ray reached: pullpush, mip (the paper's), none")->capture_default_str();
+  app.add_option("--repair", o->repair, "filling of grid points no ray reached: mip (the paper's), pullpush, none")->capture_default_str();
   app.add_option("--memory", o->memory, "peak memory budget (e.g. 2G, 512M)")->capture_default_str();
   app.add_option("--buckets", o->buckets, "folder for the direction buckets (default: OUT.buckets; reused by re-runs)");
   app.add_option("--directions", o->directions, "direction buckets: auto, pixel (one per probe pixel, the paper's) or N (N×N octahedral cells)")->capture_default_str();

@@ -20,7 +20,7 @@ Repair parse_repair(const std::string& s);
 struct ProjectDesc {
   double kernel_cells = 3.0;  // Gaussian kernel support diameter in grid cells ([1] §5.2 uses 3)
   double raster_cells = 0.5;  // pixel size of the plane raster in grid cells (smaller = exacter, slower)
-  Repair repair = Repair::PullPush;  // how grid points without a ray are filled
+  Repair repair = Repair::Mip;  // how grid points without a ray are filled (mip measured better overall: docs/ilf.md)
 };
 
 // The rays of one bucket: n_dirs directions × n_probes origins, radiance per (probe, direction).
