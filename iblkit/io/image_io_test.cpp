@@ -159,8 +159,11 @@ TEST(EnvMapIo, CubeFaceFolderRoundTrip) {
   auto back = read_envmap(dir);
   ASSERT_EQ(back.mapping.kind(), sphere::MappingKind::CubeHCross);
   for (int y = 0; y < 48; ++y)
-    for (int x = 0; x < 64; ++x)
-      if (env.mapping.solid_angle(x, y) > 0) ASSERT_EQ(back.image.at(x, y, 0), cross.at(x, y, 0)) << x << "," << y;
+    for (int x = 0; x < 64; ++x) {
+      if (env.mapping.solid_angle(x, y) > 0) {
+        ASSERT_EQ(back.image.at(x, y, 0), cross.at(x, y, 0)) << x << "," << y;
+      }
+    }
   fs::remove(fs::path(dir) / "pz.exr");
   expect_error([&] { read_envmap(dir); }, ErrorKind::Io, {"pz"});
 }
