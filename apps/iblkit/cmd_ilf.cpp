@@ -59,7 +59,7 @@ size_t parse_bytes(const std::string& s) {
 }
 
 nlohmann::json report_json(const ilf::BuildReport& r) {
-  return {{"probes_in", r.probes_in}, {"probes_used", r.probes_used}, {"skipped", r.skipped},
+  return {{"probes_in", r.probes_in}, {"probes_used", r.probes_used}, {"skipped", r.skipped}, {"subsampled_out", r.subsampled_out},
           {"buckets", r.buckets}, {"blocks", r.blocks}, {"octahedral", r.octahedral}, {"samples", r.samples},
           {"fraction_uncovered", r.fraction_uncovered}, {"buckets_reused", r.buckets_reused},
           {"seconds", {{"subsample", r.t_subsample}, {"sort", r.t_sort}, {"project", r.t_project},
@@ -96,6 +96,7 @@ void setup_build(CLI::App& app) {
   app.footer("Example:\n  iblkit ilf build captures/sequence.json --grid 32 --bands 5 --out room.shgrid");
   app.callback([o] {
     auto grid = parse_grid(o->grid);
+    if (!o->vdb.empty() && !ilf::have_vdb()) ilf::write_vdb(o->vdb, ilf::SHGrid());  // fails now, not after the build
     ilf::BuildDesc bd;
     bd.nx = grid[0]; bd.ny = grid[1]; bd.nz = grid[2];
     bd.bands = o->bands;
@@ -131,8 +132,9 @@ void setup_build(CLI::App& app) {
     j["out"] = o->out;
     iblcli::emit(j, [&] {
       fmt::print("wrote {} ({}x{}x{}, {} coefficients)\n", o->out, bd.nx, bd.ny, bd.nz, bd.bands * bd.bands);
-      fmt::print("probes    {} used of {}{}\n", rep.probes_used + srep.skipped - rep.skipped, rep.probes_in + srep.skipped,
-                 rep.skipped ? fmt::format(", {} skipped", rep.skipped) : "");
+      fmt::print("probes    {} used of {} in the manifest{}{}\n", rep.probes_used, rep.probes_in + srep.skipped,
+                 rep.skipped ? fmt::format(", {} skipped as bad", rep.skipped) : "",
+                 rep.subsampled_out ? fmt::format(", {} dropped by --subsample", rep.subsampled_out) : "");
       fmt::print("buckets   {} ({}), {} blocks{}\n", rep.buckets, rep.octahedral ? fmt::format("{0}x{0} octahedral", rep.octahedral) : "one per pixel",
                  rep.blocks, rep.buckets_reused ? ", reused" : "");
       fmt::print("samples   {} ({:.3g}/s), {:.2f}% of grid point × bucket pairs repaired\n", rep.samples,

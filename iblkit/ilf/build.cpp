@@ -59,9 +59,12 @@ SHGrid build_shgrid(const Sequence& seq_in, const BuildDesc& desc, const Progres
   Sequence seq = seq_in;
   if (desc.subsample) {
     auto t0 = Clock::now();
-    auto keep = subsample(seq_in, *desc.subsample, progress);
+    SubsampleDesc sd = *desc.subsample;
+    sd.skip_bad = sd.skip_bad || desc.buckets.skip_bad;
+    auto keep = subsample(seq_in, sd, progress);
     seq.probes.clear();
     for (int i : keep) seq.probes.push_back(seq_in.probes[i]);
+    rep.subsampled_out = int(seq_in.probes.size() - keep.size());
     rep.t_subsample = since(t0);
   }
   // Sort.

@@ -28,7 +28,8 @@ struct BuildDesc {
 
 struct BuildReport {
   int probes_in = 0, probes_used = 0;  // before and after sub-sampling / skipping
-  int skipped = 0;                     // frames skipped (--skip-bad), manifest and frames together
+  int skipped = 0;                     // probes skipped as bad (--skip-bad)
+  int subsampled_out = 0;              // probes dropped by sub-sampling
   std::vector<std::string> skip_reasons;
   int buckets = 0, blocks = 0;         // direction buckets and blocks
   int octahedral = 0;                  // 0 = pixel buckets

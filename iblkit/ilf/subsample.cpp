@@ -39,7 +39,19 @@ std::vector<int> subsample(const Sequence& seq, const SubsampleDesc& desc, const
   parallel_for(0, n - 1, [&](int64_t i) {
     const auto &pa = seq.probes[i], &pb = seq.probes[i + 1];
     if (length(pa.position - pb.position) <= desc.max_distance) {
-      Image a = io::read_image(pa.image, {false, 3}), b = io::read_image(pb.image, {false, 3});
+      Image a, b;
+      try {
+        a = io::read_image(pa.image, {false, 3});
+      } catch (const Error& err) {
+        if (desc.skip_bad) return;
+        fail(err.kind(), "{}: probe {}: field \"image\": {}", seq.manifest, i, err.what());
+      }
+      try {
+        b = io::read_image(pb.image, {false, 3});
+      } catch (const Error& err) {
+        if (desc.skip_bad) return;
+        fail(err.kind(), "{}: probe {}: field \"image\": {}", seq.manifest, i + 1, err.what());
+      }
       if (a.width() != b.width() || a.height() != b.height())
         fail(ErrorKind::Value, "{}: probe {}: field \"image\": {}x{} differs from probe {}'s {}x{}", seq.manifest, i + 1,
              b.width(), b.height(), i, a.width(), a.height());

@@ -13,6 +13,7 @@ namespace ibl::ilf {
 struct SubsampleDesc {
   double threshold = 0.05;     // drop when relative difference energy E to both neighbours is below this
   double max_distance = 0.05;  // … and both neighbours lie within this many metres
+  bool skip_bad = false;       // a frame that cannot be read keeps its neighbours (the bucket sort skips it)
 };
 
 struct SubsampleReport {
