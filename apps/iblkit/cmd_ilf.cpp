@@ -236,6 +236,7 @@ void setup_slice(CLI::App& app) {
 void setup_info(CLI::App& app) {
   auto* path = new std::string();
   app.add_option("grid", *path, ".shgrid file")->required();
+  app.footer("Example:\n  iblkit ilf info room.shgrid");
   app.callback([path] {
     auto g = ilf::read_shgrid(*path);
     const auto& gd = g.grid();
