@@ -110,7 +110,7 @@ SHGrid build_shgrid(const Sequence& seq_in, const BuildDesc& desc, const Progres
     auto tp = Clock::now();
     store.load_block(k, buf);
     int b0 = t.block_begin[k], b1 = t.block_begin[k + 1], D = b1 - b0;
-    R.assign(size_t(rows) * D, 0.0f);
+    R.resize(size_t(rows) * D);  // no clearing: project_bucket writes every (point, channel) of its column
     parallel_for(0, D, [&](int64_t j) {
       int b = b0 + int(j);
       int nb = int(t.bucket_begin[b + 1] - t.bucket_begin[b]);
