@@ -156,7 +156,11 @@ Image resample(const EnvMap& src, const Mapping& dst, const ResampleDesc& desc) 
     RowBuffers& rb = buffers.local();
     std::vector<float>&dx = rb.dx, &dy = rb.dy, &dz = rb.dz;
     std::vector<int>& owner = rb.owner;
-    dx.clear(); dy.clear(); dz.clear(); owner.clear();
+    const size_t most = static_cast<size_t>(dst.width()) * desc.max_supersampling * desc.max_supersampling;
+    if (dx.size() < most) {
+      dx.resize(most); dy.resize(most); dz.resize(most); owner.resize(most);
+    }
+    int count = 0;
     int nx = 1, ny = 1, footprint_at = -1000;
     for (int x = 0; x < dst.width(); ++x) {
       Vec3 c;
@@ -202,11 +206,12 @@ Image resample(const EnvMap& src, const Mapping& dst, const ResampleDesc& desc) 
               case 4: px = s; py = -t; pz = 1; break;
               default: px = -s; py = -t; pz = -1; break;
             }
-            float inv_len = 1.0f / std::sqrt(px * px + py * py + pz * pz);
-            dx.push_back(px * inv_len);
-            dy.push_back(py * inv_len);
-            dz.push_back(pz * inv_len);
-            owner.push_back(x);
+            // The lat-long lookup needs no unit vector (both of its angles are scale-free).
+            float inv_len = fast ? 1.0f : 1.0f / std::sqrt(px * px + py * py + pz * pz);
+            dx[count] = px * inv_len;
+            dy[count] = py * inv_len;
+            dz[count] = pz * inv_len;
+            owner[count++] = x;
           }
         continue;
       }
@@ -215,13 +220,12 @@ Image resample(const EnvMap& src, const Mapping& dst, const ResampleDesc& desc) 
           Vec3 d;
           if (!dst.to_direction(x + (i + 0.5) / nx, y + (j + 0.5) / ny, &d)) continue;
           if (rotate) d = inv * d;
-          dx.push_back(static_cast<float>(d.x));
-          dy.push_back(static_cast<float>(d.y));
-          dz.push_back(static_cast<float>(d.z));
-          owner.push_back(x);
+          dx[count] = static_cast<float>(d.x);
+          dy[count] = static_cast<float>(d.y);
+          dz[count] = static_cast<float>(d.z);
+          owner[count++] = x;
         }
     }
-    int count = static_cast<int>(dx.size());
     std::vector<float>&vals = rb.vals, &ub = rb.ub, &vb = rb.vb;
     vals.resize(static_cast<size_t>(count) * nc);
     ub.resize(count);
