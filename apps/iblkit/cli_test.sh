@@ -59,6 +59,8 @@ if [ -f "$PROBE" ]; then
   check render-lights ok "8 directional lights" -- "$BIN" render blob --light "$T/l.json" --backend cpu --size 64x48 --triangles 2000 --out "$T/rl.png"
   check lights-zero fail "" -- "$BIN" lights "$PROBE" --count 0
   check eval-small ok "" -- "$BIN" eval "$PROBE" --methods median-cut,variance-cut --counts 1,4 --normals-level 2 --out "$T/ev"
+  check render-mesh-file ok "CPU time" -- "$BIN" render "$(dirname "$0")/../../examples/crypt.obj" --light "$PROBE" --backend cpu --size 64x48 --out "$T/rm.png"
+  check render-missing-mesh fail "nothere.obj" -- "$BIN" render "$T/nothere.obj" --light "$PROBE" --backend cpu --out "$T/rm.png"
   check render-bad-size fail "--size" -- "$BIN" render blob --light "$PROBE" --size 64by48 --out "$T/r.png"
   printf '{"format":"iblkit.lights/1","lights":[{"direction":[0,1,0]}]}' > "$T/bad_lights.json"
   check render-bad-lights fail "lacks" -- "$BIN" render blob --light "$T/bad_lights.json" --backend cpu --out "$T/r.png"

@@ -9,6 +9,7 @@
 
 #include "cli.h"
 #include "iblkit/core/error.h"
+#include "iblkit/geometry/mesh_io.h"
 #include "iblkit/ilf/shgrid.h"
 #include "iblkit/io/envmap_io.h"
 #include "iblkit/io/image_io.h"
@@ -94,8 +95,9 @@ void setup(CLI::App& app) {
     double gloss = 0, exponent = 20;
   };
   auto* o = new Opts();
-  app.add_option("scene", o->scene, "built-in scene: blob (a bunny-sized object on a floor) or sphere")
-      ->check(CLI::IsMember({"blob", "sphere"}))
+  app.add_option("scene", o->scene,
+                 "the object: blob (a bunny-sized procedural object), sphere, or a mesh file (OBJ, PLY, glTF), "
+                 "scaled to --object-size and placed at --at, on a floor")
       ->capture_default_str();
   app.add_option("-l,--light", o->light, "lighting: a probe image, an SH grid (.shgrid), iblkit.sh/1 or iblkit.lights/1 JSON")->required();
   app.add_option("--at", o->at, "place the object's centre here, x,y,z (e.g. inside an SH grid's volume)")->capture_default_str();
@@ -124,7 +126,21 @@ void setup(CLI::App& app) {
     d.camera.eye = iblcli::parse_vec3(o->eye, "--eye");
     d.camera.target = iblcli::parse_vec3(o->target, "--target");
     Vec3 at = iblcli::parse_vec3(o->at, "--at");
-    Mesh object = o->scene == "blob" ? make_blob(o->triangles, o->object_size) : make_sphere(o->object_size / 2, 128, 256);
+    Mesh object;
+    if (o->scene == "blob") {
+      object = make_blob(o->triangles, o->object_size);
+    } else if (o->scene == "sphere") {
+      object = make_sphere(o->object_size / 2, 128, 256);
+    } else {
+      object = from_trimesh(geometry::read_mesh(o->scene));
+      // Centre the file's mesh on the origin and scale its largest extent to --object-size.
+      Vec3 lo, hi;
+      object.bounds(&lo, &hi);
+      double extent = std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
+      if (!(extent > 0)) fail(ErrorKind::Value, "{}: the mesh has no extent", o->scene);
+      object.transform(1.0, (lo + hi) * -0.5);
+      object.transform(o->object_size / extent, {0, 0, 0});
+    }
     object.transform(1.0, at);
     Mesh floor = make_floor(6, at.y - 0.52 * o->object_size);
     Material mat{{0.75, 0.75, 0.75}, Vec3{1, 1, 1} * o->gloss, o->exponent};

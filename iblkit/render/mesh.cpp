@@ -74,6 +74,17 @@ Mesh sphere_grid(int rings, int segments, R&& r) {
 }
 }  // namespace
 
+Mesh from_trimesh(const geometry::TriMesh& m) {
+  Mesh out;
+  out.positions.reserve(m.positions.size() * 3);
+  for (Vec3 p : m.positions)
+    out.positions.insert(out.positions.end(), {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z)});
+  out.indices.reserve(m.triangles.size() * 3);
+  for (const auto& t : m.triangles) out.indices.insert(out.indices.end(), t.begin(), t.end());
+  out.compute_normals();
+  return out;
+}
+
 Mesh make_sphere(double radius, int rings, int segments) {
   Mesh m = sphere_grid(rings, segments, [&](Vec3) { return radius; });
   m.normals.resize(m.positions.size());

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "iblkit/core/vec.h"
+#include "iblkit/geometry/mesh.h"
 
 namespace ibl::render {
 
@@ -24,6 +25,10 @@ struct Mesh {
   // Recomputes vertex normals as area-weighted averages of face normals.
   void compute_normals();
 };
+
+// A geometry mesh (lab scenes, OBJ/PLY/glTF files) as a render mesh: float positions and
+// area-weighted smooth vertex normals.
+Mesh from_trimesh(const geometry::TriMesh& m);
 
 // A UV sphere of `rings` × `segments` quads.
 Mesh make_sphere(double radius, int rings, int segments);
