@@ -84,7 +84,7 @@ nlohmann::json opt_json(const OptimizeReport& r) {
 
 struct LightsOpts {
   std::string probe, method = "median-cut", out, gltf, overlay;
-  int count = 16, shadows = 4, level = 5;
+  int count = 16, shadows = 4, level = 5, iterations = 30;
   double sep = 0, lux = 1.0;
 };
 
@@ -95,6 +95,7 @@ void run_lights(const LightsOpts& o, const ibl::io::EnvReadDesc& rd) {
   std::vector<ibl::Vec3> normals, gt;
   OptimizeDesc od;
   od.progress = iblcli::progress_bar();
+  od.final_iterations = o.iterations;
   if (o.method == "optimize") {
     if (o.level < 1 || o.level > 7) ibl::fail(ibl::ErrorKind::Value, "--normals-level must be in 1..7 (got {})", o.level);
     normals = ibl::sphere::icosphere_face_centres(o.level);
@@ -153,6 +154,9 @@ void setup_lights(CLI::App& app) {
   app.add_option("--overlay", o->overlay, "write a PNG of the probe with every light and its region marked");
   app.add_option("--shadows", o->shadows, "how many lights (in priority order) deserve shadow maps")->capture_default_str();
   app.add_option("--normals-level", o->level, "optimize: icosphere level of the fitted normals (5: 20480)")->capture_default_str();
+  app.add_option("--iterations", o->iterations,
+                 "optimize: Levenberg–Marquardt iterations on the full normal set (30 is fast; 300 reaches Ceres' "
+                 "convergence test for 64 lights, 15 s, a 12% lower cost)")->check(CLI::Range(1, 100000))->capture_default_str();
   auto& rd = iblcli::add_probe_read_options(app);
   app.footer("Example:\n  iblkit lights forest.exr --method median-cut --count 16 --out lights.json --gltf lights.gltf --overlay lights.png");
   app.callback([o, &rd] { run_lights(*o, rd); });
@@ -165,7 +169,7 @@ iblcli::Command reg_lights("lights", "Directional lights from a probe: median cu
 
 struct EvalOpts {
   std::string probe, methods, counts = "1,2,4,8,16,32,64,128,256", lights, out = "eval";
-  int level = 5, sh_bands = 3, picture_count = 16;
+  int level = 5, sh_bands = 3, picture_count = 16, iterations = 30;
   double sep = 0;
   bool no_pictures = false;
 };
@@ -187,7 +191,8 @@ struct EvalResult {
 };
 
 EvalResult evaluate(const ibl::sphere::EnvMap& env, const std::vector<std::string>& methods, const std::vector<int>& counts,
-                    int level, int sh_bands, double sep, int picture_count, const std::string& lights_file) {
+                    int level, int sh_bands, double sep, int picture_count, const std::string& lights_file,
+                    int iterations = 30) {
   EvalResult res;
   auto normals = ibl::sphere::icosphere_face_centres(level);
   auto t0 = std::chrono::steady_clock::now();
@@ -213,6 +218,7 @@ EvalResult evaluate(const ibl::sphere::EnvMap& env, const std::vector<std::strin
     res.picture_sets[set.method] = set;
   }
   OptimizeDesc od;
+  od.final_iterations = iterations;
   int done = 0, total = static_cast<int>(methods.size() * counts.size());
   auto bar = iblcli::progress_bar();
   for (const auto& m : methods)
@@ -280,7 +286,7 @@ void run_eval(const EvalOpts& o, const ibl::io::EnvReadDesc& rd) {
   if (o.level < 1 || o.level > 7) ibl::fail(ibl::ErrorKind::Value, "--normals-level must be in 1..7 (got {})", o.level);
   auto env = ibl::io::read_envmap(o.probe, rd);
   for (int n : counts) validate_probe(env, n);
-  auto r = evaluate(env, methods, counts, o.level, o.sh_bands, o.sep, o.picture_count, o.lights);
+  auto r = evaluate(env, methods, counts, o.level, o.sh_bands, o.sep, o.picture_count, o.lights, o.iterations);
   std::string csv = o.out + ".csv", plot = o.out + "_fig4.png", cmp = o.out + "_irradiance.png";
   write_csv(csv, r);
   if (!o.no_pictures) {
@@ -339,6 +345,9 @@ void setup_eval(CLI::App& app) {
   app.add_option("--counts", o->counts, "comma-separated light counts N")->capture_default_str();
   app.add_option("--lights", o->lights, "also evaluate this iblkit.lights/1 file");
   app.add_option("--normals-level", o->level, "icosphere level of the normals (5: 20480, as the paper)")->capture_default_str();
+  app.add_option("--iterations", o->iterations,
+                 "optimize: Levenberg–Marquardt iterations on the full normal set (30 is fast; 300 reaches Ceres' "
+                 "convergence test for 64 lights, 15 s, a 12% lower cost)")->check(CLI::Range(1, 100000))->capture_default_str();
   app.add_option("--sh-bands", o->sh_bands, "SH reference line bands (0: none)")->capture_default_str();
   app.add_option("--min-separation", o->sep, "minimum angular separation of lights in degrees (0: off)");
   app.add_option("--picture-count", o->picture_count, "N of the sets drawn in the irradiance comparison")->capture_default_str();
