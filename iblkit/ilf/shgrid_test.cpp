@@ -1,6 +1,9 @@
 // SHGrid: trilinear lookup, the furnace responses, .shgrid round trips and header errors; the block
 // matrix product against a naive sum.
 #include <gtest/gtest.h>
+#ifdef IBLKIT_HAVE_OPENVDB
+#include <openvdb/openvdb.h>
+#endif
 
 #include <cmath>
 #include <filesystem>
@@ -104,8 +107,30 @@ TEST(SHGrid, VdbExportOrClearError) {
   SHGrid g(small_grid(), 2);
   auto path = (fs::temp_directory_path() / fmt::format("iblkit_shgrid_{}.vdb", ::getpid())).string();
   if (have_vdb()) {
+    for (size_t i = 0; i < g.data().size(); ++i) g.data()[i] = 0.25f * static_cast<float>(i % 17) - 1.0f;
     write_vdb(path, g);
     EXPECT_GT(fs::file_size(path), 0u);
+#ifdef IBLKIT_HAVE_OPENVDB
+    // Read it back: grid "sh_l1_m-1" (k = 1) at index (2, 1, 3) holds that point's RGB.
+    openvdb::initialize();
+    openvdb::io::File file(path);
+    file.open();
+    auto base = file.readGrid("sh_l1_m-1");
+    file.close();
+    auto grid = openvdb::gridPtrCast<openvdb::Vec3fGrid>(base);
+    ASSERT_TRUE(grid);
+    openvdb::Vec3f v = grid->getConstAccessor().getValue(openvdb::Coord(2, 1, 3));
+    const float* want = g.at(2, 1, 3) + 3 * 1;
+    EXPECT_EQ(v.x(), want[0]);
+    EXPECT_EQ(v.y(), want[1]);
+    EXPECT_EQ(v.z(), want[2]);
+    // The index-to-world transform puts grid point (2, 1, 3) where the grid says it is.
+    openvdb::Vec3d w = grid->transform().indexToWorld(openvdb::Vec3d(2, 1, 3));
+    Vec3 p = g.grid().point(2, 1, 3);
+    EXPECT_NEAR(w.x(), p.x, 1e-9);
+    EXPECT_NEAR(w.y(), p.y, 1e-9);
+    EXPECT_NEAR(w.z(), p.z, 1e-9);
+#endif
     fs::remove(path);
   } else {
     try {
