@@ -190,22 +190,22 @@ Image resample(const EnvMap& src, const Mapping& dst, const ResampleDesc& desc) 
         ny = oky ? supersampling(pixel_distance(src.mapping, p0x, p0y, p2x, p2y), desc.max_supersampling) : 1;
       }
       if (cube_dst && !rotate) {
-        // Cube faces: the sub-sample directions straight from the face's (s, t), in float.
+        // Cube faces: the sub-sample directions straight from the face's (s, t), in float:
+        // point = centre + s·ds + t·dt with the face's axes (cube_face_point is linear in s, t).
         const int F = dst.face_size();
-        const float fx = static_cast<float>(x % F), fy = static_cast<float>(y % F), inv_f = 2.0f / F;
-        for (int j = 0; j < ny; ++j)
+        const float inv_f = 2.0f / F;
+        const float s0 = (static_cast<float>(x % F) + 0.5f / nx) * inv_f - 1.0f, sd = inv_f / nx;
+        const float t0 = (static_cast<float>(y % F) + 0.5f / ny) * inv_f - 1.0f, td = inv_f / ny;
+        const Vec3 c0 = cube_face_point(face, 0, 0), cs = cube_face_point(face, 1, 0) - c0, ct = cube_face_point(face, 0, 1) - c0;
+        const float sign = rot ? -1.0f : 1.0f;  // vcross −Z is turned 180°: (s, t) → (−s, −t)
+        const float ax = static_cast<float>(c0.x), ay = static_cast<float>(c0.y), az = static_cast<float>(c0.z);
+        const float sx = sign * static_cast<float>(cs.x), sy = sign * static_cast<float>(cs.y), sz = sign * static_cast<float>(cs.z);
+        const float tx = sign * static_cast<float>(ct.x), ty = sign * static_cast<float>(ct.y), tz = sign * static_cast<float>(ct.z);
+        for (int j = 0; j < ny; ++j) {
+          const float t = t0 + j * td;
           for (int i = 0; i < nx; ++i) {
-            float s = (fx + (i + 0.5f) / nx) * inv_f - 1.0f, t = (fy + (j + 0.5f) / ny) * inv_f - 1.0f;
-            if (rot) { s = -s; t = -t; }
-            float px, py, pz;
-            switch (face) {
-              case 0: px = 1; py = -t; pz = -s; break;
-              case 1: px = -1; py = -t; pz = s; break;
-              case 2: px = s; py = 1; pz = t; break;
-              case 3: px = s; py = -1; pz = -t; break;
-              case 4: px = s; py = -t; pz = 1; break;
-              default: px = -s; py = -t; pz = -1; break;
-            }
+            const float sv = s0 + i * sd;
+            float px = ax + sv * sx + t * tx, py = ay + sv * sy + t * ty, pz = az + sv * sz + t * tz;
             // The lat-long lookup needs no unit vector (both of its angles are scale-free).
             float inv_len = fast ? 1.0f : 1.0f / std::sqrt(px * px + py * py + pz * pz);
             dx[count] = px * inv_len;
@@ -213,6 +213,7 @@ Image resample(const EnvMap& src, const Mapping& dst, const ResampleDesc& desc) 
             dz[count] = pz * inv_len;
             owner[count++] = x;
           }
+        }
         continue;
       }
       for (int j = 0; j < ny; ++j)
