@@ -86,7 +86,8 @@ namespace {
 // most conversions.
 // kNc > 0 fixes the channel count at compile time (the common RGB case); 0 reads it from the image.
 template <int kNc>
-void latlong_lookup_batch(const Image& img, const float* dx, const float* dy, const float* dz, int count,
+// `rows[y]` points at row y's pixels (the image's own, or a pole-filtered copy).
+void latlong_lookup_batch(const Image& img, const float* const* rows, const float* dx, const float* dy, const float* dz, int count,
                           float* u_buf, float* v_buf, float* out) {
   constexpr float kInv2Pi = 0.159154943091895f, kInvPi = 0.318309886183791f;
   const float fw = static_cast<float>(img.width()), fh = static_cast<float>(img.height());
@@ -97,7 +98,6 @@ void latlong_lookup_batch(const Image& img, const float* dx, const float* dy, co
   }
   const int w = img.width(), h = img.height();
   const int nc = kNc > 0 ? kNc : img.channels();
-  const float* base = img.data();
   for (int k = 0; k < count; ++k) {
     float px = u_buf[k], py = v_buf[k];
     float x0f = std::floor(px), y0f = std::floor(py);
@@ -106,10 +106,10 @@ void latlong_lookup_batch(const Image& img, const float* dx, const float* dy, co
     int xa = x0 < 0 ? x0 + w : (x0 >= w ? x0 - w : x0);
     int xb = x0 + 1 >= w ? x0 + 1 - w : x0 + 1;
     int ya = std::clamp(y0, 0, h - 1), yb = std::clamp(y0 + 1, 0, h - 1);
-    const float* p00 = base + (static_cast<size_t>(ya) * w + xa) * nc;
-    const float* p10 = base + (static_cast<size_t>(ya) * w + xb) * nc;
-    const float* p01 = base + (static_cast<size_t>(yb) * w + xa) * nc;
-    const float* p11 = base + (static_cast<size_t>(yb) * w + xb) * nc;
+    const float* p00 = rows[ya] + xa * nc;
+    const float* p10 = rows[ya] + xb * nc;
+    const float* p01 = rows[yb] + xa * nc;
+    const float* p11 = rows[yb] + xb * nc;
     float w00 = (1 - tx) * (1 - ty), w10 = tx * (1 - ty), w01 = (1 - tx) * ty, w11 = tx * ty;
     float* o = out + static_cast<size_t>(k) * nc;
     for (int c = 0; c < nc; ++c) o[c] = w00 * p00[c] + w10 * p10[c] + w01 * p01[c] + w11 * p11[c];
@@ -127,10 +127,52 @@ int supersampling(double extent, int max_n) {
 }
 
 // Distance in input pixels between two input positions, across the lat-long seam if shorter.
-double pixel_distance(const Mapping& m, double ax, double ay, double bx, double by) {
+double pixel_distance(const Mapping& m, double ax, double ay, double bx, double by, double u_scale = 1.0) {
   double dx = std::abs(ax - bx), dy = std::abs(ay - by);
   if (m.kind() == MappingKind::LatLong) dx = std::min(dx, m.width() - dx);
+  dx *= u_scale;
   return std::sqrt(dx * dx + dy * dy);
+}
+
+// Lat-long rows near the poles hold many narrow pixels: row y is box-filtered along u over
+// k(y) = ⌊1/sin θ⌋ pixels (wrapping), so that sampling it needs only ~1/k(y) as many sub-samples
+// across. Every pixel of a row has the same solid angle, so each row's ∫L dω is unchanged.
+int pole_filter_width(int y, int height) {
+  double st = std::sin(kPi * (y + 0.5) / height);
+  return std::max(1, static_cast<int>(std::floor(1.0 / std::max(st, 1e-3))));
+}
+
+// Row pointers of the lookup image: the source's rows, except polar rows, which point into
+// `storage` where they are box-filtered along u.
+std::vector<const float*> prefilter_poles(const Image& src, std::vector<float>* storage) {
+  const int W = src.width(), H = src.height(), nc = src.channels();
+  std::vector<const float*> rows(H);
+  std::vector<size_t> offset(H, 0);
+  size_t need = 0;
+  for (int y = 0; y < H; ++y)
+    if (std::min(pole_filter_width(y, H), W) > 1) {
+      offset[y] = need;
+      need += static_cast<size_t>(W) * nc;
+    }
+  storage->resize(need);
+  for (int y = 0; y < H; ++y) rows[y] = std::min(pole_filter_width(y, H), W) > 1 ? storage->data() + offset[y] : src.pixel(0, y);
+  parallel_for(0, H, [&](int64_t yy) {
+    int y = static_cast<int>(yy);
+    int k = std::min(pole_filter_width(y, H), W);
+    if (k <= 1) return;
+    const float* in = src.pixel(0, y);
+    float* o = storage->data() + offset[y];
+    std::vector<double> acc(nc, 0.0);
+    int lo = -(k / 2);  // window [x + lo, x + lo + k)
+    for (int i = lo; i < lo + k; ++i)
+      for (int c = 0; c < nc; ++c) acc[c] += in[((i % W + W) % W) * nc + c];
+    for (int x = 0; x < W; ++x) {
+      for (int c = 0; c < nc; ++c) o[x * nc + c] = static_cast<float>(acc[c] / k);
+      int out_i = ((x + lo) % W + W) % W, in_i = ((x + lo + k) % W + W) % W;
+      for (int c = 0; c < nc; ++c) acc[c] += in[in_i * nc + c] - in[out_i * nc + c];
+    }
+  });
+  return rows;
 }
 
 }  // namespace
@@ -143,6 +185,10 @@ Image resample(const EnvMap& src, const Mapping& dst, const ResampleDesc& desc) 
     for (int j = 0; j < 3; ++j) rotate |= std::abs(desc.rotation.m[i][j] - (i == j ? 1.0 : 0.0)) > 0;
   Mat3 inv = desc.rotation.transposed();
   bool fast = src.mapping.kind() == MappingKind::LatLong;
+  // Lat-long sources: look up a copy whose polar rows are filtered along u (prefilter_poles).
+  std::vector<float> pole_rows;
+  std::vector<const float*> rows;
+  if (fast) rows = prefilter_poles(src.image, &pole_rows);
   bool cube_dst = dst.kind() == MappingKind::CubeHCross || dst.kind() == MappingKind::CubeVCross ||
                   dst.kind() == MappingKind::CubeStrip;
   struct RowBuffers {
@@ -186,8 +232,11 @@ Image resample(const EnvMap& src, const Mapping& dst, const ResampleDesc& desc) 
         src.mapping.to_pixel(cc, &p0x, &p0y);
         src.mapping.to_pixel(cx, &p1x, &p1y);
         src.mapping.to_pixel(cy, &p2x, &p2y);
-        nx = okx ? supersampling(pixel_distance(src.mapping, p0x, p0y, p1x, p1y), desc.max_supersampling) : 1;
-        ny = oky ? supersampling(pixel_distance(src.mapping, p0x, p0y, p2x, p2y), desc.max_supersampling) : 1;
+        double u_scale = fast ? 1.0 / pole_filter_width(std::clamp(static_cast<int>(p0y), 0, src.mapping.height() - 1),
+                                                          src.mapping.height())
+                              : 1.0;
+        nx = okx ? supersampling(pixel_distance(src.mapping, p0x, p0y, p1x, p1y, u_scale), desc.max_supersampling) : 1;
+        ny = oky ? supersampling(pixel_distance(src.mapping, p0x, p0y, p2x, p2y, u_scale), desc.max_supersampling) : 1;
       }
       if (cube_dst && !rotate) {
         // Cube faces: the sub-sample directions straight from the face's (s, t), in float:
@@ -232,8 +281,8 @@ Image resample(const EnvMap& src, const Mapping& dst, const ResampleDesc& desc) 
     ub.resize(count);
     vb.resize(count);
     if (fast) {
-      if (nc == 3) latlong_lookup_batch<3>(src.image, dx.data(), dy.data(), dz.data(), count, ub.data(), vb.data(), vals.data());
-      else latlong_lookup_batch<0>(src.image, dx.data(), dy.data(), dz.data(), count, ub.data(), vb.data(), vals.data());
+      if (nc == 3) latlong_lookup_batch<3>(src.image, rows.data(), dx.data(), dy.data(), dz.data(), count, ub.data(), vb.data(), vals.data());
+      else latlong_lookup_batch<0>(src.image, rows.data(), dx.data(), dy.data(), dz.data(), count, ub.data(), vb.data(), vals.data());
     } else {
       for (int k = 0; k < count; ++k) src.sample({dx[k], dy[k], dz[k]}, vals.data() + static_cast<size_t>(k) * nc);
     }
