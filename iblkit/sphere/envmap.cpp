@@ -167,7 +167,8 @@ std::vector<const float*> prefilter_poles(const Image& src, std::vector<float>* 
     for (int i = lo; i < lo + k; ++i)
       for (int c = 0; c < nc; ++c) acc[c] += in[((i % W + W) % W) * nc + c];
     for (int x = 0; x < W; ++x) {
-      for (int c = 0; c < nc; ++c) o[x * nc + c] = static_cast<float>(acc[c] / k);
+      // The running sum can round a little below zero where the row is black; inputs are ≥ 0.
+      for (int c = 0; c < nc; ++c) o[x * nc + c] = static_cast<float>(std::max(0.0, acc[c] / k));
       int out_i = ((x + lo) % W + W) % W, in_i = ((x + lo + k) % W + W) % W;
       for (int c = 0; c < nc; ++c) acc[c] += in[in_i * nc + c] - in[out_i * nc + c];
     }
