@@ -30,7 +30,7 @@ using namespace ibl::render;
 
 // Reads --light: an SH grid (.shgrid), an iblkit.lights/1 or iblkit.sh/1 JSON file, or a probe image
 // (projected to SH).
-void load_lighting(const std::string& path, int bands, const io::EnvReadDesc& rd, Lighting* L, std::string* kind) {
+void load_lighting(const std::string& path, int bands, int shadows, const io::EnvReadDesc& rd, Lighting* L, std::string* kind) {
   std::string ext = fs::path(path).extension().string();
   if (ext == ".shgrid") {
     ilf::SHGrid g = ilf::read_shgrid(path);
@@ -64,7 +64,9 @@ void load_lighting(const std::string& path, int bands, const io::EnvReadDesc& rd
           fail(ErrorKind::Format, "{}: light {} lacks \"direction\" or \"irradiance\"", path, i);
         auto dv = l["direction"].get<std::vector<double>>(), ev = l["irradiance"].get<std::vector<double>>();
         if (dv.size() != 3 || ev.size() != 3) fail(ErrorKind::Format, "{}: light {}: direction and irradiance need 3 numbers", path, i);
-        L->lights.push_back({normalize(Vec3{dv[0], dv[1], dv[2]}), {ev[0], ev[1], ev[2]}, l.value("shadow", i < 4)});
+        // Lights come in shadow-map priority order (docs/formats.md): the first `shadows` get maps.
+        L->lights.push_back({normalize(Vec3{dv[0], dv[1], dv[2]}), {ev[0], ev[1], ev[2]},
+                             l.value("shadow", static_cast<int>(i) < shadows)});
       }
       *kind = fmt::format("{} directional lights", L->lights.size());
       return;
@@ -91,7 +93,7 @@ void setup(CLI::App& app) {
     std::string scene = "blob", light, out = "frame.png", backend = "auto", size = "1024x768", eye = "0,0.5,1.6",
                 target = "0,0,0", at = "0,0,0";
     double object_size = 0.8;
-    int frames = 1, bands = 5, triangles = 100000;
+    int frames = 1, bands = 5, triangles = 100000, shadows = 4;
     double gloss = 0, exponent = 20;
   };
   auto* o = new Opts();
@@ -106,6 +108,9 @@ void setup(CLI::App& app) {
   app.add_option("--backend", o->backend, "cpu, gl or auto (gl when available)")->check(CLI::IsMember({"cpu", "gl", "auto"}))->capture_default_str();
   app.add_option("--size", o->size, "frame size WxH")->capture_default_str();
   app.add_option("--frames", o->frames, "GL: render this many frames and report the median GPU time")->check(CLI::Range(1, 10000));
+  app.add_option("--shadows", o->shadows, "lights (in the file's priority order) that cast shadows")
+      ->check(CLI::Range(0, 16))
+      ->capture_default_str();
   app.add_option("--bands", o->bands, "SH bands when projecting a probe")->check(CLI::Range(1, 9))->capture_default_str();
   app.add_option("--triangles", o->triangles, "triangles of the blob")->check(CLI::Range(100, 5000000))->capture_default_str();
   app.add_option("--gloss", o->gloss, "weight of the glossy Phong lobe (0..1)")->check(CLI::Range(0.0, 1.0));
@@ -146,7 +151,7 @@ void setup(CLI::App& app) {
     Material mat{{0.75, 0.75, 0.75}, Vec3{1, 1, 1} * o->gloss, o->exponent};
     d.objects = {{&object, mat}, {&floor, Material{{0.5, 0.5, 0.5}, {0, 0, 0}, 1}}};
     std::string kind;
-    load_lighting(o->light, o->bands, rd, &d.lighting, &kind);
+    load_lighting(o->light, o->bands, o->shadows, rd, &d.lighting, &kind);
     std::string backend = o->backend;
     nlohmann::json j = {{"scene", o->scene}, {"light", o->light}, {"lighting", kind}, {"size", o->size}};
     RenderResult f;
