@@ -57,6 +57,29 @@ struct Region {
   int axis = -1, pos = 0;  // variance cut: the best split (axis −1: none)
 };
 
+// The any-N cut: split the region with the highest key next until there are n regions or none can
+// be split. split(r, &a, &b) returns false for a region that must stay whole.
+template <typename Split>
+std::vector<Region> cut_highest_first(const Region& all, int n, Split&& split) {
+  std::vector<Region> out;
+  auto less = [](const Region& a, const Region& b) { return a.key < b.key; };
+  std::priority_queue<Region, std::vector<Region>, decltype(less)> pq(less);
+  pq.push(all);
+  while (!pq.empty() && static_cast<int>(out.size() + pq.size()) < n) {
+    Region r = pq.top();
+    pq.pop();
+    Region a, b;
+    if (split(r, &a, &b)) {
+      pq.push(a);
+      pq.push(b);
+    } else {
+      out.push_back(r);
+    }
+  }
+  for (; !pq.empty(); pq.pop()) out.push_back(pq.top());
+  return out;
+}
+
 // Per-pixel directions of the grid in separable form: ω = (−sinθ cosφ, cosθ, −sinθ sinφ).
 struct Trig {
   std::vector<double> sin_t, cos_t, cos_p, sin_p;
@@ -211,17 +234,7 @@ LightSet median_cut(const LatLongGrid& g, const CutDesc& desc) {
       }
       return out;
     }
-    auto less = [](const Region& a, const Region& b) { return a.key < b.key; };
-    std::priority_queue<Region, std::vector<Region>, decltype(less)> pq(less);
-    pq.push(all);
-    while (!pq.empty() && static_cast<int>(out.size() + pq.size()) < n) {
-      Region r = pq.top();
-      pq.pop();
-      Region a, b;
-      if (split(r, &a, &b)) { pq.push(a); pq.push(b); } else out.push_back(r);
-    }
-    for (; !pq.empty(); pq.pop()) out.push_back(pq.top());
-    return out;
+    return cut_highest_first(all, n, split);
   };
   return finish(g, desc, "median-cut", cut);
 }
@@ -267,23 +280,15 @@ LightSet variance_cut(const LatLongGrid& g, const CutDesc& desc) {
   best_split(all);
 
   auto cut = [&](int n) {
-    std::vector<Region> out;
-    auto less = [](const Region& a, const Region& b) { return a.key < b.key; };
-    std::priority_queue<Region, std::vector<Region>, decltype(less)> pq(less);
-    pq.push(all);
-    while (!pq.empty() && static_cast<int>(out.size() + pq.size()) < n) {
-      Region r = pq.top();
-      pq.pop();
-      if (r.axis < 0) { out.push_back(r); continue; }
-      Region a = r, b = r;
-      if (r.axis == 0) { a.x1 = r.pos; b.x0 = r.pos; } else { a.y1 = r.pos; b.y0 = r.pos; }
-      best_split(a);
-      best_split(b);
-      pq.push(a);
-      pq.push(b);
-    }
-    for (; !pq.empty(); pq.pop()) out.push_back(pq.top());
-    return out;
+    return cut_highest_first(all, n, [&](const Region& r, Region* a, Region* b) {
+      if (r.axis < 0) return false;
+      *a = r;
+      *b = r;
+      if (r.axis == 0) { a->x1 = r.pos; b->x0 = r.pos; } else { a->y1 = r.pos; b->y0 = r.pos; }
+      best_split(*a);
+      best_split(*b);
+      return true;
+    });
   };
   return finish(g, desc, "variance-cut", cut);
 }

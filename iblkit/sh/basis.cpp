@@ -30,6 +30,24 @@ const NormTable& norms() {
   return t;
 }
 
+// Column m of P̃_lm(z) for l = m … bands−1 by the recurrence above, given pmm = P̃_mm = (2m−1)!!;
+// emit(l, P̃_lm) receives each value.
+template <typename Emit>
+void legendre_column(int bands, int m, double z, double pmm, Emit&& emit) {
+  double p2 = 0.0, p1 = 0.0, p0 = pmm;
+  for (int l = m; l < bands; ++l) {
+    if (l == m + 1) {
+      p1 = p0;
+      p0 = (2.0 * m + 1.0) * z * pmm;
+    } else if (l > m + 1) {
+      p2 = p1;
+      p1 = p0;
+      p0 = ((2.0 * l - 1.0) * z * p1 - (l + m - 1.0) * p2) / (l - m);
+    }
+    emit(l, p0);
+  }
+}
+
 template <typename T>
 void eval_basis_t(int bands, Vec3 d, T* out) {
   check_bands(bands);
@@ -44,24 +62,15 @@ void eval_basis_t(int bands, Vec3 d, T* out) {
       C = c;
       pmm *= 2.0 * m - 1.0;
     }
-    double p2 = 0.0, p1 = 0.0, p0 = pmm;
-    for (int l = m; l < bands; ++l) {
-      if (l == m + 1) {
-        p1 = p0;
-        p0 = (2.0 * m + 1.0) * z * pmm;
-      } else if (l > m + 1) {
-        p2 = p1;
-        p1 = p0;
-        p0 = ((2.0 * l - 1.0) * z * p1 - (l + m - 1.0) * p2) / (l - m);
-      }
-      double kp = K.k[l][m] * p0;
+    legendre_column(bands, m, z, pmm, [&](int l, double p) {
+      double kp = K.k[l][m] * p;
       if (m == 0) {
         out[index(l, 0)] = static_cast<T>(kp);
       } else {
         out[index(l, m)] = static_cast<T>(kp * C);
         out[index(l, -m)] = static_cast<T>(kp * S);
       }
-    }
+    });
   }
 }
 
@@ -86,18 +95,7 @@ void legendre_table(int bands, double z, double* out) {
   double pmm = 1.0;
   for (int m = 0; m < bands; ++m) {
     if (m > 0) pmm *= 2.0 * m - 1.0;
-    double p2 = 0.0, p1 = 0.0, p0 = pmm;
-    for (int l = m; l < bands; ++l) {
-      if (l == m + 1) {
-        p1 = p0;
-        p0 = (2.0 * m + 1.0) * z * pmm;
-      } else if (l > m + 1) {
-        p2 = p1;
-        p1 = p0;
-        p0 = ((2.0 * l - 1.0) * z * p1 - (l + m - 1.0) * p2) / (l - m);
-      }
-      out[l * bands + m] = p0;
-    }
+    legendre_column(bands, m, z, pmm, [&](int l, double p) { out[l * bands + m] = p; });
   }
 }
 
