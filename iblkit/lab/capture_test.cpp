@@ -14,6 +14,16 @@
 namespace ibl::lab {
 namespace {
 
+// An empty scene inside a closed box facing inwards (for depth checks with known distances).
+Scene inside_box(Vec3 lo, Vec3 hi) {
+  Scene s;
+  Surface box;
+  box.mesh = geometry::make_box(lo, hi, true);
+  s.surfaces.push_back(box);
+  s.build();
+  return s;
+}
+
 Scene emitting_sphere(Vec3 L, double albedo) {
   Scene s;
   s.name = "emitting sphere";
@@ -89,11 +99,7 @@ TEST(LabCapture, DiscLightSeenFromAxisMatchesClosedForm) {
 TEST(LabCapture, DepthMapsMatchDistancesInABox) {
   constexpr double kDepthTol = 2e-5;  // relative: Embree intersects in float
   Vec3 lo{-2, 0, -1.5}, hi{1, 2.5, 3}, o{0.4, 0.9, -0.3};
-  Scene s;
-  Surface box;
-  box.mesh = geometry::make_box(lo, hi, true);
-  s.surfaces.push_back(box);
-  s.build();
+  Scene s = inside_box(lo, hi);
   for (auto kind : {sphere::MappingKind::LatLong, sphere::MappingKind::CubeHCross, sphere::MappingKind::MirrorBall}) {
     CaptureDesc cd;
     cd.mapping = kind;
@@ -293,11 +299,7 @@ namespace {
 TEST(LabCapture, BallParallaxStartsRaysOnTheBall) {
   constexpr double kDepthTol = 2e-5;  // metres: float intersection
   Vec3 lo{-2, 0, -2}, hi{2, 3, 2}, o{0.3, 1.0, -0.2};
-  Scene s;
-  Surface box;
-  box.mesh = geometry::make_box(lo, hi, true);
-  s.surfaces.push_back(box);
-  s.build();
+  Scene s = inside_box(lo, hi);
   CaptureDesc cd;
   cd.mapping = sphere::MappingKind::MirrorBall;
   cd.camera = Camera::MirrorBall;

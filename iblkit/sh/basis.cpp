@@ -105,27 +105,24 @@ void gauss_legendre(int n, std::vector<double>* nodes, std::vector<double>* weig
   weights->assign(n, 0.0);
   for (int i = 0; i < (n + 1) / 2; ++i) {
     // Chebyshev-like first guess, then Newton on P_n [3].
-    double z = std::cos(kPi * (i + 0.75) / (n + 0.5)), dp = 1.0;
-    for (int it = 0; it < 100; ++it) {
+    // P_n(z) and its derivative, by Bonnet's recurrence.
+    auto pn_and_derivative = [n](double z, double* dp) {
       double p0 = 1.0, p1 = 0.0;
       for (int j = 1; j <= n; ++j) {
         double p2 = p1;
         p1 = p0;
         p0 = ((2.0 * j - 1.0) * z * p1 - (j - 1.0) * p2) / j;
       }
-      dp = n * (z * p0 - p1) / (z * z - 1.0);
-      double dz = p0 / dp;
+      *dp = n * (z * p0 - p1) / (z * z - 1.0);
+      return p0;
+    };
+    double z = std::cos(kPi * (i + 0.75) / (n + 0.5)), dp = 1.0;
+    for (int it = 0; it < 100; ++it) {
+      double dz = pn_and_derivative(z, &dp) / dp;
       z -= dz;
       if (std::abs(dz) < 1e-16) break;
     }
-    // Recompute the derivative at the converged node for the weight.
-    double p0 = 1.0, p1 = 0.0;
-    for (int j = 1; j <= n; ++j) {
-      double p2 = p1;
-      p1 = p0;
-      p0 = ((2.0 * j - 1.0) * z * p1 - (j - 1.0) * p2) / j;
-    }
-    dp = n * (z * p0 - p1) / (z * z - 1.0);
+    pn_and_derivative(z, &dp);  // the derivative at the converged node, for the weight
     double w = 2.0 / ((1.0 - z * z) * dp * dp);
     (*nodes)[i] = -z;
     (*nodes)[n - 1 - i] = z;
