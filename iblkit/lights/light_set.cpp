@@ -180,8 +180,11 @@ nlohmann::json to_json(const LightSet& set) {
                    {"irradiance", {l.irradiance.x, l.irradiance.y, l.irradiance.z}},
                    {"solid_angle", l.solid_angle},
                    {"radiance", {r.x, r.y, r.z}}});
+    if (l.position) arr.back()["position"] = {l.position->x, l.position->y, l.position->z};
   }
-  return {{"format", "iblkit.lights/1"}, {"method", set.method}, {"lights", arr}};
+  nlohmann::json j = {{"format", "iblkit.lights/1"}, {"method", set.method}, {"lights", arr}};
+  if (set.origin) j["origin"] = {set.origin->x, set.origin->y, set.origin->z};
+  return j;
 }
 
 namespace {
@@ -217,9 +220,11 @@ LightSet from_json(const nlohmann::json& j, const std::string& what) {
     light.solid_angle = l.value("solid_angle", 0.0);
     if (!(light.solid_angle >= 0) || light.solid_angle > kFourPi + 1e-9)
       fail(ErrorKind::Format, "{}: \"solid_angle\" must be in [0, 4π]", where);
+    if (l.contains("position")) light.position = vec3_field(l, "position", where);
     set.lights.push_back(light);
   }
   if (set.lights.empty()) fail(ErrorKind::Format, "{}: \"lights\" is empty", what);
+  if (j.contains("origin")) set.origin = vec3_field(j, "origin", what);
   return set;
 }
 

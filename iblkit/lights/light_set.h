@@ -11,6 +11,7 @@
 //  [3] Pedersen, "Fusing environment maps for IBL in large scenes", 2008, §5.3.1 (../shared/papers/003_…).
 #pragma once
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -26,6 +27,7 @@ struct Light {
   Vec3 direction;          // unit vector towards the light (world frame of the probe)
   Vec3 irradiance;         // RGB irradiance at normal incidence, W/m² (Σ L·dω over its region)
   double solid_angle = 0;  // sr of the probe region the light stands for
+  std::optional<Vec3> position;  // where the light sits when localised (fusion), world metres
   Vec3 radiance() const { return solid_angle > 0 ? irradiance / solid_angle : Vec3{}; }
 };
 
@@ -41,6 +43,9 @@ struct LightSet {
   std::string method;         // "median-cut", "variance-cut", "optimize", or the name from a file
   std::vector<Light> lights;  // in shadow-map priority order (rank_for_shadows)
   RegionMap regions;          // optional: the region of every light on the lat-long grid
+  // Optional (fusion): the point whose irradiance the lights' `irradiance` values are, world metres.
+  // A light with a position is then a point light of intensity irradiance·|position − origin|² (W/sr).
+  std::optional<Vec3> origin;
 };
 
 // Sum of the lights' irradiance (RGB) — equals ∫ L dω of the probe for every cut.

@@ -30,6 +30,27 @@ TEST(LightsJson, RoundTrip) {
     EXPECT_NEAR(j["lights"][i]["radiance"][0].get<double>(), s.lights[i].irradiance.x / s.lights[i].solid_angle, kExact * 1e3);
   }
   EXPECT_EQ(back.method, "median-cut");
+  EXPECT_FALSE(back.origin);
+  EXPECT_FALSE(back.lights[0].position);
+  EXPECT_FALSE(j.contains("origin"));
+}
+
+TEST(LightsJson, LocalisedPositionsAndOriginRoundTrip) {
+  constexpr double kExact = 1e-15;  // JSON numbers keep doubles exactly (17 significant digits)
+  auto s = sample_set();
+  s.origin = Vec3{1.5, -0.25, 3};
+  s.lights[1].position = Vec3{0.125, 2, -7};
+  auto back = from_json(nlohmann::json::parse(to_json(s).dump()));
+  ASSERT_TRUE(back.origin);
+  EXPECT_NEAR(back.origin->x, 1.5, kExact);
+  EXPECT_NEAR(back.origin->z, 3, kExact);
+  EXPECT_FALSE(back.lights[0].position);
+  ASSERT_TRUE(back.lights[1].position);
+  EXPECT_NEAR(back.lights[1].position->y, 2, kExact);
+  EXPECT_NEAR(back.lights[1].position->z, -7, kExact);
+  EXPECT_THROW(from_json(nlohmann::json::parse(
+                   R"({"format":"iblkit.lights/1","origin":[1,2],"lights":[{"direction":[0,1,0],"irradiance":[1,1,1]}]})")),
+               Error);
 }
 
 TEST(LightsJson, BadFilesNameTheField) {
