@@ -102,6 +102,7 @@ struct TruthOpts {
   std::vector<std::string> normals;
   int size = 128, samples = 4, area_samples = 64, bands = 3;
   uint64_t seed = 1;
+  double blind_cone = 0;
 };
 
 void run_truth(const TruthOpts& o) {
@@ -112,6 +113,7 @@ void run_truth(const TruthOpts& o) {
   d.area_samples = o.area_samples;
   d.bands = o.bands;
   d.seed = o.seed;
+  d.blind_cone_deg = o.blind_cone;
   for (const auto& n : o.normals) d.normals.push_back(iblcli::parse_vec3(n, "--normal"));
   if (d.normals.empty()) d.normals = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
   Vec3 at = iblcli::parse_vec3(o.at, "--at");
@@ -123,12 +125,14 @@ void run_truth(const TruthOpts& o) {
   for (size_t i = 0; i < t.normals.size(); ++i) irr.push_back({{"normal", rgb(t.normals[i])}, {"irradiance", rgb(t.irradiance[i])}});
   j["irradiance"] = irr;
   if (d.bands > 0) j["sh"] = ibl::sh::to_json(t.sh);
+  if (!t.sh_visible.c.empty()) j["sh_visible"] = ibl::sh::to_json(t.sh_visible);
   if (!o.out.empty()) {
     fs::create_directories(o.out);
     fs::path out(o.out);
     ibl::io::write_image((out / "radiance.exr").string(), t.radiance.image);
     ibl::io::write_image((out / "radiance.png").string(), ibl::io::tonemap(t.radiance.image));
     if (d.bands > 0) ibl::sh::write_coeffs((out / "sh.json").string(), t.sh);
+    if (!t.sh_visible.c.empty()) ibl::sh::write_coeffs((out / "sh_visible.json").string(), t.sh_visible);
     std::ofstream(out / "truth.json") << j.dump(1) << "\n";
     j["out"] = o.out;
   }
@@ -188,6 +192,8 @@ void setup(CLI::App& app) {
   t->add_option("--bands", to->bands, "SH bands (0: none)")->capture_default_str();
   t->add_option("--normal", to->normals, "irradiance normal x,y,z (repeat; default the six axes)");
   t->add_option("--seed", to->seed, "random seed")->capture_default_str();
+  t->add_option("--blind-cone", to->blind_cone,
+                "also give sh_visible: the SH without the directions within DEG of -Z (a mirror-ball sequence's dead angle)");
   t->add_option("-o,--out", to->out, "folder for radiance.exr/.png, sh.json, truth.json");
   t->footer("Example:\n  iblkit lab truth low-scene1 --at 0,1,0 --size 256 --out truth");
   t->callback([to] { run_truth(*to); });

@@ -1,5 +1,6 @@
 #include "iblkit/lab/capture.h"
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 
@@ -34,6 +35,60 @@ bool ball_ray(const sphere::Mapping& m, double px, double py, Vec3* n, Vec3* d) 
   return true;
 }
 
+constexpr int kApertureRings = 16, kApertureSectors = 16;  // 256 equal-area strata of the disc
+constexpr double kShadowShorten = 1e-4;  // relative: as radiance.cpp, stop short of the aperture
+
+// Lamps whose aperture is small in this capture (see kSmallApertureFactor): bit i = emitters[i].
+uint64_t small_apertures(const Scene& scene, Vec3 position, const CaptureDesc& desc, const sphere::Mapping& m) {
+  uint64_t mask = 0;
+  if (!desc.integrate_apertures || desc.camera != Camera::Ideal) return mask;
+  const double mean_pixel = 4 * kPi / (static_cast<double>(m.width()) * m.height());
+  for (size_t i = 0; i < scene.emitters.size() && i < 64; ++i) {
+    const Emitter& e = scene.emitters[i];
+    if ((e.type != EmitterType::Spot && e.type != EmitterType::Projector) || e.aperture_radius <= 0) continue;
+    Vec3 w = e.position - position;
+    double d = length(w);
+    if (d <= 2 * e.aperture_radius) continue;  // the lamp fills much of the view: pixels resolve it
+    w = w / d;
+    double omega = e.emit_area * std::abs(dot(w, e.direction)) / (d * d);
+    double px, py, pixel = mean_pixel;
+    if (m.to_pixel(desc.rotation.transposed() * w, &px, &py)) {
+      int x = std::clamp(static_cast<int>(px), 0, m.width() - 1), y = std::clamp(static_cast<int>(py), 0, m.height() - 1);
+      if (m.solid_angle_estimate(x, y) > 0) pixel = m.solid_angle_estimate(x, y);
+    }
+    if (omega < kSmallApertureFactor * pixel) mask |= uint64_t{1} << i;
+  }
+  return mask;
+}
+
+// Adds the light of lamp e's aperture to the pixels it falls in: K equal-area points q on the disc,
+// each visible one carrying E = I(−ω)/(K·|q − o|²) into the pixel of ω, divided by that pixel's solid
+// angle (a pixel holds the mean radiance over its solid angle).
+void add_aperture(const Scene& scene, const Emitter& e, Vec3 o, const CaptureDesc& desc, const sphere::Mapping& m, Image& img) {
+  const Frame f = Frame::from_normal(e.direction);
+  const Mat3 to_probe = desc.rotation.transposed();
+  constexpr int K = kApertureRings * kApertureSectors;
+  for (int i = 0; i < kApertureRings; ++i) {
+    double r = e.aperture_radius * std::sqrt((i + 0.5) / kApertureRings);
+    for (int j = 0; j < kApertureSectors; ++j) {
+      double phi = 2 * kPi * (j + 0.5) / kApertureSectors;
+      Vec3 q = e.position + (f.t * std::cos(phi) + f.b * std::sin(phi)) * r;
+      Vec3 w = q - o;
+      double d2 = dot(w, w), dist = std::sqrt(d2);
+      w = w / dist;
+      if (-dot(w, e.direction) <= 0) continue;  // behind the lamp: the disc emits from its front only
+      Vec3 I = e.intensity_towards(-w);
+      if (max_component(I) <= 0 || scene.tracer().occluded(o, w, 0, dist * (1 - kShadowShorten))) continue;
+      double px, py;
+      if (!m.to_pixel(to_probe * w, &px, &py)) continue;  // a direction without data (dead angle)
+      int x = std::clamp(static_cast<int>(px), 0, m.width() - 1), y = std::clamp(static_cast<int>(py), 0, m.height() - 1);
+      double sa = m.solid_angle(x, y);
+      if (sa <= 0) continue;
+      img.set_rgb(x, y, img.rgb(x, y) + I / (K * d2 * sa));
+    }
+  }
+}
+
 }  // namespace
 
 Capture capture_probe(const Scene& scene, Vec3 position, const CaptureDesc& desc, uint64_t probe_index,
@@ -55,6 +110,7 @@ Capture capture_probe(const Scene& scene, Vec3 position, const CaptureDesc& desc
   const int W = m.width(), H = m.height(), n = desc.samples;
   cap.radiance = Image(W, H, 3);
   if (desc.depth) cap.depth = Image(W, H, 1);
+  const uint64_t hidden = small_apertures(scene, position, desc, m);
   std::atomic<int> rows_done{0};
   parallel_for(0, H, [&](int64_t y) {
     for (int x = 0; x < W; ++x) {
@@ -73,7 +129,7 @@ Capture capture_probe(const Scene& scene, Vec3 position, const CaptureDesc& desc
         } else {
           if (!m.to_direction(px, py, &d)) continue;
           ++used;
-          sum += radiance(scene, o, desc.rotation * d, rng, desc.render);
+          sum += radiance(scene, o, desc.rotation * d, rng, desc.render, hidden);
         }
       }
       if (used) cap.radiance.set_rgb(x, static_cast<int>(y), sum / used);
@@ -89,6 +145,8 @@ Capture capture_probe(const Scene& scene, Vec3 position, const CaptureDesc& desc
     }
     if (progress) report(progress, "capture", static_cast<double>(++rows_done) / H);
   });
+  for (size_t i = 0; i < scene.emitters.size() && i < 64; ++i)
+    if ((hidden >> i) & 1) add_aperture(scene, scene.emitters[i], position, desc, m, cap.radiance);
   return cap;
 }
 

@@ -26,8 +26,17 @@ struct CaptureDesc {
   bool ball_parallax = false;    // MirrorBall: rays leave the ball's surface (non-single viewpoint)
   double ball_reflectance = 1;   // MirrorBall: mirror reflectance (chrome is ~0.6–0.7)
   bool depth = false;            // also compute the distance to the first hit at each pixel centre
+  bool integrate_apertures = true;  // Ideal camera: a lamp aperture smaller than kSmallApertureFactor
+                                 // pixels is integrated per pixel (256 points with shadow rays),
+                                 // not point-sampled by the sub-pixel rays (which alias it)
   RenderDesc render;             // light estimation settings and seed
 };
+
+// A spot/projector aperture whose solid angle is below this many pixels (at the pixel it falls in)
+// is integrated analytically: each pixel then holds the exact pixel average of the lamp's radiance,
+// E_pixel = Σ_points I(−ω)/(K·d²) / Ω_pixel, instead of n×n point samples of a disc that covers a
+// fraction of a pixel at 10⁴× the scene's radiance. Larger apertures are resolved by the pixels.
+inline constexpr double kSmallApertureFactor = 16;
 
 struct Capture {
   Image radiance;                // RGB, W/(sr·m²); 0 where a pixel carries no direction

@@ -226,6 +226,97 @@ TEST(LabCapture, SpotApertureDeliversTheLampsIntensity) {
   EXPECT_NEAR(t.irradiance[0].x / (10 / d2), 1.0, kApertureTol);
 }
 
+// A spot of intensity 10 W/sr at (0, 2, 0) pointing down with a 2 cm aperture, optionally behind a
+// black-bottomed board over x < 0 just below it (it hides exactly the half of the disc with x < 0
+// from a probe on the axis).
+Scene small_spot(bool half_blocked) {
+  Scene s;
+  Emitter sp;
+  sp.type = EmitterType::Spot;
+  sp.position = {0, 2, 0};
+  sp.direction = {0, -1, 0};
+  sp.cone_deg = 60;
+  sp.falloff_deg = 50;  // the probes below lie well inside the full-intensity cone
+  sp.intensity = {10, 10, 10};
+  sp.aperture_radius = 0.02;
+  s.emitters.push_back(sp);
+  if (half_blocked) {
+    Surface board;
+    board.mesh = geometry::make_quad({-0.5, 1.95, 0}, {0, 1, 0}, {0, 0, 1}, 1.0, 2.0);
+    s.surfaces.push_back(board);
+  }
+  s.build();
+  return s;
+}
+
+// ∫ L dω over a capture: Σ pixel radiance × exact pixel solid angle.
+Vec3 total_radiance(const Capture& c) {
+  Vec3 sum;
+  for (int y = 0; y < c.mapping.height(); ++y)
+    for (int x = 0; x < c.mapping.width(); ++x) sum += c.radiance.rgb(x, y) * c.mapping.solid_angle(x, y);
+  return sum;
+}
+
+TEST(LabCapture, SmallApertureIsIntegratedPerPixel) {
+  // A 2 cm disc 1.5 m away subtends 1.4·10⁻⁴ sr, a few percent of one pixel of these captures: one
+  // centre ray per pixel almost surely misses it. Integrated per pixel, the capture must carry the
+  // lamp's E = I/d² into ∫L dω whatever the mapping, and exactly half of it behind the board.
+  constexpr double kEnergyTol = 1e-4;  // relative: float32 pixels; no other approximation on the axis
+  const Vec3 p{0, 0.5, 0};
+  const double E = 10 / (1.5 * 1.5);
+  for (auto kind : {sphere::MappingKind::LatLong, sphere::MappingKind::MirrorBall}) {
+    CaptureDesc cd;
+    cd.mapping = kind;
+    cd.size = 24;
+    cd.dead_angle_deg = 4.2;
+    cd.rotation = Mat3::rotation({1, 0, 0}, -kPi / 2);  // the probe's +Z (the ball's centre) looks up
+    Capture c = capture_probe(small_spot(false), p, cd);
+    EXPECT_NEAR(total_radiance(c).x / E, 1.0, kEnergyTol) << sphere::mapping_name(kind);
+    Capture h = capture_probe(small_spot(true), p, cd);
+    EXPECT_NEAR(total_radiance(h).x / E, 0.5, kEnergyTol) << sphere::mapping_name(kind);
+    cd.integrate_apertures = false;  // point-sampled: the centre rays miss the disc
+    Capture a = capture_probe(small_spot(false), p, cd);
+    EXPECT_LT(total_radiance(a).x / E, 0.5) << sphere::mapping_name(kind);
+  }
+}
+
+TEST(LabTruth, SmallApertureSHAgreeAtAnyResolution) {
+  // The truth's SH must not depend on whether a map's pixels happen to hit the aperture: at 32, 64
+  // and 128 rows the spot's c00 is (I/d²)·Y00 (plus nothing else in this scene).
+  constexpr double kSHTol = 2e-3;  // relative: Y00 is constant; float32 pixels and summation order
+  const Vec3 p{0.3, 0.5, -0.2};
+  Scene s = small_spot(false);
+  double d2 = dot(Vec3{0, 2, 0} - p, Vec3{0, 2, 0} - p);
+  for (int size : {32, 64, 128}) {
+    TruthDesc td;
+    td.size = size;
+    td.samples = 2;
+    td.bands = 3;
+    Truth t = ground_truth(s, p, td);
+    EXPECT_NEAR(t.sh.c[0].x / (10 / d2 * 0.5 / std::sqrt(kPi)), 1.0, kSHTol) << size;
+  }
+}
+
+TEST(LabTruth, BlindConeLeavesOutItsSolidAngle) {
+  // Under a uniform sky L, the SH without a 30° cone around −Z has c00 = L·(4π − 2π(1 − cos 30°))·Y00.
+  constexpr double kConeTol = 2e-3;  // relative: pixels are in or out by their centre (128 rows)
+  Scene s;
+  Emitter env;
+  env.type = EmitterType::Environment;
+  env.radiance = {1, 1, 1};
+  s.emitters.push_back(env);
+  s.build();
+  TruthDesc td;
+  td.size = 128;
+  td.samples = 1;
+  td.bands = 3;
+  td.blind_cone_deg = 30;
+  Truth t = ground_truth(s, {0, 0, 0}, td);
+  const double y00 = 0.5 / std::sqrt(kPi);
+  EXPECT_NEAR(t.sh.c[0].x / (4 * kPi * y00), 1.0, kConeTol);
+  EXPECT_NEAR(t.sh_visible.c[0].x / ((4 * kPi - 2 * kPi * (1 - std::cos(kPi / 6))) * y00), 1.0, kConeTol);
+}
+
 TEST(LabTruth, UniformEnvironmentGivesPiLIrradiance) {
   constexpr double kQuadTol = 3e-3;  // relative: pixel-centre cosines over a 64×32 map (horizon pixels)
   Scene s;

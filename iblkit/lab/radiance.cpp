@@ -97,7 +97,7 @@ Vec3 direct_irradiance(const Scene& s, Vec3 p, Vec3 n, Rng& rng, const RenderDes
   return e_sum;
 }
 
-Vec3 radiance(const Scene& s, Vec3 o, Vec3 d, Rng& rng, const RenderDesc& desc) {
+Vec3 radiance(const Scene& s, Vec3 o, Vec3 d, Rng& rng, const RenderDesc& desc, uint64_t hidden_apertures) {
   Vec3 L, beta{1, 1, 1};
   double tnear = 0;
   for (int depth = 0;; ++depth) {
@@ -115,7 +115,7 @@ Vec3 radiance(const Scene& s, Vec3 o, Vec3 d, Rng& rng, const RenderDesc& desc) 
         const Emitter& e = s.emitters[surf.emitter];
         if (surf.role == SurfaceRole::AreaLight) {
           L += beta * e.radiance;
-        } else {
+        } else if (surf.emitter >= 64 || !((hidden_apertures >> surf.emitter) & 1)) {
           double cos_a = -dot(d, e.direction);  // lamp axis vs. the direction towards the viewer
           if (cos_a > 0) L += beta * e.intensity_towards(-d) / (e.emit_area * cos_a);
         }

@@ -11,6 +11,8 @@
 // apertures, the environment) is not counted again when a bounce ray hits it; emission of
 // ordinary surfaces is not light-sampled and counts whenever it is hit (front side only).
 #pragma once
+#include <cstdint>
+
 #include "iblkit/core/vec.h"
 #include "iblkit/lab/rng.h"
 #include "iblkit/lab/scene.h"
@@ -18,7 +20,9 @@
 namespace ibl::lab {
 
 // Radiance arriving at o from direction d (unit; the ray leaves o along d). Scene must be built.
-Vec3 radiance(const Scene& scene, Vec3 o, Vec3 d, Rng& rng, const RenderDesc& desc);
+// Bit i of `hidden_apertures` makes the aperture of emitters[i] black to this (camera) ray: the
+// caller adds that lamp's light by other means (capture_probe integrates small apertures per pixel).
+Vec3 radiance(const Scene& scene, Vec3 o, Vec3 d, Rng& rng, const RenderDesc& desc, uint64_t hidden_apertures = 0);
 
 // Distance to the first surface along the ray (emitters' geometry included), +inf when none.
 double first_hit_distance(const Scene& scene, Vec3 o, Vec3 d);

@@ -1,6 +1,7 @@
 #include "iblkit/lab/truth.h"
 
 #include <atomic>
+#include <cmath>
 
 #include "iblkit/core/error.h"
 #include "iblkit/core/parallel.h"
@@ -50,6 +51,17 @@ Truth ground_truth(const Scene& scene, Vec3 position, const TruthDesc& desc, con
   Truth t;
   t.radiance = sphere::EnvMap(std::move(cap.radiance), cap.mapping);
   if (desc.bands > 0) t.sh = sh::project(t.radiance, desc.bands);
+  if (desc.bands > 0 && desc.blind_cone_deg > 0) {
+    if (!(desc.blind_cone_deg < 180)) fail(ErrorKind::Value, "blind cone {}° must lie in (0, 180)", desc.blind_cone_deg);
+    const double cos_blind = std::cos(desc.blind_cone_deg * kPi / 180);
+    sphere::EnvMap vis = t.radiance;
+    for (int y = 0; y < vis.image.height(); ++y)
+      for (int x = 0; x < vis.image.width(); ++x) {
+        Vec3 d;
+        if (vis.mapping.to_direction(x + 0.5, y + 0.5, &d) && -d.z > cos_blind) vis.image.set_rgb(x, y, {0, 0, 0});
+      }
+    t.sh_visible = sh::project(vis, desc.bands);
+  }
   for (Vec3 n : desc.normals) {
     if (length(n) == 0) fail(ErrorKind::Value, "irradiance normal (0,0,0) has no direction");
     t.normals.push_back(normalize(n));

@@ -17,11 +17,15 @@ struct TruthDesc {
   int bands = 3;           // SH bands of the projection (0: none)
   std::vector<Vec3> normals;  // irradiance is computed for each (normalised here)
   uint64_t seed = 1;       // random streams
+  double blind_cone_deg = 0;  // > 0: also project `sh_visible`, the map without the directions within
+                              // this angle of −Z (a mirror-ball sequence's dead angle, identity rotation)
 };
 
 struct Truth {
   sphere::EnvMap radiance{Image(2, 1, 3), sphere::Mapping(sphere::MappingKind::LatLong, 2, 1)};  // lat-long map
   sh::Coeffs sh;                 // SH projection of `radiance` (sh::project; empty when bands = 0)
+  sh::Coeffs sh_visible;         // the same with the pixels whose centre lies in the blind cone set to 0
+                                 // (what a sequence with that dead angle can see; empty unless asked)
   std::vector<Vec3> normals;     // the unit normals of `irradiance`
   std::vector<Vec3> irradiance;  // E(n) = ∫ L(ω) max(0, n·ω) dω, W/m²
 };
