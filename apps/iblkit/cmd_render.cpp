@@ -16,6 +16,7 @@
 #include "iblkit/io/tonemap.h"
 #include "iblkit/render/cpu_renderer.h"
 #include "iblkit/render/mesh.h"
+#include "iblkit/render/prefilter.h"
 #include "iblkit/sh/project.h"
 #ifdef IBLKIT_HAVE_GL
 #include "iblkit/render/gl/context.h"
@@ -30,7 +31,8 @@ using namespace ibl::render;
 
 // Reads --light: an SH grid (.shgrid), an iblkit.lights/1 or iblkit.sh/1 JSON file, or a probe image
 // (projected to SH).
-void load_lighting(const std::string& path, int bands, int shadows, const io::EnvReadDesc& rd, Lighting* L, std::string* kind) {
+void load_lighting(const std::string& path, int bands, int shadows, const io::EnvReadDesc& rd, double glossy_exponent, Lighting* L,
+                   std::string* kind) {
   std::string ext = fs::path(path).extension().string();
   if (ext == ".shgrid") {
     ilf::SHGrid g = ilf::read_shgrid(path);
@@ -86,6 +88,11 @@ void load_lighting(const std::string& path, int bands, int shadows, const io::En
   auto env = io::read_envmap(path, rd);
   L->environment = sh::project(env, bands);
   *kind = fmt::format("probe projected to {} SH bands", bands);
+  if (glossy_exponent > 0) {
+    L->glossy_maps.push_back(prefilter_phong(env, glossy_exponent));
+    const Image& g = L->glossy_maps.back().latlong;
+    *kind += fmt::format(", glossy from a prefiltered {}x{} Phong map (s = {:g})", g.width(), g.height(), glossy_exponent);
+  }
 }
 
 void setup(CLI::App& app) {
@@ -95,6 +102,7 @@ void setup(CLI::App& app) {
     double object_size = 0.8;
     int frames = 1, bands = 5, triangles = 100000, shadows = 4;
     double gloss = 0, exponent = 20;
+    std::string glossy = "map";
   };
   auto* o = new Opts();
   app.add_option("scene", o->scene,
@@ -115,6 +123,11 @@ void setup(CLI::App& app) {
   app.add_option("--triangles", o->triangles, "triangles of the blob")->check(CLI::Range(100, 5000000))->capture_default_str();
   app.add_option("--gloss", o->gloss, "weight of the glossy Phong lobe (0..1)")->check(CLI::Range(0.0, 1.0));
   app.add_option("--exponent", o->exponent, "Phong exponent of the glossy lobe")->check(CLI::Range(1.0, 10000.0));
+  app.add_option("--glossy", o->glossy,
+                 "probe lighting with --gloss > 0: the glossy lobe from a prefiltered Phong map of the probe (map) "
+                 "or from its --bands SH (sh, band-limited)")
+      ->check(CLI::IsMember({"map", "sh"}))
+      ->capture_default_str();
   app.add_option("--eye", o->eye, "camera position x,y,z")->capture_default_str();
   app.add_option("--target", o->target, "camera target x,y,z")->capture_default_str();
   auto& rd = iblcli::add_probe_read_options(app);
@@ -151,7 +164,7 @@ void setup(CLI::App& app) {
     Material mat{{0.75, 0.75, 0.75}, Vec3{1, 1, 1} * o->gloss, o->exponent};
     d.objects = {{&object, mat}, {&floor, Material{{0.5, 0.5, 0.5}, {0, 0, 0}, 1}}};
     std::string kind;
-    load_lighting(o->light, o->bands, o->shadows, rd, &d.lighting, &kind);
+    load_lighting(o->light, o->bands, o->shadows, rd, o->gloss > 0 && o->glossy == "map" ? o->exponent : 0.0, &d.lighting, &kind);
     std::string backend = o->backend;
     nlohmann::json j = {{"scene", o->scene}, {"light", o->light}, {"lighting", kind}, {"size", o->size}};
     RenderResult f;
@@ -219,7 +232,9 @@ void demo_step(iblcli::DemoContext& ctx) {
   d.camera.eye = {0, 0.5, 1.6};
   Mesh object = make_blob(60000, 0.8), floor = make_floor(6, -0.42);
   d.objects = {{&object, Material{{0.75, 0.75, 0.75}, {0.15, 0.15, 0.15}, 20}}, {&floor, Material{{0.5, 0.5, 0.5}, {0, 0, 0}, 1}}};
-  d.lighting.environment = sh::project(io::read_envmap(ctx.probe), 5);
+  auto probe = io::read_envmap(ctx.probe);
+  d.lighting.environment = sh::project(probe, 5);
+  d.lighting.glossy_maps.push_back(prefilter_phong(probe, 20));  // the highlight without the SH band limit
   auto t0 = std::chrono::steady_clock::now();
   RenderResult cpu = render_cpu(d);
   double cpu_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();

@@ -72,4 +72,23 @@ inline Mat4f light_view_projection(Vec3 dir_to_light, Vec3 centre, double radius
   return mul(p, v);
 }
 
+// Perspective light-space matrix for a light at `position` looking at a bounding sphere (centre,
+// radius) that it sits outside of: the frustum just contains the sphere. Returns false (and leaves
+// *m alone) when the light is inside or too close to the sphere for one frustum to hold it.
+inline bool point_light_view_projection(Vec3 position, Vec3 centre, double radius, Mat4f* m) {
+  Vec3 to = centre - position;
+  double dist = length(to);
+  if (!(dist > radius * 1.05)) return false;
+  Camera c;
+  c.eye = position;
+  c.target = centre;
+  c.up = std::abs(to.y / dist) > 0.99 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
+  c.fov_y_deg = 2 * std::asin(std::min(1.0, radius / dist)) * 180 / kPi * 1.02;
+  c.width = c.height = 1;
+  c.znear = std::max(1e-4, dist - radius) * 0.95;
+  c.zfar = (dist + radius) * 1.05;
+  *m = mul(c.projection(), c.view());
+  return true;
+}
+
 }  // namespace ibl::render

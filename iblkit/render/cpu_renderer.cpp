@@ -41,14 +41,14 @@ class ShadowScene {
     rtcReleaseScene(scene_);
     rtcReleaseDevice(device_);
   }
-  bool occluded(Vec3 o, Vec3 dir) const {
+  bool occluded(Vec3 o, Vec3 dir, double distance) const {
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     RTCRay ray{};
     ray.org_x = static_cast<float>(o.x); ray.org_y = static_cast<float>(o.y); ray.org_z = static_cast<float>(o.z);
     ray.dir_x = static_cast<float>(dir.x); ray.dir_y = static_cast<float>(dir.y); ray.dir_z = static_cast<float>(dir.z);
     ray.tnear = 0.0f;
-    ray.tfar = std::numeric_limits<float>::infinity();
+    ray.tfar = std::isfinite(distance) ? static_cast<float>(distance * (1 - 1e-4)) : std::numeric_limits<float>::infinity();
     ray.mask = 0xffffffff;
     rtcOccluded1(scene_, &ctx, &ray);
     return ray.tfar < 0.0f;
@@ -161,6 +161,7 @@ RenderResult render_cpu(const FrameDesc& d, const ProgressFn& progress) {
   report(progress, "rasterise", 1.0);
   bool need_shadows = false;
   for (const auto& l : d.lighting.lights) need_shadows |= l.shadow;
+  for (const auto& l : d.lighting.point_lights) need_shadows |= l.shadow;
   std::unique_ptr<ShadowScene> shadows;
   if (need_shadows) shadows = std::make_unique<ShadowScene>(d);
   RenderResult f{Image(W, H, 3), Image(W, H, 1)};
@@ -182,7 +183,7 @@ RenderResult render_cpu(const FrameDesc& d, const ProgressFn& progress) {
       Vec3 v = normalize(cam.eye - p);
       VisibilityFn vis;
       if (shadows)
-        vis = [&](Vec3 q, int li) { return !shadows->occluded(q + n * d.shadow_bias, d.lighting.lights[li].direction); };
+        vis = [&](Vec3 q, Vec3 l, double dist) { return !shadows->occluded(q + n * d.shadow_bias, l, dist); };
       f.color.set_rgb(x, y, shade(d.lighting, o.material, p, n, v, vis));
       f.coverage.at(x, y, 0) = 1.0f;
     }

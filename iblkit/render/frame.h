@@ -25,6 +25,9 @@ struct FrameDesc {
 struct RenderResult {
   Image color;     // width × height × 3
   Image coverage;  // 1 where a surface was hit, else 0
+  int unshadowed_lights = 0;  // GPU: shadow-casting lights drawn without a shadow map (beyond
+                              // gl::Renderer::kMaxShadowMaps, or point lights inside the objects'
+                              // bounding sphere); 0 on the CPU, whose shadow rays serve every light
 };
 
 }  // namespace ibl::render

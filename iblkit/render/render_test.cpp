@@ -77,6 +77,30 @@ TEST(RenderCpu, DirectionalLightOnSphereMatchesClosedForm) {
   EXPECT_GT(checked, 1000);
 }
 
+// A point light near a sphere: L_o = ρ/π · I · max(0, n·l)/d² with l and d from the exact hit point.
+TEST(RenderCpu, PointLightOnSphereMatchesClosedForm) {
+  constexpr double kFacetTol = 0.02;  // interpolated normals and facet positions of the UV sphere
+  Mesh m = make_sphere(0.4, 64, 128);
+  FrameDesc d = sphere_scene(&m);
+  d.objects[0].material.albedo = {0.5, 0.5, 0.5};
+  const Vec3 q{0.5, 0.9, 0.7};
+  d.lighting.point_lights.push_back({q, {2, 2, 2}, true});  // shadow rays: a convex object never shadows itself
+  RenderResult f = render_cpu(d);
+  int checked = 0;
+  for (int y = 0; y < f.color.height(); ++y)
+    for (int x = 0; x < f.color.width(); ++x) {
+      Vec3 dir = d.camera.ray_direction(x + 0.5, y + 0.5), o = d.camera.eye;
+      double b = dot(o, dir), c = dot(o, o) - 0.16, disc = b * b - c;
+      if (disc < 1e-3) continue;
+      Vec3 p = o + dir * (-b - std::sqrt(disc)), n = normalize(p);
+      Vec3 to = q - p;
+      double want = 0.5 / kPi * 2 * std::max(0.0, dot(n, normalize(to))) / dot(to, to);
+      ASSERT_NEAR(f.color.at(x, y, 0), want, kFacetTol * 2) << x << "," << y;
+      ++checked;
+    }
+  EXPECT_GT(checked, 1000);
+}
+
 // A floor under a blob and a light from above: the floor below the blob is in shadow.
 TEST(RenderCpu, ShadowsFromShadowRays) {
   Mesh blob = make_blob(2000, 0.4), floor = make_floor(4, -0.3);
@@ -237,6 +261,64 @@ TEST_F(RenderGl, ShGridAgreesWithCpu) {
     EXPECT_LT(a.coverage_mismatch, kCoverageTol) << "deferred " << deferred;
     EXPECT_LT(a.median, kGridMedianTol) << "deferred " << deferred;
     EXPECT_LT(a.p99, kGridP99Tol) << "deferred " << deferred;
+  }
+}
+
+// Point lights with perspective shadow maps against shadow rays; a light inside the objects'
+// bounds is drawn unshadowed on the GPU and counted.
+TEST_F(RenderGl, PointLightsWithShadowsAgreeWithCpu) {
+  gl::Context ctx;
+  Mesh blob = make_blob(6000, 0.5), floor = make_floor(1.6, -0.25);
+  FrameDesc d;
+  d.camera.eye = {0.3, 0.9, 1.4};
+  d.camera.target = {0, 0, 0};
+  d.camera.width = 128;
+  d.camera.height = 96;
+  d.objects = {{&blob, Material{{0.7, 0.6, 0.5}, {0.1, 0.1, 0.1}, 20}}, {&floor, Material{}}};
+  d.lighting.point_lights = {{{1.2, 1.5, 0.6}, {4, 4, 4}, true}, {{-1.0, 0.8, -0.9}, {1.0, 0.8, 0.6}, true},
+                             {{0, 2, 0}, {0.3, 0.3, 0.4}, false}};
+  RenderResult cpu = render_cpu(d);
+  for (bool deferred : {false, true}) {
+    gl::Renderer r({deferred});
+    RenderResult g = r.render(d);
+    EXPECT_EQ(g.unshadowed_lights, 0);
+    Agreement a = compare(cpu, g);
+    constexpr double kLightsMedianTol = 1e-3;  // as for directional lights: shadow edges differ, the rest is float
+    constexpr double kLightsP99Tol = 0.5;
+    EXPECT_GT(a.pixels, 4000) << "deferred " << deferred;
+    EXPECT_LT(a.coverage_mismatch, kCoverageTol) << "deferred " << deferred;
+    EXPECT_LT(a.median, kLightsMedianTol) << "deferred " << deferred;
+    EXPECT_LT(a.p99, kLightsP99Tol) << "deferred " << deferred;
+  }
+  d.lighting.point_lights[0].position = {0, 0.1, 0};  // inside the bounding sphere of blob + floor
+  gl::Renderer r;
+  EXPECT_EQ(r.render(d).unshadowed_lights, 1);
+}
+
+// A probe's glossy reflection through a prefiltered Phong map (render/prefilter.h): both renderers
+// read the same texels with the same bilinear filter.
+TEST_F(RenderGl, GlossyMapAgreesWithCpu) {
+  gl::Context ctx;
+  Mesh m = make_sphere(0.4, 48, 96);
+  FrameDesc d = sphere_scene(&m, 80, 60);
+  sphere::EnvMap probe(Image(64, 32, 3), sphere::Mapping(sphere::MappingKind::LatLong, 64, 32));
+  for (int y = 0; y < 32; ++y)
+    for (int x = 0; x < 64; ++x) probe.image.set_rgb(x, y, Vec3{0.2, 0.3, 0.4} + Vec3{5, 4, 3} * ((x / 8 + y / 8) % 2));
+  sh::Coeffs ambient(1);
+  ambient.c[0] = Vec3{1, 1, 1} * std::sqrt(4 * kPi) * 0.3;
+  d.lighting.environment = ambient;
+  d.objects[0].material = Material{{0.3, 0.3, 0.3}, {0.6, 0.6, 0.6}, 30};
+  d.lighting.glossy_maps.push_back(prefilter_phong(probe, 30));
+  RenderResult cpu = render_cpu(d);
+  for (bool deferred : {false, true}) {
+    gl::Renderer r({deferred});
+    Agreement a = compare(cpu, r.render(d));
+    constexpr double kMapMedianTol = 2e-3;  // GL's 8-bit bilinear weights on an RGBA32F texture
+    constexpr double kMapP99Tol = 3e-2;     // silhouettes, and texels where the checker's edges sit
+    EXPECT_GT(a.pixels, 1000) << "deferred " << deferred;
+    EXPECT_LT(a.coverage_mismatch, kCoverageTol) << "deferred " << deferred;
+    EXPECT_LT(a.median, kMapMedianTol) << "deferred " << deferred;
+    EXPECT_LT(a.p99, kMapP99Tol) << "deferred " << deferred;
   }
 }
 

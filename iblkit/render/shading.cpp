@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "iblkit/sh/basis.h"
 #include "iblkit/sh/convolve.h"
@@ -44,6 +45,8 @@ Vec3 shade(const Lighting& lighting, const Material& m, Vec3 p, Vec3 n, Vec3 v, 
   } else if (lighting.environment) {
     c = &*lighting.environment;
   }
+  const GlossyMap* gmap = lighting.grid ? nullptr : lighting.glossy_map(m.exponent);
+  if (gmap) G += lookup(*gmap, r);
   if (c && c->bands > 0) {
     int bands = c->bands;
     auto diffuse = sh::clamped_cosine_zh(bands);
@@ -55,18 +58,25 @@ Vec3 shade(const Lighting& lighting, const Material& m, Vec3 p, Vec3 n, Vec3 v, 
       for (int mm = -l; mm <= l; ++mm) {
         int k = l * (l + 1) + mm;
         E += c->c[k] * (diffuse[l] * yn[k]);
-        G += c->c[k] * (glossy[l] * yr[k]);
+        if (!gmap) G += c->c[k] * (glossy[l] * yr[k]);
       }
   }
   const double lobe_norm = (m.exponent + 1) / kTwoPi;
-  for (size_t i = 0; i < lighting.lights.size(); ++i) {
-    const DirectionalLight& L = lighting.lights[i];
-    double ndl = dot(n, L.direction);
-    if (ndl <= 0) continue;
-    if (L.shadow && visible && !visible(p, static_cast<int>(i))) continue;
-    E += L.irradiance * ndl;
-    double rdl = dot(r, L.direction);
-    if (rdl > 0) G += L.irradiance * (lobe_norm * std::pow(rdl, m.exponent));
+  auto add_light = [&](Vec3 l, Vec3 irradiance, bool shadow, double distance) {
+    double ndl = dot(n, l);
+    if (ndl <= 0) return;
+    if (shadow && visible && !visible(p, l, distance)) return;
+    E += irradiance * ndl;
+    double rdl = dot(r, l);
+    if (rdl > 0) G += irradiance * (lobe_norm * std::pow(rdl, m.exponent));
+  };
+  for (const DirectionalLight& L : lighting.lights) add_light(L.direction, L.irradiance, L.shadow, std::numeric_limits<double>::infinity());
+  for (const PointLight& L : lighting.point_lights) {
+    Vec3 to = L.position - p;
+    double d2 = dot(to, to);
+    if (!(d2 > 0)) continue;
+    double d = std::sqrt(d2);
+    add_light(to / d, L.intensity / d2, L.shadow, d);
   }
   Vec3 out = m.albedo * E * (1.0 / kPi) + m.specular * G;
   // SH ringing can make a few values negative; light is never negative.

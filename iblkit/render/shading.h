@@ -9,13 +9,16 @@
 //   G(r) = Σ_lm ρ̂_l(s) c_lm Y_lm(r)      ρ̂_l(s): normalised Phong lobe (s+1)/2π (r·ω)^s, its
 //                                          zonal harmonics rotated to r (Löw et al. 2009 §4)
 // and for each directional light (direction l towards the light, irradiance E_i, visibility V_i)
-//   E(n) += V_i E_i max(0, n·l),   G(r) += V_i E_i (s+1)/2π max(0, r·l)^s   (only where n·l > 0).
+//   E(n) += V_i E_i max(0, n·l),   G(r) += V_i E_i (s+1)/2π max(0, r·l)^s   (only where n·l > 0),
+// point lights the same with l = (q − p)/|q − p| and E_i = I_i/|q − p|².
+// A distant probe may instead give G(r) through a prefiltered map (render/prefilter.h): G(r) = G_s(r).
 #pragma once
 #include <functional>
 #include <optional>
 #include <vector>
 
 #include "iblkit/core/vec.h"
+#include "iblkit/render/prefilter.h"
 #include "iblkit/sh/coeffs.h"
 
 namespace ibl::render {
@@ -32,6 +35,14 @@ struct DirectionalLight {
   bool shadow = false;  // cast shadows (shadow rays on the CPU, shadow maps on the GPU)
 };
 
+// An isotropic point light: E = I/d² at normal incidence. Fusion's localised lights (a light of
+// irradiance E at the set's origin o, sitting at position q) become I = E·|q − o|² (docs/fusion.md).
+struct PointLight {
+  Vec3 position;        // world metres
+  Vec3 intensity;       // radiant intensity, W/sr (RGB)
+  bool shadow = false;  // shadow rays on the CPU; a perspective shadow map on the GPU
+};
+
 // A regular grid of SH radiance (the .shgrid layout of DESIGN.md): value index
 // (((z·ny + y)·nx + x)·K + k)·3 + channel; point (i,j,k) at min + (max−min)·(i/(nx−1), …).
 struct SHGridData {
@@ -46,11 +57,22 @@ struct SHGridData {
 struct Lighting {
   std::optional<sh::Coeffs> environment;  // distant light
   std::optional<SHGridData> grid;         // local light field (takes precedence over environment)
-  std::vector<DirectionalLight> lights;   // directional or localised-as-directional lights
+  std::vector<DirectionalLight> lights;   // directional lights
+  std::vector<PointLight> point_lights;   // point lights (e.g. fusion's localised lights)
+  // Glossy term of a distant probe without the SH band limit (render/prefilter.h): a material whose
+  // exponent equals a map's takes G(r) from the map instead of from the SH environment.
+  std::vector<GlossyMap> glossy_maps;
+  // The map for exponent s, or null.
+  const GlossyMap* glossy_map(double s) const {
+    for (const auto& g : glossy_maps)
+      if (g.exponent == s) return &g;
+    return nullptr;
+  }
 };
 
-// Visibility of light `i` from point p (true = lit). Null means everything is lit.
-using VisibilityFn = std::function<bool(Vec3 p, int light)>;
+// Visibility of a light from point p: true when nothing blocks the segment from p along the unit
+// direction `to_light` for `distance` metres (+inf for a directional light). Null: all lit.
+using VisibilityFn = std::function<bool(Vec3 p, Vec3 to_light, double distance)>;
 
 Vec3 shade(const Lighting& lighting, const Material& m, Vec3 p, Vec3 n, Vec3 v, const VisibilityFn& visible = {});
 

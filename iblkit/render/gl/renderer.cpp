@@ -115,7 +115,9 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing)
   // Lights and shadow matrices.
   std::vector<float> light_data;
   std::vector<Mat4f> shadow_mats;
+  int unshadowed = 0;
   for (const auto& l : L.lights) {
+    if (l.shadow && static_cast<int>(shadow_mats.size()) >= kMaxShadowMaps) ++unshadowed;
     float layer = -1;
     if (l.shadow && static_cast<int>(shadow_mats.size()) < kMaxShadowMaps) {
       layer = static_cast<float>(shadow_mats.size());
@@ -126,6 +128,30 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing)
                                          static_cast<float>(l.irradiance.x), static_cast<float>(l.irradiance.y),
                                          static_cast<float>(l.irradiance.z), 0.0f});
   }
+  // Point lights: a perspective shadow map each when they sit outside the objects' bounding sphere
+  // (a light inside it would need a cube map: it is drawn unshadowed, and `unshadowed` counts it).
+  std::vector<float> point_data;
+  for (const auto& l : L.point_lights) {
+    float layer = -1;
+    Mat4f m;
+    if (l.shadow && static_cast<int>(shadow_mats.size()) >= kMaxShadowMaps) ++unshadowed;
+    if (l.shadow && static_cast<int>(shadow_mats.size()) < kMaxShadowMaps) {
+      if (point_light_view_projection(l.position, centre, radius, &m)) {
+        layer = static_cast<float>(shadow_mats.size());
+        shadow_mats.push_back(m);
+      } else {
+        ++unshadowed;
+      }
+    }
+    point_data.insert(point_data.end(), {static_cast<float>(l.position.x), static_cast<float>(l.position.y),
+                                         static_cast<float>(l.position.z), layer, static_cast<float>(l.intensity.x),
+                                         static_cast<float>(l.intensity.y), static_cast<float>(l.intensity.z), 0.0f});
+  }
+  GLuint point_ssbo;
+  glCreateBuffers(1, &point_ssbo);
+  glNamedBufferStorage(point_ssbo, static_cast<GLsizeiptr>(std::max<size_t>(1, point_data.size()) * sizeof(float)),
+                       point_data.empty() ? nullptr : point_data.data(), 0);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, point_ssbo);
   GLuint ssbo[2];
   glCreateBuffers(2, ssbo);
   glNamedBufferStorage(ssbo[0], static_cast<GLsizeiptr>(std::max<size_t>(1, light_data.size()) * sizeof(float)),
@@ -211,11 +237,48 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing)
   if (glCheckNamedFramebufferStatus(fbo, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
     fail(ErrorKind::Unsupported, "GL framebuffer {}x{} is incomplete", W, H);
 
+  // Prefiltered glossy maps of a distant probe: one 2D array texture, a layer per map used by a
+  // material (all of one size).
+  std::vector<const GlossyMap*> gmaps;
+  std::vector<int> material_layer;
+  for (const auto& o : d.objects) {
+    const GlossyMap* g = L.grid ? nullptr : L.glossy_map(o.material.exponent);
+    int layer = -1;
+    if (g) {
+      auto it = std::find(gmaps.begin(), gmaps.end(), g);
+      layer = static_cast<int>(it - gmaps.begin());
+      if (it == gmaps.end()) gmaps.push_back(g);
+    }
+    material_layer.push_back(layer);
+  }
+  GLuint glossy_tex = 0;
+  if (!gmaps.empty()) {
+    const int gw = gmaps[0]->latlong.width(), gh = gmaps[0]->latlong.height();
+    for (const GlossyMap* g : gmaps)
+      if (g->latlong.width() != gw || g->latlong.height() != gh || g->latlong.channels() != 3)
+        fail(ErrorKind::Unsupported, "the GL renderer takes glossy maps of one size per frame ({}x{} and {}x{} given)", gw, gh,
+             g->latlong.width(), g->latlong.height());
+    glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, &glossy_tex);
+    glTextureStorage3D(glossy_tex, 1, GL_RGBA32F, gw, gh, static_cast<GLsizei>(gmaps.size()));
+    std::vector<float> rgba(static_cast<size_t>(gw) * gh * 4);
+    for (size_t li = 0; li < gmaps.size(); ++li) {
+      const Image& im = gmaps[li]->latlong;
+      for (size_t i = 0; i < im.pixel_count(); ++i)
+        for (int c = 0; c < 4; ++c) rgba[i * 4 + c] = c < 3 ? im.data()[i * 3 + c] : 0.0f;
+      glTextureSubImage3D(glossy_tex, 0, 0, 0, static_cast<GLint>(li), gw, gh, 1, GL_RGBA, GL_FLOAT, rgba.data());
+    }
+    glTextureParameteri(glossy_tex, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTextureParameteri(glossy_tex, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTextureParameteri(glossy_tex, GL_TEXTURE_WRAP_S, GL_REPEAT);
+    glTextureParameteri(glossy_tex, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  }
+
   // Materials (deferred: a table indexed from the G-buffer; forward: uniforms per object).
   std::vector<float> materials;
-  for (const auto& o : d.objects) {
-    const Material& m = o.material;
-    float row[20] = {static_cast<float>(m.albedo.x),   static_cast<float>(m.albedo.y),   static_cast<float>(m.albedo.z),   0,
+  for (size_t oi = 0; oi < d.objects.size(); ++oi) {
+    const Material& m = d.objects[oi].material;
+    float row[20] = {static_cast<float>(m.albedo.x),   static_cast<float>(m.albedo.y),   static_cast<float>(m.albedo.z),
+                     static_cast<float>(material_layer[oi]),
                      static_cast<float>(m.specular.x), static_cast<float>(m.specular.y), static_cast<float>(m.specular.z),
                      static_cast<float>(m.exponent)};
     if (bands > 0) {
@@ -244,6 +307,7 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing)
     set_vec3(prog, "u_ray_dy", u * (-2 * t / H));
   }
   glProgramUniform1i(prog, glGetUniformLocation(prog, "u_light_count"), static_cast<GLint>(L.lights.size()));
+  glProgramUniform1i(prog, glGetUniformLocation(prog, "u_point_light_count"), static_cast<GLint>(L.point_lights.size()));
   glProgramUniform1f(prog, glGetUniformLocation(prog, "u_shadow_bias"), static_cast<float>(d.shadow_bias));
   glProgramUniform1i(prog, glGetUniformLocation(prog, "u_shadow_maps"), 0);
   int mode = L.grid ? 2 : (L.environment ? 1 : 0);
@@ -265,8 +329,10 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing)
   }
   // Every sampler gets its own unit even when unused: two sampler types on one unit is an error.
   glProgramUniform1i(prog, glGetUniformLocation(prog, "u_grid"), 1);
+  glProgramUniform1i(prog, glGetUniformLocation(prog, "u_glossy_maps"), 3);
   GLint loc_albedo = glGetUniformLocation(prog, "u_albedo"), loc_specular = glGetUniformLocation(prog, "u_specular"),
         loc_exponent = glGetUniformLocation(prog, "u_exponent"), loc_glossy = glGetUniformLocation(prog, "u_glossy_zh"),
+        loc_glossy_layer = glGetUniformLocation(prog, "u_glossy_layer"),
         loc_material = glGetUniformLocation(raster, "u_object"),
         loc_light_vp = glGetUniformLocation(impl_->shadow_program, "u_light_view_projection");
 
@@ -316,6 +382,7 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing)
     glUseProgram(raster);
     glBindTextureUnit(0, shadow_tex);
     if (grid_tex) glBindTextureUnit(1, grid_tex);
+    if (glossy_tex) glBindTextureUnit(3, glossy_tex);
     for (size_t i = 0; i < meshes.size(); ++i) {
       if (deferred) {
         glUniform1ui(loc_material, static_cast<GLuint>(i));
@@ -324,6 +391,7 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing)
         glUniform3f(loc_albedo, static_cast<float>(mat.albedo.x), static_cast<float>(mat.albedo.y), static_cast<float>(mat.albedo.z));
         glUniform3f(loc_specular, static_cast<float>(mat.specular.x), static_cast<float>(mat.specular.y), static_cast<float>(mat.specular.z));
         glUniform1f(loc_exponent, static_cast<float>(mat.exponent));
+        glUniform1i(loc_glossy_layer, material_layer[i]);
         if (bands > 0) glUniform1fv(loc_glossy, bands, materials.data() + i * 20 + 8);
       }
       glBindVertexArray(meshes[i].vao);
@@ -350,7 +418,7 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing)
     timing->wall_ms_per_frame = wall_ms / nframes;
   }
 
-  RenderResult out{Image(W, H, 3), Image(W, H, 1)};
+  RenderResult out{Image(W, H, 3), Image(W, H, 1), unshadowed};
   std::vector<float> rgba(static_cast<size_t>(W) * H * 4);
   glGetTextureImage(color_tex, 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(rgba.size() * sizeof(float)), rgba.data());
   for (int y = 0; y < H; ++y)
@@ -372,7 +440,9 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing)
   glDeleteTextures(1, &color_tex);
   glDeleteTextures(1, &shadow_tex);
   if (grid_tex) glDeleteTextures(1, &grid_tex);
+  if (glossy_tex) glDeleteTextures(1, &glossy_tex);
   glDeleteBuffers(2, ssbo);
+  glDeleteBuffers(1, &point_ssbo);
   for (auto& m : meshes) release(m);
   if (err != GL_NO_ERROR) fail(ErrorKind::Internal, "OpenGL error 0x{:x} while rendering", err);
   return out;

@@ -6,7 +6,7 @@ layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = 2) uniform usampler2D u_visibility;
 layout(rgba32f, binding = 0) writeonly uniform image2D u_out;
 struct MaterialGpu {
-  vec4 albedo;          // rgb
+  vec4 albedo;          // rgb, w = layer of the prefiltered glossy map or −1
   vec4 specular;        // rgb, w = Phong exponent
   float glossy_zh[12];  // ρ̂_l(s) for l < SH_BANDS (≤ 12)
 };
@@ -28,6 +28,7 @@ uniform vec3 u_ray_dy;
 
 int g_material = 0;
 float glossy_factor(int l) { return materials[g_material].glossy_zh[l]; }
+int glossy_layer() { return int(materials[g_material].albedo.w); }
 
 vec3 fetch3(uint v, bool normal) {
   return normal ? vec3(normals[3u * v], normals[3u * v + 1u], normals[3u * v + 2u])

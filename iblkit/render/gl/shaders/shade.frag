@@ -8,5 +8,7 @@ uniform vec3 u_albedo;
 uniform vec3 u_specular;
 uniform float u_exponent;
 uniform float u_glossy_zh[SH_BANDS];
+uniform int u_glossy_layer;
 float glossy_factor(int l) { return u_glossy_zh[l]; }
+int glossy_layer() { return u_glossy_layer; }
 void main() { o_color = vec4(shade(v_position, v_normal, u_albedo, u_specular, u_exponent), 1.0); }

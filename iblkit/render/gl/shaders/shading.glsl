@@ -2,7 +2,9 @@
 // fragment shader (shade.frag) and the deferred compute shader (shade.comp):
 //   L_o = (albedo/π)·E(n) + specular·G(r)
 //   E(n) = Σ Â_l c_lm Y_lm(n),  G(r) = Σ ρ̂_l(s) c_lm Y_lm(r)   (SH environment or SH grid at p)
-//   + per directional light: V·E_i·max(0, n·l) and V·E_i·(s+1)/2π·max(0, r·l)^s where n·l > 0.
+//   + per directional light: V·E_i·max(0, n·l) and V·E_i·(s+1)/2π·max(0, r·l)^s where n·l > 0,
+//     and the same per point light with l towards it and E_i = I_i/d².
+//   or G(r) from a prefiltered map of a distant probe (render/prefilter.h).
 // Needs SH_BANDS, SH_K, sh_eval() and GLOSSY defined before it.
 uniform vec3 u_eye;
 
@@ -23,6 +25,12 @@ struct Light {
 layout(std430, binding = 0) readonly buffer Lights { Light lights[]; };
 layout(std430, binding = 1) readonly buffer ShadowMatrices { mat4 shadow_matrices[]; };
 uniform int u_light_count;
+struct PointLightGpu {
+  vec4 position;   // xyz: world position; w: shadow layer or −1
+  vec4 intensity;  // rgb, W/sr
+};
+layout(std430, binding = 7) readonly buffer PointLights { PointLightGpu point_lights[]; };
+uniform int u_point_light_count;
 uniform sampler2DArrayShadow u_shadow_maps;
 uniform float u_shadow_bias;
 
@@ -31,6 +39,10 @@ const float PI = 3.14159265358979;
 // ρ̂_l(s) of the material being shaded: defined by the including shader (a uniform array in the
 // forward path, the material table in the deferred path).
 float glossy_factor(int l);
+// Layer of the material's prefiltered glossy map in u_glossy_maps, or −1 (same two sources).
+int glossy_layer();
+// Prefiltered Phong maps of a distant probe (render/prefilter.h): lat-long, u repeats, v clamps.
+uniform sampler2DArray u_glossy_maps;
 
 float visibility(vec3 p, vec3 n, int layer) {
   vec4 q = shadow_matrices[layer] * vec4(p + n * u_shadow_bias, 1.0);
@@ -44,6 +56,11 @@ vec3 shade(vec3 p, vec3 n_in, vec3 albedo, vec3 specular, float exponent) {
   vec3 v = normalize(u_eye - p);
   vec3 r = normalize(2.0 * dot(n, v) * n - v);
   vec3 E = vec3(0.0), G = vec3(0.0);
+  int gmap = u_sh_mode == 2 ? -1 : glossy_layer();
+  if (gmap >= 0) {
+    vec2 uv = vec2(atan(r.z, r.x) / (2.0 * PI) + 0.5, acos(clamp(r.y, -1.0, 1.0)) / PI);
+    G += texture(u_glossy_maps, vec3(uv, float(gmap))).rgb;
+  }
   if (u_sh_mode != 0) {
     float yn[SH_K], yr[SH_K];
     sh_eval(n, yn);
@@ -62,17 +79,30 @@ vec3 shade(vec3 p, vec3 n_in, vec3 albedo, vec3 specular, float exponent) {
         vec3 c = u_sh_mode == 2 ? texture(u_grid, vec3(tc.xy, (float(k) * u_grid_res.z + tc.z) * inv_depth)).rgb : u_env[k];
         E += c * (u_diffuse_zh[l] * yn[k]);
 #if GLOSSY
-        G += c * (glossy_factor(l) * yr[k]);
+        if (gmap < 0) G += c * (glossy_factor(l) * yr[k]);
 #endif
       }
   }
   float lobe_norm = (exponent + 1.0) / (2.0 * PI);
-  for (int i = 0; i < u_light_count; ++i) {
-    vec3 l = lights[i].direction.xyz;
+  for (int i = 0; i < u_light_count + u_point_light_count; ++i) {
+    vec3 l, irr;
+    float layer;
+    if (i < u_light_count) {
+      l = lights[i].direction.xyz;
+      irr = lights[i].irradiance.rgb;
+      layer = lights[i].direction.w;
+    } else {
+      PointLightGpu q = point_lights[i - u_light_count];
+      vec3 to = q.position.xyz - p;
+      float d2 = dot(to, to);
+      if (!(d2 > 0.0)) continue;
+      l = to * inversesqrt(d2);
+      irr = q.intensity.rgb / d2;
+      layer = q.position.w;
+    }
     float ndl = dot(n, l);
     if (ndl <= 0.0) continue;
-    float vis = lights[i].direction.w >= 0.0 ? visibility(p, n, int(lights[i].direction.w)) : 1.0;
-    vec3 irr = lights[i].irradiance.rgb * vis;
+    if (layer >= 0.0) irr *= visibility(p, n, int(layer));
     E += irr * ndl;
     float rdl = dot(r, l);
     if (rdl > 0.0) G += irr * (lobe_norm * pow(rdl, exponent));
