@@ -1,0 +1,181 @@
+#include "iblkit/nearfield/dataset.h"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+
+#include "iblkit/core/error.h"
+#include "iblkit/io/image_io.h"
+#include "iblkit/nearfield/basis.h"
+
+namespace ibl::nearfield {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+const char* basis_name(Basis b) { return b == Basis::Bilinear ? "bilinear" : "biquadratic"; }
+
+Basis basis_from_name(const std::string& name, const std::string& what) {
+  if (name == "bilinear") return Basis::Bilinear;
+  if (name == "biquadratic") return Basis::Biquadratic;
+  fail(ErrorKind::Value, "{}: unknown basis '{}' (bilinear or biquadratic)", what, name);
+}
+
+Image Dataset::measurement(int i, int j) const {
+  const size_t k = static_cast<size_t>(j * nx + i);
+  const Image& p = positive.at(k);
+  const Image& n = negative.at(k);
+  Image e(p.width(), p.height(), 3);
+  for (int y = 0; y < p.height(); ++y)
+    for (int x = 0; x < p.width(); ++x) e.set_rgb(x, y, (p.rgb(x, y) - n.rgb(x, y)) * filter_gain);
+  return e;
+}
+
+void Dataset::validate(const std::string& what) const {
+  if (nx < 1 || ny < 1) fail(ErrorKind::Value, "{}: grid {}x{} has no filter positions", what, nx, ny);
+  if (!(spacing > 0) || !std::isfinite(spacing)) fail(ErrorKind::Value, "{}: spacing {} must be positive", what, spacing);
+  const double want = 2 * dual_half_width(basis) * spacing;
+  if (!(std::abs(filter_width - want) <= 1e-6 * want))  // written with 6+ significant digits
+    fail(ErrorKind::Value, "{}: filter_width {} m does not match the {} basis at spacing {} m (its dual is {} m wide)",
+         what, filter_width, basis_name(basis), spacing, want);
+  if (!(distance > 0) || !std::isfinite(distance)) fail(ErrorKind::Value, "{}: distance {} must be positive", what, distance);
+  if (!(m_max.x > m_min.x) || !(m_max.y > m_min.y))
+    fail(ErrorKind::Value, "{}: M extent [{}, {}]x[{}, {}] is empty", what, m_min.x, m_max.x, m_min.y, m_max.y);
+  if (!(filter_gain > 0)) fail(ErrorKind::Value, "{}: filter_gain {} must be positive", what, filter_gain);
+  const size_t n = static_cast<size_t>(count());
+  if (positive.size() != n || negative.size() != n)
+    fail(ErrorKind::Value, "{}: {} positive and {} negative images for {}x{} filter positions", what, positive.size(),
+         negative.size(), nx, ny);
+  const int w = positive[0].width(), h = positive[0].height();
+  for (size_t k = 0; k < n; ++k)
+    for (int part = 0; part < 2; ++part) {
+      const Image& img = part ? negative[k] : positive[k];
+      const int i = static_cast<int>(k) % nx, j = static_cast<int>(k) / nx;
+      const char* pn = part ? "negative" : "positive";
+      if (img.empty()) fail(ErrorKind::Value, "{}: the {} image of filter position ({}, {}) is missing", what, pn, i, j);
+      if (img.width() != w || img.height() != h || img.channels() < 3)
+        fail(ErrorKind::Value, "{}: the {} image of ({}, {}) is {}x{}x{}, the first is {}x{}x3", what, pn, i, j, img.width(),
+             img.height(), img.channels(), w, h);
+      for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+          for (int c = 0; c < 3; ++c) {
+            const float v = img.at(x, y, c);
+            if (!std::isfinite(v) || v < 0)
+              fail(ErrorKind::Value, "{}: the {} image of ({}, {}) has pixel ({}, {}) channel {} = {} (measurements are non-negative irradiances)",
+                   what, pn, i, j, x, y, c, v);
+          }
+    }
+}
+
+namespace {
+
+double number(const json& j, const char* key, const std::string& what) {
+  if (!j.contains(key) || !j[key].is_number()) fail(ErrorKind::Format, "{}: field '{}' missing or not a number", what, key);
+  return j[key].get<double>();
+}
+
+Vec2 vec2(const json& j, const std::string& what) {
+  if (!j.is_array() || j.size() != 2 || !j[0].is_number() || !j[1].is_number())
+    fail(ErrorKind::Format, "{}: expected [x, y]", what);
+  return {j[0].get<double>(), j[1].get<double>()};
+}
+
+}  // namespace
+
+Dataset read_dataset(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) fail(ErrorKind::Io, "{}: no such file or not readable", path);
+  json j;
+  try {
+    j = json::parse(in);
+  } catch (const json::exception& e) {
+    fail(ErrorKind::Format, "{}: not JSON ({})", path, e.what());
+  }
+  if (!j.is_object() || j.value("format", "") != "iblkit.nearfield/1")
+    fail(ErrorKind::Format, "{}: not an iblkit.nearfield/1 manifest (\"format\" is missing or different)", path);
+  Dataset ds;
+  ds.name = j.value("name", fs::path(path).stem().string());
+  ds.basis = basis_from_name(j.value("basis", ""), path + ": basis");
+  ds.spacing = number(j, "spacing", path);
+  ds.filter_width = number(j, "filter_width", path);
+  ds.distance = number(j, "distance", path);
+  if (!j.contains("grid") || !j["grid"].is_array() || j["grid"].size() != 2 || !j["grid"][0].is_number_integer() ||
+      !j["grid"][1].is_number_integer())
+    fail(ErrorKind::Format, "{}: 'grid' must be [nx, ny]", path);
+  ds.nx = j["grid"][0].get<int>();
+  ds.ny = j["grid"][1].get<int>();
+  if (ds.nx < 1 || ds.ny < 1 || ds.nx > 256 || ds.ny > 256) fail(ErrorKind::Value, "{}: grid {}x{} out of range (1..256)", path, ds.nx, ds.ny);
+  if (!j.contains("m_extent") || !j["m_extent"].is_object()) fail(ErrorKind::Format, "{}: 'm_extent' {{min, max}} missing", path);
+  ds.m_min = vec2(j["m_extent"].value("min", json()), path + ": m_extent.min");
+  ds.m_max = vec2(j["m_extent"].value("max", json()), path + ": m_extent.max");
+  ds.m_basis = basis_from_name(j.value("m_basis", "bilinear"), path + ": m_basis");
+  ds.filter_gain = j.value("filter_gain", 1.0);
+  if (!j.contains("measurements") || !j["measurements"].is_array()) fail(ErrorKind::Format, "{}: 'measurements' array missing", path);
+  const size_t n = static_cast<size_t>(ds.count());
+  ds.positive.assign(n, Image());
+  ds.negative.assign(n, Image());
+  std::vector<bool> seen(n, false);
+  const fs::path dir = fs::path(path).parent_path();
+  for (const auto& m : j["measurements"]) {
+    if (!m.is_object() || !m.contains("i") || !m.contains("j") || !m["i"].is_number_integer() || !m["j"].is_number_integer())
+      fail(ErrorKind::Format, "{}: a measurement lacks integer 'i' and 'j'", path);
+    const int i = m["i"].get<int>(), jj = m["j"].get<int>();
+    if (i < 0 || i >= ds.nx || jj < 0 || jj >= ds.ny)
+      fail(ErrorKind::Value, "{}: measurement ({}, {}) is outside the {}x{} grid", path, i, jj, ds.nx, ds.ny);
+    const size_t k = static_cast<size_t>(jj * ds.nx + i);
+    if (seen[k]) fail(ErrorKind::Value, "{}: filter position ({}, {}) is listed twice", path, i, jj);
+    seen[k] = true;
+    for (int part = 0; part < 2; ++part) {
+      const char* key = part ? "negative" : "positive";
+      if (!m.contains(key) || !m[key].is_string())
+        fail(ErrorKind::Format, "{}: measurement ({}, {}) has no '{}' image", path, i, jj, key);
+      io::ReadDesc rd;
+      rd.max_channels = 3;
+      Image img = io::read_image((dir / m[key].get<std::string>()).string(), rd);
+      if (img.channels() < 3) img = img.with_channels(3);
+      (part ? ds.negative : ds.positive)[k] = std::move(img);
+    }
+  }
+  for (size_t k = 0; k < n; ++k)
+    if (!seen[k])
+      fail(ErrorKind::Value, "{}: filter position ({}, {}) of the {}x{} grid has no measurement", path, k % ds.nx, k / ds.nx,
+           ds.nx, ds.ny);
+  ds.validate(path);
+  return ds;
+}
+
+void write_dataset(const std::string& path, const Dataset& ds) {
+  ds.validate(path);
+  const fs::path dir = fs::path(path).parent_path();
+  std::error_code ec;
+  fs::create_directories(dir / "images", ec);
+  if (ec) fail(ErrorKind::Io, "{}: cannot create {}: {}", path, (dir / "images").string(), ec.message());
+  json ms = json::array();
+  for (int j = 0; j < ds.ny; ++j)
+    for (int i = 0; i < ds.nx; ++i) {
+      const size_t k = static_cast<size_t>(j * ds.nx + i);
+      std::string pos = fmt::format("images/ij_{}_{}_pos.exr", i, j), neg = fmt::format("images/ij_{}_{}_neg.exr", i, j);
+      io::write_image((dir / pos).string(), ds.positive[k]);
+      io::write_image((dir / neg).string(), ds.negative[k]);
+      ms.push_back({{"i", i}, {"j", j}, {"positive", pos}, {"negative", neg}});
+    }
+  json j = {{"format", "iblkit.nearfield/1"},
+            {"name", ds.name},
+            {"basis", basis_name(ds.basis)},
+            {"spacing", ds.spacing},
+            {"filter_width", ds.filter_width},
+            {"grid", {ds.nx, ds.ny}},
+            {"distance", ds.distance},
+            {"m_extent", {{"min", {ds.m_min.x, ds.m_min.y}}, {"max", {ds.m_max.x, ds.m_max.y}}}},
+            {"m_basis", basis_name(ds.m_basis)},
+            {"filter_gain", ds.filter_gain},
+            {"measurements", ms}};
+  std::ofstream out(path);
+  if (!out) fail(ErrorKind::Io, "{}: cannot write", path);
+  out << j.dump(1) << "\n";
+  if (!out) fail(ErrorKind::Io, "{}: write failed", path);
+}
+
+}  // namespace ibl::nearfield
