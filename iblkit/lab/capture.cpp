@@ -38,6 +38,13 @@ bool ball_ray(const sphere::Mapping& m, double px, double py, Vec3* n, Vec3* d) 
 constexpr int kApertureRings = 16, kApertureSectors = 16;  // 256 equal-area strata of the disc
 constexpr double kShadowShorten = 1e-4;  // relative: as radiance.cpp, stop short of the aperture
 
+// Whether a probe-frame direction carries light under desc.cone.
+bool cone_selects(const CaptureDesc& desc, Vec3 d) {
+  if (desc.cone == CaptureDesc::Cone::All) return true;
+  bool inside = -d.z > std::cos(desc.cone_deg * kPi / 180);
+  return inside == (desc.cone == CaptureDesc::Cone::Inside);
+}
+
 // Lamps whose aperture is small in this capture (see kSmallApertureFactor): bit i = emitters[i].
 uint64_t small_apertures(const Scene& scene, Vec3 position, const CaptureDesc& desc, const sphere::Mapping& m) {
   uint64_t mask = 0;
@@ -80,7 +87,9 @@ void add_aperture(const Scene& scene, const Emitter& e, Vec3 o, const CaptureDes
       Vec3 I = e.intensity_towards(-w);
       if (max_component(I) <= 0 || scene.tracer().occluded(o, w, 0, dist * (1 - kShadowShorten))) continue;
       double px, py;
-      if (!m.to_pixel(to_probe * w, &px, &py)) continue;  // a direction without data (dead angle)
+      Vec3 local = to_probe * w;
+      if (!cone_selects(desc, local)) continue;
+      if (!m.to_pixel(local, &px, &py)) continue;  // a direction without data (dead angle)
       int x = std::clamp(static_cast<int>(px), 0, m.width() - 1), y = std::clamp(static_cast<int>(py), 0, m.height() - 1);
       double sa = m.solid_angle(x, y);
       if (sa <= 0) continue;
@@ -98,6 +107,8 @@ Capture capture_probe(const Scene& scene, Vec3 position, const CaptureDesc& desc
   bool ball = desc.camera == Camera::MirrorBall;
   if (ball && desc.mapping != MappingKind::MirrorBall)
     fail(ErrorKind::Value, "the mirror-ball camera makes mirrorball images, not {}", sphere::mapping_name(desc.mapping));
+  if (desc.cone != CaptureDesc::Cone::All && (ball || !(desc.cone_deg > 0 && desc.cone_deg < 180)))
+    fail(ErrorKind::Value, "a cone selection needs the ideal camera and a half-angle in (0, 180), got {}", desc.cone_deg);
   if (ball && !(desc.ball_radius >= 0)) fail(ErrorKind::Value, "ball radius {} must be ≥ 0", desc.ball_radius);
   if (ball && !(desc.ball_reflectance >= 0 && desc.ball_reflectance <= 1))
     fail(ErrorKind::Value, "ball reflectance {} must lie in [0, 1]", desc.ball_reflectance);
@@ -129,6 +140,7 @@ Capture capture_probe(const Scene& scene, Vec3 position, const CaptureDesc& desc
         } else {
           if (!m.to_direction(px, py, &d)) continue;
           ++used;
+          if (!cone_selects(desc, d)) continue;
           sum += radiance(scene, o, desc.rotation * d, rng, desc.render, hidden);
         }
       }

@@ -24,8 +24,8 @@ struct TruthDesc {
 struct Truth {
   sphere::EnvMap radiance{Image(2, 1, 3), sphere::Mapping(sphere::MappingKind::LatLong, 2, 1)};  // lat-long map
   sh::Coeffs sh;                 // SH projection of `radiance` (sh::project; empty when bands = 0)
-  sh::Coeffs sh_visible;         // the same with the pixels whose centre lies in the blind cone set to 0
-                                 // (what a sequence with that dead angle can see; empty unless asked)
+  sh::Coeffs sh_visible;         // the same without the light from inside the blind cone (per sub-sample:
+                                 // what a sequence with that dead angle can see; empty unless asked)
   std::vector<Vec3> normals;     // the unit normals of `irradiance`
   std::vector<Vec3> irradiance;  // E(n) = ∫ L(ω) max(0, n·ω) dω, W/m²
 };
