@@ -8,12 +8,15 @@
 #include <fmt/format.h>
 
 #include "cli.h"
+#include "render_truth.h"
+#include "iblkit/io/draw.h"
 #include "iblkit/core/error.h"
 #include "iblkit/geometry/mesh_io.h"
 #include "iblkit/ilf/shgrid.h"
 #include "iblkit/io/envmap_io.h"
 #include "iblkit/io/image_io.h"
 #include "iblkit/io/tonemap.h"
+#include "iblkit/lights/light_set.h"
 #include "iblkit/render/cpu_renderer.h"
 #include "iblkit/render/mesh.h"
 #include "iblkit/render/prefilter.h"
@@ -59,18 +62,25 @@ void load_lighting(const std::string& path, int bands, int shadows, const io::En
     }
     std::string format = j.value("format", "");
     if (format == "iblkit.lights/1") {
-      if (!j.contains("lights") || !j["lights"].is_array()) fail(ErrorKind::Format, "{}: no \"lights\" array", path);
-      for (size_t i = 0; i < j["lights"].size(); ++i) {
-        const auto& l = j["lights"][i];
-        if (!l.contains("direction") || !l.contains("irradiance"))
-          fail(ErrorKind::Format, "{}: light {} lacks \"direction\" or \"irradiance\"", path, i);
-        auto dv = l["direction"].get<std::vector<double>>(), ev = l["irradiance"].get<std::vector<double>>();
-        if (dv.size() != 3 || ev.size() != 3) fail(ErrorKind::Format, "{}: light {}: direction and irradiance need 3 numbers", path, i);
-        // Lights come in shadow-map priority order (docs/formats.md): the first `shadows` get maps.
-        L->lights.push_back({normalize(Vec3{dv[0], dv[1], dv[2]}), {ev[0], ev[1], ev[2]},
-                             l.value("shadow", static_cast<int>(i) < shadows)});
+      lights::LightSet set = lights::from_json(j, path);
+      // Lights come in shadow-map priority order (docs/formats.md): the first `shadows` get maps,
+      // unless a light says "shadow" itself. A light with a position (fusion's localised lights)
+      // is a point light of intensity irradiance·|position − origin|².
+      int points = 0;
+      for (size_t i = 0; i < set.lights.size(); ++i) {
+        const lights::Light& l = set.lights[i];
+        bool shadow = static_cast<int>(i) < shadows;
+        if (j["lights"][i].contains("shadow")) shadow = j["lights"][i]["shadow"].get<bool>();
+        if (l.position && set.origin) {
+          Vec3 q = *l.position - *set.origin;
+          L->point_lights.push_back({*l.position, l.irradiance * dot(q, q), shadow});
+          ++points;
+        } else {
+          L->lights.push_back({normalize(l.direction), l.irradiance, shadow});
+        }
       }
-      *kind = fmt::format("{} directional lights", L->lights.size());
+      *kind = points ? fmt::format("{} point lights and {} directional lights", points, set.lights.size() - points)
+                     : fmt::format("{} directional lights", set.lights.size());
       return;
     }
     if (format == "iblkit.sh/1") {
@@ -103,6 +113,9 @@ void setup(CLI::App& app) {
     int frames = 1, bands = 5, triangles = 100000, shadows = 4;
     double gloss = 0, exponent = 20;
     std::string glossy = "map";
+    std::string truth;
+    int truth_samples = 4, truth_bounces = 1;
+    double floor_size = 6;
   };
   auto* o = new Opts();
   app.add_option("scene", o->scene,
@@ -127,6 +140,16 @@ void setup(CLI::App& app) {
                  "probe lighting with --gloss > 0: the glossy lobe from a prefiltered Phong map of the probe (map) "
                  "or from its --bands SH (sh, band-limited)")
       ->check(CLI::IsMember({"map", "sh"}))
+      ->capture_default_str();
+  app.add_option("--floor-size", o->floor_size, "side of the square floor under the object, metres (a table top when small)")
+      ->check(CLI::Range(0.0, 1000.0))
+      ->capture_default_str();
+  app.add_option("--truth", o->truth,
+                 "a lab scene (iblkit.scene/1, e.g. examples/low-scene2.json): also photograph the object and floor in it "
+                 "with its real emitters (lab path tracing) and report the frame's error against that photograph");
+  app.add_option("--truth-samples", o->truth_samples, "--truth: n×n rays per pixel")->check(CLI::Range(1, 64))->capture_default_str();
+  app.add_option("--truth-bounces", o->truth_bounces, "--truth: indirect bounces (the scene's stray light reaches the object through them)")
+      ->check(CLI::Range(0, 16))
       ->capture_default_str();
   app.add_option("--eye", o->eye, "camera position x,y,z")->capture_default_str();
   app.add_option("--target", o->target, "camera target x,y,z")->capture_default_str();
@@ -160,7 +183,9 @@ void setup(CLI::App& app) {
       object.transform(o->object_size / extent, {0, 0, 0});
     }
     object.transform(1.0, at);
-    Mesh floor = make_floor(6, at.y - 0.52 * o->object_size);
+    Vec3 lo, hi;
+    object.bounds(&lo, &hi);
+    Mesh floor = make_floor(o->floor_size, lo.y - 1e-3);  // just under the object's lowest point
     Material mat{{0.75, 0.75, 0.75}, Vec3{1, 1, 1} * o->gloss, o->exponent};
     d.objects = {{&object, mat}, {&floor, Material{{0.5, 0.5, 0.5}, {0, 0, 0}, 1}}};
     std::string kind;
@@ -209,6 +234,34 @@ void setup(CLI::App& app) {
     if (ext == ".png" || ext == ".jpg") io::write_image(o->out, io::tonemap(f.color));
     else io::write_image(o->out, f.color);
     j["output"] = o->out;
+    if (!o->truth.empty()) {
+      auto t0 = std::chrono::steady_clock::now();
+      iblcli::TruthComparison c = iblcli::compare_with_lab(o->truth, d, f, o->truth_samples, o->truth_bounces, iblcli::progress_bar());
+      iblcli::progress_done();
+      fs::path stem = fs::path(o->out).replace_extension();
+      io::ToneMapDesc td;  // one exposure for both pictures: the truth's
+      td.auto_exposure = false;
+      td.exposure_stops = std::log2(io::auto_exposure_scale(c.truth));
+      Image truth_png = io::tonemap(c.truth, td), render_png = io::tonemap(f.color, td);
+      Image error_png = io::false_colour(c.error, 0.5);
+      io::write_image(stem.string() + "_truth.exr", c.truth);
+      io::write_image(stem.string() + "_truth.png", truth_png);
+      io::write_image(stem.string() + "_error.png", error_png);
+      io::write_image(stem.string() + "_compare.png",
+                      io::contact_sheet({{"lab photograph (truth)", truth_png},
+                                         {fmt::format("render ({}): L1 {:.3f}", backend, c.rel_l1_first), render_png},
+                                         {"relative error, 0 (black) .. 0.5 (red)", error_png}},
+                                        3, std::min(480, w), std::min(480, w) * h / w));
+      j["truth"] = {{"scene", o->truth},
+                    {"rel_l1_object", c.rel_l1_first},
+                    {"rel_l1_object_and_floor", c.rel_l1},
+                    {"median_rel_object", c.median_rel},
+                    {"mean_luminance_render", c.mean_render},
+                    {"mean_luminance_truth", c.mean_truth},
+                    {"object_pixels", c.first_pixels},
+                    {"ms", std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count()},
+                    {"pictures", stem.string() + "_compare.png"}};
+    }
     iblcli::emit(j, [&] {
       fmt::print("rendered {} ({}, {} backend) lit by {}\n", o->out, o->size, backend, kind);
       if (j.contains("gpu_ms_median"))
@@ -218,6 +271,12 @@ void setup(CLI::App& app) {
         fmt::print("{:.1f} ms/frame wall clock over {} frames on {} (a software renderer: its GPU timer queries mean nothing)\n",
                    j["wall_ms_per_frame"].get<double>(), o->frames, j["gl_renderer"].get<std::string>());
       if (j.contains("cpu_ms")) fmt::print("CPU time {:.0f} ms\n", j["cpu_ms"].get<double>());
+      if (j.contains("truth"))
+        fmt::print("against the lab photograph in {}: object relative L1 {:.3f} (median pixel {:.3f}; mean luminance {:.4g} vs {:.4g}), "
+                   "object and floor {:.3f}; pictures {}\n",
+                   o->truth, j["truth"]["rel_l1_object"].get<double>(), j["truth"]["median_rel_object"].get<double>(),
+                   j["truth"]["mean_luminance_render"].get<double>(), j["truth"]["mean_luminance_truth"].get<double>(),
+                   j["truth"]["rel_l1_object_and_floor"].get<double>(), j["truth"]["pictures"].get<std::string>());
     });
   });
 }

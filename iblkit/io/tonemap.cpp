@@ -52,4 +52,25 @@ Image tonemap(const Image& img, const ToneMapDesc& desc) {
   return out;
 }
 
+Image false_colour(const Image& values, double vmax) {
+  // Piecewise-linear ramp through five stops, in sRGB-looking steps (converted to linear below).
+  static const Vec3 kStops[] = {{0, 0, 0}, {0.1, 0.2, 0.9}, {0.1, 0.8, 0.3}, {1.0, 0.9, 0.1}, {0.9, 0.1, 0.1}};
+  Image out(values.width(), values.height(), 3);
+  for (int y = 0; y < values.height(); ++y)
+    for (int x = 0; x < values.width(); ++x) {
+      double v = values.at(x, y, 0);
+      Vec3 c{0.5, 0.5, 0.5};
+      if (std::isfinite(v) && v >= 0) {
+        double t = std::clamp(vmax > 0 ? v / vmax : 0.0, 0.0, 1.0) * 4;
+        int i = std::min(3, static_cast<int>(t));
+        double f = t - i;
+        c = kStops[i] * (1 - f) + kStops[i + 1] * f;
+      }
+      // sRGB-looking stops to linear light (PNG writing encodes again).
+      for (int k = 0; k < 3; ++k) c[k] = std::pow(c[k], 2.2);
+      out.set_rgb(x, y, c);
+    }
+  return out;
+}
+
 }  // namespace ibl::io

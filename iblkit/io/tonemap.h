@@ -19,4 +19,8 @@ double auto_exposure_scale(const Image& img, double key = 0.18);
 // Returns a linear-light RGB image in [0,1] (write it as .png to get sRGB encoding).
 Image tonemap(const Image& img, const ToneMapDesc& desc = {});
 
+// False colour for a one-channel image of values in [0, vmax] (errors, differences): black → blue →
+// green → yellow → red, clamped above vmax; negative or NaN values show as grey. Linear-light RGB.
+Image false_colour(const Image& values, double vmax);
+
 }  // namespace ibl::io

@@ -237,7 +237,7 @@ std::string resolve_scene_path(const std::string& name) {
   fail(ErrorKind::Io, "{}: no such scene file (built-in scenes: low-scene1, low-scene2, t-corridor, crypt)", name);
 }
 
-Scene load_scene(const std::string& name_or_path) {
+Scene load_scene(const std::string& name_or_path, bool build) {
   std::string path = resolve_scene_path(name_or_path);
   std::ifstream in(path);
   if (!in) fail(ErrorKind::Io, "{}: cannot open", path);
@@ -288,7 +288,7 @@ Scene load_scene(const std::string& name_or_path) {
     if (std::string(e.what()).find(path) != std::string::npos) throw;
     fail(e.kind(), "{}: {}: {}", path, c.where, e.what());
   }
-  s.build();
+  if (build) s.build();
   return s;
 }
 

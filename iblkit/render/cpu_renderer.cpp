@@ -162,6 +162,7 @@ RenderResult render_cpu(const FrameDesc& d, const ProgressFn& progress) {
   bool need_shadows = false;
   for (const auto& l : d.lighting.lights) need_shadows |= l.shadow;
   for (const auto& l : d.lighting.point_lights) need_shadows |= l.shadow;
+  for (const auto& l : d.lighting.spotlights) need_shadows |= l.shadow;
   std::unique_ptr<ShadowScene> shadows;
   if (need_shadows) shadows = std::make_unique<ShadowScene>(d);
   RenderResult f{Image(W, H, 3), Image(W, H, 1)};

@@ -18,6 +18,7 @@ struct FrameDesc {
   Lighting lighting;
   Vec3 background{0, 0, 0};  // radiance where no surface is hit
   int shadow_map_size = 2048;  // GPU only: shadow map resolution
+  int spot_shadow_map_size = 1024;  // GPU only: shadow map resolution of each textured spotlight
   double shadow_bias = 2e-3;   // offset along the normal before shadow tests, metres
 };
 

@@ -4,7 +4,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 
+#include "iblkit/io/image_io.h"
+#include "iblkit/io/tonemap.h"
 #include "iblkit/render/cpu_renderer.h"
 #include "iblkit/render/mesh.h"
 #include "iblkit/sh/basis.h"
@@ -293,6 +296,60 @@ TEST_F(RenderGl, PointLightsWithShadowsAgreeWithCpu) {
   d.lighting.point_lights[0].position = {0, 0.1, 0};  // inside the bounding sphere of blob + floor
   gl::Renderer r;
   EXPECT_EQ(r.render(d).unshadowed_lights, 1);
+}
+
+// Textured spotlights (a 3×3 grid of them, as a measured luminaire's terms) with shadow maps
+// against the CPU reference with shadow rays: same texels, same mip selection, same formulas.
+TEST_F(RenderGl, TexturedSpotlightsWithShadowsAgreeWithCpu) {
+  gl::Context ctx;
+  Mesh blob = make_blob(6000, 0.5), floor = make_floor(3, -0.25);
+  FrameDesc d;
+  d.camera.eye = {0.3, 0.9, 1.4};
+  d.camera.target = {0, 0, 0};
+  d.camera.width = 128;
+  d.camera.height = 96;
+  d.spot_shadow_map_size = 512;
+  d.objects = {{&blob, Material{{0.7, 0.6, 0.5}, {0.1, 0.1, 0.1}, 20}}, {&floor, Material{}}};
+  Image tex(32, 24, 3);
+  for (int y = 0; y < 24; ++y)
+    for (int x = 0; x < 32; ++x)
+      tex.set_rgb(x, y, Vec3{1.0 + 0.5 * std::sin(0.4 * x), 0.8 + 0.4 * std::cos(0.3 * y), ((x / 4 + y / 4) % 2) ? 1.5 : 0.3} * 100.0);
+  auto mips = std::make_shared<const std::vector<Image>>(nearfield::build_mips(tex));
+  for (int j = 0; j < 3; ++j)
+    for (int i = 0; i < 3; ++i) {
+      nearfield::TexturedSpotlight sp;
+      sp.position = {0.3 + 0.05 * (i - 1), 1.4, 0.2 + 0.05 * (j - 1)};
+      Vec3 fwd = normalize(Vec3{-0.2, -1, -0.1});
+      sp.frame = Frame::from_normal(fwd);
+      sp.plane_distance = 0.5;
+      sp.tex_min = {-0.4, -0.3};
+      sp.tex_max = {0.4, 0.3};
+      sp.mips = mips;
+      sp.support_area = 0.05 * 0.05;
+      sp.support_width = 0.1;  // footprints of a few texels: the lookups blend mip levels
+      sp.shadow = true;
+      d.lighting.spotlights.push_back(sp);
+    }
+  RenderResult cpu = render_cpu(d);
+  double peak = 0;
+  for (int y = 0; y < 96; ++y)
+    for (int x = 0; x < 128; ++x) peak = std::max(peak, luminance(cpu.color.rgb(x, y)));
+  EXPECT_GT(peak, 0.01);  // the spotlights light the scene
+  for (bool deferred : {false, true}) {
+    gl::Renderer r({deferred});
+    RenderResult g = r.render(d);
+    if (const char* dir = std::getenv("IBLKIT_TEST_PICTURES")) {  // for a person to look at
+      io::write_image(std::string(dir) + "/spotlights_cpu.png", io::tonemap(cpu.color));
+      io::write_image(std::string(dir) + "/spotlights_gl.png", io::tonemap(g.color));
+    }
+    Agreement a = compare(cpu, g);
+    constexpr double kSpotMedianTol = 2e-3;  // float math and GL's 8-bit filter weights (bilinear and between mips)
+    constexpr double kSpotP99Tol = 0.5;      // shadow-map edges against exact shadow rays
+    EXPECT_GT(a.pixels, 4000) << "deferred " << deferred;
+    EXPECT_LT(a.coverage_mismatch, kCoverageTol) << "deferred " << deferred;
+    EXPECT_LT(a.median, kSpotMedianTol) << "deferred " << deferred;
+    EXPECT_LT(a.p99, kSpotP99Tol) << "deferred " << deferred;
+  }
 }
 
 // A probe's glossy reflection through a prefiltered Phong map (render/prefilter.h): both renderers

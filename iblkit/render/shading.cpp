@@ -65,6 +65,7 @@ Vec3 shade(const Lighting& lighting, const Material& m, Vec3 p, Vec3 n, Vec3 v, 
   auto add_light = [&](Vec3 l, Vec3 irradiance, bool shadow, double distance) {
     double ndl = dot(n, l);
     if (ndl <= 0) return;
+    if (irradiance.x == 0 && irradiance.y == 0 && irradiance.z == 0) return;  // no shadow ray for no light
     if (shadow && visible && !visible(p, l, distance)) return;
     E += irradiance * ndl;
     double rdl = dot(r, l);
@@ -77,6 +78,15 @@ Vec3 shade(const Lighting& lighting, const Material& m, Vec3 p, Vec3 n, Vec3 v, 
     if (!(d2 > 0)) continue;
     double d = std::sqrt(d2);
     add_light(to / d, L.intensity / d2, L.shadow, d);
+  }
+  for (const nearfield::TexturedSpotlight& L : lighting.spotlights) {
+    Vec3 to = L.position - p;
+    double d = length(to);
+    if (!(d > 0)) continue;
+    Vec3 l = to / d;
+    double ndl = dot(n, l);
+    if (ndl <= 0) continue;
+    add_light(l, nearfield::irradiance(L, p, n) / ndl, L.shadow, d);
   }
   Vec3 out = m.albedo * E * (1.0 / kPi) + m.specular * G;
   // SH ringing can make a few values negative; light is never negative.

@@ -10,7 +10,9 @@
 //                                          zonal harmonics rotated to r (Löw et al. 2009 §4)
 // and for each directional light (direction l towards the light, irradiance E_i, visibility V_i)
 //   E(n) += V_i E_i max(0, n·l),   G(r) += V_i E_i (s+1)/2π max(0, r·l)^s   (only where n·l > 0),
-// point lights the same with l = (q − p)/|q − p| and E_i = I_i/|q − p|².
+// point lights the same with l = (q − p)/|q − p| and E_i = I_i/|q − p|², and textured spotlights with
+// l towards the spotlight and E_i·max(0, n·l) = nearfield::irradiance(spot, p, n) (which may be
+// negative for one term: the dual filter's lobes; the sum of all terms is not).
 // A distant probe may instead give G(r) through a prefiltered map (render/prefilter.h): G(r) = G_s(r).
 #pragma once
 #include <functional>
@@ -18,6 +20,7 @@
 #include <vector>
 
 #include "iblkit/core/vec.h"
+#include "iblkit/nearfield/spotlight.h"
 #include "iblkit/render/prefilter.h"
 #include "iblkit/sh/coeffs.h"
 
@@ -59,6 +62,10 @@ struct Lighting {
   std::optional<SHGridData> grid;         // local light field (takes precedence over environment)
   std::vector<DirectionalLight> lights;   // directional lights
   std::vector<PointLight> point_lights;   // point lights (e.g. fusion's localised lights)
+  // Textured spotlights: the terms of a measured luminaire's near field (Granier et al. 2003,
+  // Eq. 14; nearfield/spotlight.h defines each term's irradiance E_i(p, n), visibility towards its
+  // filter centre).
+  std::vector<nearfield::TexturedSpotlight> spotlights;
   // Glossy term of a distant probe without the SH band limit (render/prefilter.h): a material whose
   // exponent equals a map's takes G(r) from the map instead of from the SH environment.
   std::vector<GlossyMap> glossy_maps;

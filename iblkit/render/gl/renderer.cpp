@@ -152,6 +152,95 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing)
   glNamedBufferStorage(point_ssbo, static_cast<GLsizeiptr>(std::max<size_t>(1, point_data.size()) * sizeof(float)),
                        point_data.empty() ? nullptr : point_data.data(), 0);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, point_ssbo);
+  // Textured spotlights: their textures in one mip-mapped 2D array (one layer each, all of one
+  // size), their parameters in an SSBO, and a perspective shadow map each (its own array) covering
+  // the frustum through its texture's extent on M.
+  std::vector<float> spot_data;
+  std::vector<Mat4f> spot_mats;
+  GLuint spot_tex = 0;
+  int spot_levels = 0;
+  if (!L.spotlights.empty()) {
+    const auto& first = L.spotlights[0];
+    if (!first.mips || first.mips->empty()) fail(ErrorKind::Value, "textured spotlight 0 has no texture");
+    const int tw = (*first.mips)[0].width(), th = (*first.mips)[0].height();
+    spot_levels = static_cast<int>(first.mips->size());
+    glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, &spot_tex);
+    glTextureStorage3D(spot_tex, spot_levels, GL_RGBA32F, tw, th, static_cast<GLsizei>(L.spotlights.size()));
+    std::vector<float> rgba;
+    for (size_t i = 0; i < L.spotlights.size(); ++i) {
+      const auto& sp = L.spotlights[i];
+      if (!sp.mips || sp.mips->size() != static_cast<size_t>(spot_levels) || (*sp.mips)[0].width() != tw ||
+          (*sp.mips)[0].height() != th)
+        fail(ErrorKind::Unsupported, "the GL renderer takes textured spotlights of one texture size per frame (spotlight {} differs from spotlight 0)", i);
+      for (int lv = 0; lv < spot_levels; ++lv) {
+        const Image& im = (*sp.mips)[lv];
+        if (im.channels() != 3) fail(ErrorKind::Value, "spotlight {} mip {} is not RGB", i, lv);
+        rgba.assign(im.pixel_count() * 4, 0.0f);
+        for (size_t k = 0; k < im.pixel_count(); ++k)
+          for (int c = 0; c < 3; ++c) rgba[k * 4 + c] = im.data()[k * 3 + c];
+        glTextureSubImage3D(spot_tex, lv, 0, 0, static_cast<GLint>(i), im.width(), im.height(), 1, GL_RGBA, GL_FLOAT, rgba.data());
+      }
+      float layer = -1;
+      if (sp.shadow) {
+        // Perspective frustum along forward through the texture's extent (a texel of margin).
+        const double d = sp.plane_distance, margin = std::max((sp.tex_max.x - sp.tex_min.x) / tw, (sp.tex_max.y - sp.tex_min.y) / th);
+        const double tx = (std::max(std::abs(sp.tex_min.x), std::abs(sp.tex_max.x)) + margin) / d;
+        const double ty = (std::max(std::abs(sp.tex_min.y), std::abs(sp.tex_max.y)) + margin) / d;
+        Camera c;
+        c.eye = sp.position;
+        c.target = sp.position + sp.frame.n;
+        c.up = sp.frame.b;
+        c.fov_y_deg = 2 * std::atan(ty) * 180 / kPi;
+        c.width = 1000;
+        c.height = std::max(1, static_cast<int>(std::lround(1000 * ty / tx)));
+        const double far_d = length(centre - sp.position) + radius;
+        c.zfar = far_d * 1.01;
+        c.znear = std::max(far_d * 1e-3, (length(centre - sp.position) - radius) * 0.95);
+        layer = static_cast<float>(spot_mats.size());
+        Mat4f proj = c.projection();
+        proj[0] = static_cast<float>(1.0 / tx);  // exact horizontal extent (the aspect above is rounded)
+        spot_mats.push_back(mul(proj, c.view()));
+      }
+      const double texel = std::max((sp.tex_max.x - sp.tex_min.x) / tw, (sp.tex_max.y - sp.tex_min.y) / th);
+      const float row[24] = {static_cast<float>(sp.position.x), static_cast<float>(sp.position.y), static_cast<float>(sp.position.z), layer,
+                             static_cast<float>(sp.frame.t.x), static_cast<float>(sp.frame.t.y), static_cast<float>(sp.frame.t.z), static_cast<float>(sp.tex_min.x),
+                             static_cast<float>(sp.frame.b.x), static_cast<float>(sp.frame.b.y), static_cast<float>(sp.frame.b.z), static_cast<float>(sp.tex_min.y),
+                             static_cast<float>(sp.frame.n.x), static_cast<float>(sp.frame.n.y), static_cast<float>(sp.frame.n.z), static_cast<float>(sp.plane_distance),
+                             static_cast<float>(sp.tex_max.x), static_cast<float>(sp.tex_max.y), static_cast<float>(sp.support_area), static_cast<float>(sp.support_width),
+                             static_cast<float>(texel), static_cast<float>(spot_levels), static_cast<float>(i), 0.0f};
+      spot_data.insert(spot_data.end(), row, row + 24);
+    }
+    glTextureParameteri(spot_tex, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+    glTextureParameteri(spot_tex, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTextureParameteri(spot_tex, GL_TEXTURE_BASE_LEVEL, 0);
+    glTextureParameteri(spot_tex, GL_TEXTURE_MAX_LEVEL, spot_levels - 1);
+    glTextureParameteri(spot_tex, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_BORDER);
+    glTextureParameteri(spot_tex, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_BORDER);
+    const float zero_border[4] = {0, 0, 0, 0};
+    glTextureParameterfv(spot_tex, GL_TEXTURE_BORDER_COLOR, zero_border);
+  }
+  GLuint spot_ssbo[2];
+  glCreateBuffers(2, spot_ssbo);
+  glNamedBufferStorage(spot_ssbo[0], static_cast<GLsizeiptr>(std::max<size_t>(1, spot_data.size()) * sizeof(float)),
+                       spot_data.empty() ? nullptr : spot_data.data(), 0);
+  glNamedBufferStorage(spot_ssbo[1], static_cast<GLsizeiptr>(std::max<size_t>(1, spot_mats.size()) * sizeof(Mat4f)),
+                       spot_mats.empty() ? nullptr : spot_mats.data(), 0);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 8, spot_ssbo[0]);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 9, spot_ssbo[1]);
+  const int SS = d.spot_shadow_map_size;
+  GLuint spot_shadow_tex = 0;
+  if (!spot_mats.empty()) {
+    if (SS < 16 || SS > 8192) fail(ErrorKind::Value, "spotlight shadow map size {} is out of range 16..8192", SS);
+    glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, &spot_shadow_tex);
+    glTextureStorage3D(spot_shadow_tex, 1, GL_DEPTH_COMPONENT32F, SS, SS, static_cast<GLsizei>(spot_mats.size()));
+    glTextureParameteri(spot_shadow_tex, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTextureParameteri(spot_shadow_tex, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTextureParameteri(spot_shadow_tex, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTextureParameteri(spot_shadow_tex, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glTextureParameteri(spot_shadow_tex, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+    glTextureParameteri(spot_shadow_tex, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+  }
+
   GLuint ssbo[2];
   glCreateBuffers(2, ssbo);
   glNamedBufferStorage(ssbo[0], static_cast<GLsizeiptr>(std::max<size_t>(1, light_data.size()) * sizeof(float)),
@@ -308,6 +397,9 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing)
   }
   glProgramUniform1i(prog, glGetUniformLocation(prog, "u_light_count"), static_cast<GLint>(L.lights.size()));
   glProgramUniform1i(prog, glGetUniformLocation(prog, "u_point_light_count"), static_cast<GLint>(L.point_lights.size()));
+  glProgramUniform1i(prog, glGetUniformLocation(prog, "u_spot_count"), static_cast<GLint>(L.spotlights.size()));
+  glProgramUniform1i(prog, glGetUniformLocation(prog, "u_spot_textures"), 4);
+  glProgramUniform1i(prog, glGetUniformLocation(prog, "u_spot_shadows"), 5);
   glProgramUniform1f(prog, glGetUniformLocation(prog, "u_shadow_bias"), static_cast<float>(d.shadow_bias));
   glProgramUniform1i(prog, glGetUniformLocation(prog, "u_shadow_maps"), 0);
   int mode = L.grid ? 2 : (L.environment ? 1 : 0);
@@ -365,6 +457,24 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing)
       }
       glDisable(GL_POLYGON_OFFSET_FILL);
     }
+    if (!spot_mats.empty()) {
+      glUseProgram(impl_->shadow_program);
+      glBindFramebuffer(GL_FRAMEBUFFER, shadow_fbo);
+      glViewport(0, 0, SS, SS);
+      glEnable(GL_DEPTH_TEST);
+      glEnable(GL_POLYGON_OFFSET_FILL);
+      glPolygonOffset(1.5f, 2.0f);
+      for (size_t i = 0; i < spot_mats.size(); ++i) {
+        glNamedFramebufferTextureLayer(shadow_fbo, GL_DEPTH_ATTACHMENT, spot_shadow_tex, 0, static_cast<GLint>(i));
+        glClear(GL_DEPTH_BUFFER_BIT);
+        glUniformMatrix4fv(loc_light_vp, 1, GL_FALSE, spot_mats[i].data());
+        for (auto& m : meshes) {
+          glBindVertexArray(m.vao);
+          glDrawElements(GL_TRIANGLES, m.count, GL_UNSIGNED_INT, nullptr);
+        }
+      }
+      glDisable(GL_POLYGON_OFFSET_FILL);
+    }
     // Shading pass (forward), or G-buffer pass then compute shading (deferred).
     glBindFramebuffer(GL_FRAMEBUFFER, fbo);
     glViewport(0, 0, W, H);
@@ -383,6 +493,8 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing)
     glBindTextureUnit(0, shadow_tex);
     if (grid_tex) glBindTextureUnit(1, grid_tex);
     if (glossy_tex) glBindTextureUnit(3, glossy_tex);
+    if (spot_tex) glBindTextureUnit(4, spot_tex);
+    if (spot_shadow_tex) glBindTextureUnit(5, spot_shadow_tex);
     for (size_t i = 0; i < meshes.size(); ++i) {
       if (deferred) {
         glUniform1ui(loc_material, static_cast<GLuint>(i));
@@ -441,6 +553,9 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing)
   glDeleteTextures(1, &shadow_tex);
   if (grid_tex) glDeleteTextures(1, &grid_tex);
   if (glossy_tex) glDeleteTextures(1, &glossy_tex);
+  if (spot_tex) glDeleteTextures(1, &spot_tex);
+  if (spot_shadow_tex) glDeleteTextures(1, &spot_shadow_tex);
+  glDeleteBuffers(2, spot_ssbo);
   glDeleteBuffers(2, ssbo);
   glDeleteBuffers(1, &point_ssbo);
   for (auto& m : meshes) release(m);

@@ -3,7 +3,8 @@
 //   L_o = (albedo/π)·E(n) + specular·G(r)
 //   E(n) = Σ Â_l c_lm Y_lm(n),  G(r) = Σ ρ̂_l(s) c_lm Y_lm(r)   (SH environment or SH grid at p)
 //   + per directional light: V·E_i·max(0, n·l) and V·E_i·(s+1)/2π·max(0, r·l)^s where n·l > 0,
-//     and the same per point light with l towards it and E_i = I_i/d².
+//     and the same per point light with l towards it and E_i = I_i/d², and per textured spotlight
+//     with E_i·(n·l) = spot_irradiance() (nearfield/spotlight.h).
 //   or G(r) from a prefiltered map of a distant probe (render/prefilter.h).
 // Needs SH_BANDS, SH_K, sh_eval() and GLOSSY defined before it.
 uniform vec3 u_eye;
@@ -31,6 +32,20 @@ struct PointLightGpu {
 };
 layout(std430, binding = 7) readonly buffer PointLights { PointLightGpu point_lights[]; };
 uniform int u_point_light_count;
+// Textured spotlights (nearfield/spotlight.h, formula for formula).
+struct SpotGpu {
+  vec4 position;  // xyz: filter centre; w: shadow layer in u_spot_shadows or −1
+  vec4 right;     // xyz: s axis; w: tex_min.x
+  vec4 up;        // xyz: t axis; w: tex_min.y
+  vec4 forward;   // xyz: normal of S towards M; w: plane distance d
+  vec4 extent;    // tex_max.x, tex_max.y, support area A, support width
+  vec4 tex;       // x: level-0 texel size (m), y: mip levels, z: layer in u_spot_textures
+};
+layout(std430, binding = 8) readonly buffer Spots { SpotGpu spots[]; };
+layout(std430, binding = 9) readonly buffer SpotShadowMatrices { mat4 spot_shadow_matrices[]; };
+uniform int u_spot_count;
+uniform sampler2DArray u_spot_textures;
+uniform sampler2DArrayShadow u_spot_shadows;
 uniform sampler2DArrayShadow u_shadow_maps;
 uniform float u_shadow_bias;
 
@@ -49,6 +64,32 @@ float visibility(vec3 p, vec3 n, int layer) {
   vec3 t = q.xyz / q.w * 0.5 + 0.5;
   if (any(lessThan(t.xy, vec2(0.0))) || any(greaterThan(t.xy, vec2(1.0)))) return 1.0;
   return texture(u_shadow_maps, vec4(t.xy, float(layer), t.z));
+}
+
+float spot_visibility(vec3 p, vec3 n, int layer) {
+  vec4 q = spot_shadow_matrices[layer] * vec4(p + n * u_shadow_bias, 1.0);
+  if (q.w <= 0.0) return 1.0;
+  vec3 t = q.xyz / q.w * 0.5 + 0.5;
+  if (any(lessThan(t, vec3(0.0))) || any(greaterThan(t, vec3(1.0)))) return 1.0;
+  return texture(u_spot_shadows, vec4(t.xy, float(layer), t.z));
+}
+
+// A·cos θ·cos θ'/δ²·Ē'(p) of nearfield/spotlight.h (0 behind S or facing away).
+vec3 spot_irradiance(SpotGpu L, vec3 p, vec3 n) {
+  vec3 q = p - L.position.xyz;
+  float z = dot(q, L.forward.xyz);
+  if (z <= 0.0) return vec3(0.0);
+  float d2 = dot(q, q), dl = sqrt(d2);
+  float cos_l = z / dl, cos_r = -dot(n, q) / dl;
+  if (cos_r <= 0.0) return vec3(0.0);
+  float d = L.forward.w;
+  float s = dot(q, L.right.xyz) * d / z, t = dot(q, L.up.xyz) * d / z;
+  vec2 tmin = vec2(L.right.w, L.up.w), tmax = L.extent.xy;
+  vec2 uv = vec2((s - tmin.x) / (tmax.x - tmin.x), (tmax.y - t) / (tmax.y - tmin.y));
+  float footprint = L.extent.w * abs(1.0 - d / z);
+  float lambda = footprint > 0.0 ? clamp(log2(footprint / L.tex.x), 0.0, L.tex.y - 1.0) : 0.0;
+  vec3 e = textureLod(u_spot_textures, vec3(uv, L.tex.z), lambda).rgb;
+  return e * (L.extent.z * cos_l * cos_r / d2);
 }
 
 vec3 shade(vec3 p, vec3 n_in, vec3 albedo, vec3 specular, float exponent) {
@@ -84,10 +125,22 @@ vec3 shade(vec3 p, vec3 n_in, vec3 albedo, vec3 specular, float exponent) {
       }
   }
   float lobe_norm = (exponent + 1.0) / (2.0 * PI);
-  for (int i = 0; i < u_light_count + u_point_light_count; ++i) {
+  for (int i = 0; i < u_light_count + u_point_light_count + u_spot_count; ++i) {
     vec3 l, irr;
     float layer;
-    if (i < u_light_count) {
+    bool spot = i >= u_light_count + u_point_light_count;
+    if (spot) {
+      SpotGpu q = spots[i - u_light_count - u_point_light_count];
+      vec3 to = q.position.xyz - p;
+      float dl = length(to);
+      if (!(dl > 0.0)) continue;
+      l = to / dl;
+      float ndl = dot(n, l);
+      if (ndl <= 0.0) continue;
+      irr = spot_irradiance(q, p, n) / ndl;
+      if (irr == vec3(0.0)) continue;
+      layer = q.position.w;
+    } else if (i < u_light_count) {
       l = lights[i].direction.xyz;
       irr = lights[i].irradiance.rgb;
       layer = lights[i].direction.w;
@@ -102,7 +155,7 @@ vec3 shade(vec3 p, vec3 n_in, vec3 albedo, vec3 specular, float exponent) {
     }
     float ndl = dot(n, l);
     if (ndl <= 0.0) continue;
-    if (layer >= 0.0) irr *= visibility(p, n, int(layer));
+    if (layer >= 0.0) irr *= spot ? spot_visibility(p, n, int(layer)) : visibility(p, n, int(layer));
     E += irr * ndl;
     float rdl = dot(r, l);
     if (rdl > 0.0) G += irr * (lobe_norm * pow(rdl, exponent));

@@ -1,0 +1,78 @@
+#include "render_truth.h"
+#ifdef IBLKIT_HAVE_GEOMETRY
+#include <algorithm>
+#include <cmath>
+
+#include "iblkit/core/error.h"
+#include "iblkit/lab/scene_io.h"
+#include "iblkit/lab/view.h"
+
+namespace iblcli {
+
+using namespace ibl;
+
+namespace {
+
+geometry::TriMesh to_trimesh(const render::Mesh& m) {
+  geometry::TriMesh t;
+  for (size_t i = 0; i < m.vertex_count(); ++i) t.positions.push_back(m.position(i));
+  for (size_t i = 0; i < m.triangle_count(); ++i) t.triangles.push_back({m.indices[3 * i], m.indices[3 * i + 1], m.indices[3 * i + 2]});
+  return t;
+}
+
+}  // namespace
+
+TruthComparison compare_with_lab(const std::string& scene_path, const render::FrameDesc& d, const render::RenderResult& rendered,
+                                 int samples, int bounces, const ProgressFn& progress) {
+  lab::Scene scene = lab::load_scene(scene_path, false);
+  std::vector<int> ids;
+  for (size_t i = 0; i < d.objects.size(); ++i)
+    ids.push_back(lab::add_object(scene, "object " + std::to_string(i), to_trimesh(*d.objects[i].mesh), d.objects[i].material.albedo));
+  scene.build();
+  lab::ViewDesc vd;
+  vd.width = d.camera.width;
+  vd.height = d.camera.height;
+  vd.samples = samples;
+  vd.render = scene.render;
+  vd.render.bounces = bounces;
+  const render::Camera cam = d.camera;
+  lab::View v = lab::photograph(
+      scene, [&](double px, double py, Vec3* o, Vec3* dir) { *o = cam.eye; *dir = cam.ray_direction(px, py); }, vd, progress);
+  TruthComparison c;
+  c.truth = v.radiance;
+  c.error = Image(vd.width, vd.height, 1, -1.0f);
+  double sum_abs = 0, sum_ref = 0, first_abs = 0, first_ref = 0, first_render = 0;
+  std::vector<double> rel;
+  for (int y = 0; y < vd.height; ++y)
+    for (int x = 0; x < vd.width; ++x) {
+      int s = static_cast<int>(v.surface.at(x, y, 0));
+      auto it = std::find(ids.begin(), ids.end(), s);
+      if (it == ids.end() || rendered.coverage.at(x, y, 0) <= 0) continue;
+      double a = luminance(rendered.color.rgb(x, y)), b = luminance(c.truth.rgb(x, y));
+      sum_abs += std::abs(a - b);
+      sum_ref += b;
+      ++c.pixels;
+      double e = std::abs(a - b) / std::max(b, 1e-6);
+      c.error.at(x, y, 0) = static_cast<float>(e);
+      if (it == ids.begin()) {
+        first_abs += std::abs(a - b);
+        first_ref += b;
+        first_render += a;
+        rel.push_back(e);
+        ++c.first_pixels;
+      }
+    }
+  if (c.pixels == 0) fail(ErrorKind::Value, "no pixel of the frame sees the objects in {}: check --at, --eye and --target", scene_path);
+  c.rel_l1 = sum_ref > 0 ? sum_abs / sum_ref : 0;
+  c.rel_l1_first = first_ref > 0 ? first_abs / first_ref : 0;
+  if (!rel.empty()) {
+    std::nth_element(rel.begin(), rel.begin() + rel.size() / 2, rel.end());
+    c.median_rel = rel[rel.size() / 2];
+    c.mean_render = first_render / c.first_pixels;
+    c.mean_truth = first_ref / c.first_pixels;
+  }
+  return c;
+}
+
+}  // namespace iblcli
+#endif
