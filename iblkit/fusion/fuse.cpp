@@ -1,0 +1,334 @@
+#include "iblkit/fusion/fuse.h"
+
+#include <atomic>
+#include <cmath>
+
+#include "iblkit/core/error.h"
+#include "iblkit/core/fastmath.h"
+#include "iblkit/core/parallel.h"
+
+namespace ibl::fusion {
+
+std::string blend_name(Blend b) {
+  switch (b) {
+    case Blend::Nearest: return "nearest";
+    case Blend::Angle: return "angle";
+    case Blend::Footprint: return "footprint";
+  }
+  return "?";
+}
+
+Blend parse_blend(const std::string& s) {
+  if (s == "nearest") return Blend::Nearest;
+  if (s == "angle") return Blend::Angle;
+  if (s == "footprint") return Blend::Footprint;
+  fail(ErrorKind::Value, "unknown blend \"{}\" (expected nearest, angle or footprint)", s);
+}
+
+sphere::Mapping output_mapping(sphere::MappingKind k, int size) {
+  if (size < 1 || size > 8192) fail(ErrorKind::Value, "output size {} is out of range [1, 8192]", size);
+  switch (k) {
+    case sphere::MappingKind::LatLong: return {k, 2 * size, size};
+    case sphere::MappingKind::CubeHCross: return {k, 4 * size, 3 * size};
+    case sphere::MappingKind::CubeVCross: return {k, 3 * size, 4 * size};
+    case sphere::MappingKind::CubeStrip: return {k, 6 * size, size};
+    default: return {k, size, size};
+  }
+}
+
+namespace {
+
+constexpr double kFallbackSoftening2 = 0.01;  // h² in 1/(|x − x_i|² + h²): h = 0.1 m keeps weights finite at a probe
+constexpr double kMaxTan = 20;                 // tan α cap of the slope bias (α ≈ 87°)
+constexpr double kMinCos = 0.05;               // cos α floor of the footprint weight (grazing views still count a little)
+
+// Per-probe data in the form the inner loop wants.
+struct Lut {
+  Vec3 pos;
+  Mat3 to_local;  // world -> probe frame (Rᵀ)
+  bool latlong = false;
+  int w = 0, h = 0;
+  const float* rgb = nullptr;    // 3 channels
+  const float* depth = nullptr;  // 1 channel
+  const Probe* probe = nullptr;
+  double delta = 0;      // texel angle √(4π/N)
+  double inv_omega = 0;  // 1/(4π/N)
+
+  // Continuous lat-long pixel coordinates of a local direction.
+  void ll_pixel(Vec3 d, float* px, float* py) const {
+    constexpr float kInvTwoPi = 0.159154943091895f, kInvPi = 0.318309886183791f;
+    float u = fast_atan2(static_cast<float>(d.z), static_cast<float>(d.x)) * kInvTwoPi + 0.5f;
+    float r = std::sqrt(static_cast<float>(d.x * d.x + d.z * d.z));
+    float v = fast_atan2(r, static_cast<float>(d.y)) * kInvPi;
+    *px = u * w;
+    *py = v * h;
+  }
+  // Depth at the texel nearest the local direction d (0: none).
+  float depth_at(Vec3 d) const {
+    if (latlong) {
+      float px, py;
+      ll_pixel(d, &px, &py);
+      int ix = std::clamp(static_cast<int>(px), 0, w - 1), iy = std::clamp(static_cast<int>(py), 0, h - 1);
+      return depth[static_cast<size_t>(iy) * w + ix];
+    }
+    double px, py;
+    if (!probe->radiance.mapping.to_pixel(d, &px, &py)) return 0;
+    int ix = std::clamp(static_cast<int>(px), 0, w - 1), iy = std::clamp(static_cast<int>(py), 0, h - 1);
+    return depth[static_cast<size_t>(iy) * w + ix];
+  }
+  // Bilinear radiance towards the local direction d.
+  Vec3 radiance_at(Vec3 d) const {
+    if (!latlong) return probe->radiance.sample_rgb(d);
+    float px, py;
+    ll_pixel(d, &px, &py);
+    float fx = px - 0.5f, fy = py - 0.5f;
+    float x0f = std::floor(fx), y0f = std::floor(fy);
+    float tx = fx - x0f, ty = fy - y0f;
+    int x0 = static_cast<int>(x0f), y0 = static_cast<int>(y0f);
+    int x1 = x0 + 1, y1 = y0 + 1;
+    x0 = (x0 % w + w) % w;
+    x1 = (x1 % w + w) % w;
+    y0 = std::clamp(y0, 0, h - 1);
+    y1 = std::clamp(y1, 0, h - 1);
+    const float* a = rgb + (static_cast<size_t>(y0) * w + x0) * 3;
+    const float* b = rgb + (static_cast<size_t>(y0) * w + x1) * 3;
+    const float* c = rgb + (static_cast<size_t>(y1) * w + x0) * 3;
+    const float* e = rgb + (static_cast<size_t>(y1) * w + x1) * 3;
+    float w00 = (1 - tx) * (1 - ty), w10 = tx * (1 - ty), w01 = (1 - tx) * ty, w11 = tx * ty;
+    return {w00 * a[0] + w10 * b[0] + w01 * c[0] + w11 * e[0], w00 * a[1] + w10 * b[1] + w01 * c[1] + w11 * e[1],
+            w00 * a[2] + w10 * b[2] + w01 * c[2] + w11 * e[2]};
+  }
+};
+
+struct RayOut {
+  Vec3 L;
+  double t = 0;
+  PixelStatus status = PixelStatus::NoData;
+  int seen = 0;
+};
+
+class Fuser {
+ public:
+  Fuser(const ProbeSet& set, const FuseDesc& desc) : set_(set), desc_(desc) {
+    if (!set.tracer) fail(ErrorKind::Value, "fuse: the probe set is not prepared (call fusion::prepare)");
+    if (desc.samples < 1 || desc.samples > 16) fail(ErrorKind::Value, "fuse: samples {} is out of range [1, 16]", desc.samples);
+    if (!(desc.depth_bias >= 0) || !(desc.slope_bias >= 0))
+      fail(ErrorKind::Value, "fuse: depth bias {} and slope bias {} must be ≥ 0", desc.depth_bias, desc.slope_bias);
+    if (!(desc.angle_power >= 0)) fail(ErrorKind::Value, "fuse: angle power {} must be ≥ 0", desc.angle_power);
+    if (!(desc.angle_threshold >= -1 && desc.angle_threshold <= 1))
+      fail(ErrorKind::Value, "fuse: angle threshold {} must be a cosine in [−1, 1]", desc.angle_threshold);
+    for (const Probe& p : set.probes) {
+      Lut l;
+      l.pos = p.position;
+      l.to_local = p.rotation.transposed();
+      l.latlong = p.radiance.mapping.kind() == sphere::MappingKind::LatLong;
+      l.w = p.radiance.image.width();
+      l.h = p.radiance.image.height();
+      if (p.radiance.image.channels() != 3 || p.depth.width() != l.w || p.depth.height() != l.h || p.depth.channels() != 1)
+        fail(ErrorKind::Value, "fuse: probe {} is not prepared (3-channel radiance and a 1-channel depth map of its size)", p.image);
+      l.rgb = p.radiance.image.data();
+      l.depth = p.depth.data();
+      l.probe = &p;
+      double n = 0;
+      for (int y = 0; y < l.h; ++y)
+        for (int x = 0; x < l.w; ++x) n += p.radiance.mapping.valid(x, y);
+      l.inv_omega = n / kFourPi;
+      l.delta = std::sqrt(kFourPi / std::max(n, 1.0));
+      luts_.push_back(l);
+    }
+    normals_.resize(set.proxy.triangle_count());
+    for (size_t i = 0; i < normals_.size(); ++i) normals_[i] = set.proxy.normal(i);
+  }
+
+  RayOut shade(Vec3 x, Vec3 w) const {
+    RayOut out;
+    geometry::Hit h = set_.tracer->intersect(x, w);
+    if (!h.hit) {
+      out.status = PixelStatus::LeftProxy;
+      out.L = distant(x, w, true);
+      return out;
+    }
+    out.t = h.t;
+    Vec3 p = x + w * h.t, n = normals_[h.triangle];
+    double side_x = dot(n, w);
+    // Pass 1: which probes see p, and their blend weights.
+    struct Cand {
+      int i;
+      double wgt;
+      Vec3 local;
+    };
+    thread_local std::vector<Cand> cand;
+    cand.clear();
+    int best = -1;
+    double best_s = -2;
+    Vec3 best_local;
+    for (size_t i = 0; i < luts_.size(); ++i) {
+      const Lut& l = luts_[i];
+      Vec3 v = p - l.pos;
+      double r = length(v);
+      if (r <= 0) continue;
+      Vec3 u = v / r, local = l.to_local * u;
+      double cos_a = dot(n, u);
+      if (desc_.visibility) {
+        if (cos_a * side_x <= 0) continue;  // the probe is behind p's face (x is in front of it)
+        double d = l.depth_at(local);
+        double ca = std::abs(cos_a), tan_a = std::min(std::sqrt(std::max(0.0, 1 - ca * ca)) / std::max(ca, 1e-9), kMaxTan);
+        if (!(d > 0) || r > d * (1 + desc_.depth_bias + desc_.slope_bias * l.delta * tan_a)) continue;
+      }
+      double s = dot(w, u);
+      double wgt = 0;
+      switch (desc_.blend) {
+        case Blend::Nearest: break;
+        case Blend::Angle: wgt = s >= desc_.angle_threshold && s > 0 ? s : 0; break;
+        case Blend::Footprint:
+          wgt = std::pow(0.5 * (1 + s), desc_.angle_power) * std::max(std::abs(cos_a), kMinCos) * l.inv_omega / (r * r);
+          break;
+      }
+      if (s > best_s) { best_s = s; best = static_cast<int>(i); best_local = local; }
+      if (wgt > 0) cand.push_back({static_cast<int>(i), wgt, local});
+      ++out.seen;
+    }
+    if (best < 0) {
+      out.status = PixelStatus::Unseen;
+      out.L = distant(x, w, false);
+      return out;
+    }
+    out.status = PixelStatus::Fused;
+    // Pass 2: radiance lookups of the probes that carry weight (the nearest alone when none does).
+    if (desc_.blend == Blend::Nearest || cand.empty()) {
+      out.L = luts_[best].radiance_at(best_local);
+      return out;
+    }
+    Vec3 sum;
+    double wsum = 0;
+    for (const Cand& c : cand) {
+      sum += luts_[c.i].radiance_at(c.local) * c.wgt;
+      wsum += c.wgt;
+    }
+    out.L = sum / wsum;
+    return out;
+  }
+
+ private:
+  // Distant lookup L_i(ω) weighted by 1/(|x − x_i|² + h²); when the ray left the proxy, over the
+  // probes whose own ray along ω leaves it too (when there are any).
+  Vec3 distant(Vec3 x, Vec3 w, bool left) const {
+    Vec3 all, out;
+    double wall = 0, wout = 0;
+    for (const Lut& l : luts_) {
+      Vec3 local = l.to_local * w;
+      Vec3 dx = x - l.pos;
+      double wgt = 1.0 / (dot(dx, dx) + kFallbackSoftening2);
+      Vec3 L = l.radiance_at(local);
+      all += L * wgt;
+      wall += wgt;
+      if (left && l.depth_at(local) <= 0) {
+        out += L * wgt;
+        wout += wgt;
+      }
+    }
+    return wout > 0 ? out / wout : all / wall;
+  }
+
+  const ProbeSet& set_;
+  const FuseDesc& desc_;
+  std::vector<Lut> luts_;
+  std::vector<Vec3> normals_;
+};
+
+void check_x(const ProbeSet& set, Vec3 x) {
+  if (!std::isfinite(x.x) || !std::isfinite(x.y) || !std::isfinite(x.z)) fail(ErrorKind::Value, "fuse: the point is not finite");
+  PointCheck c = check_point(set, x);
+  if (c.backface > 0.5)
+    fail(ErrorKind::Value,
+         "fuse: the point ({}, {}, {}) is inside geometry or outside the proxy ({:.0f}% of its rays reach the back of a "
+         "proxy face)", x.x, x.y, x.z, 100 * c.backface);
+}
+
+}  // namespace
+
+std::vector<Vec3> fuse_rays(const ProbeSet& set, Vec3 x, const std::vector<Vec3>& dirs, const FuseDesc& desc,
+                            std::vector<PixelStatus>* status) {
+  Fuser f(set, desc);
+  std::vector<Vec3> out(dirs.size());
+  if (status) status->assign(dirs.size(), PixelStatus::NoData);
+  parallel_for(0, static_cast<int64_t>(dirs.size()), [&](int64_t i) {
+    RayOut r = f.shade(x, normalize(dirs[i]));
+    out[i] = r.L;
+    if (status) (*status)[i] = r.status;
+  }, 256);
+  return out;
+}
+
+Vec3 fuse_ray(const ProbeSet& set, Vec3 x, Vec3 omega, const FuseDesc& desc, PixelStatus* status) {
+  Fuser f(set, desc);
+  RayOut r = f.shade(x, normalize(omega));
+  if (status) *status = r.status;
+  return r.L;
+}
+
+LocalMap fuse(const ProbeSet& set, Vec3 x, const FuseDesc& desc) {
+  sphere::Mapping m = output_mapping(desc.mapping, desc.size);
+  Fuser fuser(set, desc);
+  if (desc.check_point) check_x(set, x);
+  const int W = m.width(), H = m.height(), n = desc.samples;
+  LocalMap out;
+  out.point = x;
+  Image rad(W, H, 3);
+  out.depth = Image(W, H, 1);
+  out.coverage = Image(W, H, 1);
+  out.status.assign(static_cast<size_t>(W) * H, PixelStatus::NoData);
+  std::atomic<int> rows{0};
+  parallel_for(0, H, [&](int64_t yy) {
+    int y = static_cast<int>(yy);
+    for (int xx = 0; xx < W; ++xx) {
+      Vec3 d;
+      if (!m.to_direction(xx + 0.5, y + 0.5, &d)) continue;
+      RayOut c = fuser.shade(x, d);
+      Vec3 L = c.L;
+      if (n > 1) {
+        Vec3 sum;
+        int used = 0;
+        for (int s = 0; s < n * n; ++s) {
+          Vec3 ds;
+          if (!m.to_direction(xx + (s % n + 0.5) / n, y + (s / n + 0.5) / n, &ds)) continue;
+          sum += fuser.shade(x, ds).L;
+          ++used;
+        }
+        if (used) L = sum / used;
+      }
+      rad.set_rgb(xx, y, L);
+      out.depth.at(xx, y, 0) = static_cast<float>(c.t);
+      out.coverage.at(xx, y, 0) = static_cast<float>(c.status == PixelStatus::Fused ? c.seen : 0);
+      out.status[static_cast<size_t>(y) * W + xx] = c.status;
+    }
+    report(desc.progress, "fuse", static_cast<double>(++rows) / H);
+  }, 4);
+  out.radiance = sphere::EnvMap(std::move(rad), m);
+  double all = 0, fused = 0, left = 0, unseen = 0, probes = 0;
+  for (int y = 0; y < H; ++y)
+    for (int xx = 0; xx < W; ++xx) {
+      PixelStatus s = out.status[static_cast<size_t>(y) * W + xx];
+      if (s == PixelStatus::NoData) continue;
+      double w = m.solid_angle_estimate(xx, y);
+      all += w;
+      if (s == PixelStatus::Fused) { fused += w; probes += w * out.coverage.at(xx, y, 0); }
+      if (s == PixelStatus::LeftProxy) left += w;
+      if (s == PixelStatus::Unseen) unseen += w;
+    }
+  if (all > 0) {
+    out.stats.fused = fused / all;
+    out.stats.left_proxy = left / all;
+    out.stats.unseen = unseen / all;
+    out.stats.mean_probes = fused > 0 ? probes / fused : 0;
+  }
+  if (out.stats.fused == 0)
+    out.warnings.push_back(fmt::format("no direction at ({}, {}, {}) reaches a proxy point a probe sees: the whole map is the "
+                                       "distant fallback", x.x, x.y, x.z));
+  else if (out.stats.unseen > 0.01)
+    out.warnings.push_back(fmt::format("{:.1f}% of the sphere at ({}, {}, {}) hits proxy points no probe sees (distant fallback; "
+                                       "see the coverage map)", 100 * out.stats.unseen, x.x, x.y, x.z));
+  return out;
+}
+
+}  // namespace ibl::fusion
