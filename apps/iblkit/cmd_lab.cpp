@@ -35,7 +35,7 @@ std::vector<Vec3> parse_points(const std::string& s, const std::string& what) {
 }
 
 struct CaptureOpts {
-  std::string scene, out, mapping = "latlong", camera = "ideal", grid, path, volume, format = "exr";
+  std::string scene, out, mapping = "latlong", camera = "ideal", grid, path, volume, format = "exr", look = "0,0,1";
   std::vector<std::string> probes;
   int size = 64, samples = 1, count = 10, random = 0, bounces = -1, area_samples = 0, env_samples = 0;
   double dead_angle = 0, ball_radius = 0.04, reflectance = 1;
@@ -73,6 +73,14 @@ void run_capture(const CaptureOpts& o) {
   d.capture.size = o.size;
   d.capture.samples = o.samples;
   d.capture.dead_angle_deg = o.dead_angle;
+  {  // --look: the world direction of the probe's +Z (a mirror ball's centre; its dead angle is opposite)
+    Vec3 z = iblcli::parse_vec3(o.look, "--look");
+    if (length(z) == 0) ibl::fail(ibl::ErrorKind::Value, "--look: (0,0,0) has no direction");
+    z = normalize(z);
+    Vec3 up = std::abs(z.y) > 0.999 ? Vec3{0, 0, -z.y} : Vec3{0, 1, 0};  // keep +Y up where possible
+    Vec3 x = normalize(cross(up, z)), y = cross(z, x);
+    d.capture.rotation = ibl::Mat3::rows(x, y, z).transposed();  // columns: the probe's axes in the world
+  }
   if (o.camera != "ideal" && o.camera != "ball") ibl::fail(ibl::ErrorKind::Value, "--camera: expected ideal or ball, got {}", o.camera);
   d.capture.camera = o.camera == "ball" ? ibl::lab::Camera::MirrorBall : ibl::lab::Camera::Ideal;
   if (d.capture.camera == ibl::lab::Camera::MirrorBall) d.capture.mapping = ibl::sphere::MappingKind::MirrorBall;
@@ -103,6 +111,7 @@ struct TruthOpts {
   int size = 128, samples = 4, area_samples = 64, bands = 3;
   uint64_t seed = 1;
   double blind_cone = 0;
+  std::string blind_axis = "0,0,-1";
 };
 
 void run_truth(const TruthOpts& o) {
@@ -114,6 +123,7 @@ void run_truth(const TruthOpts& o) {
   d.bands = o.bands;
   d.seed = o.seed;
   d.blind_cone_deg = o.blind_cone;
+  d.blind_axis = iblcli::parse_vec3(o.blind_axis, "--blind-axis");
   for (const auto& n : o.normals) d.normals.push_back(iblcli::parse_vec3(n, "--normal"));
   if (d.normals.empty()) d.normals = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
   Vec3 at = iblcli::parse_vec3(o.at, "--at");
@@ -165,6 +175,8 @@ void setup(CLI::App& app) {
   c->add_option("--ball-radius", co->ball_radius, "mirror ball radius, metres")->capture_default_str();
   c->add_flag("--parallax", co->parallax, "rays leave the ball's surface (non-single viewpoint)");
   c->add_option("--reflectance", co->reflectance, "mirror ball reflectance")->capture_default_str();
+  c->add_option("--look", co->look, "world direction of the probe's +Z (a mirror ball's centre; the manifest's rotation)")
+      ->capture_default_str();
   c->add_option("--dead-angle", co->dead_angle, "ideal mirror ball: dead angle written to the manifest, degrees")->capture_default_str();
   c->add_flag("--depth", co->depth, "also write depth maps (distance to the first hit, 0 = none)");
   c->add_flag("--fusion", co->fusion, "write a fusion probe set (probes.json, depth maps, proxy.obj)");
@@ -193,7 +205,9 @@ void setup(CLI::App& app) {
   t->add_option("--normal", to->normals, "irradiance normal x,y,z (repeat; default the six axes)");
   t->add_option("--seed", to->seed, "random seed")->capture_default_str();
   t->add_option("--blind-cone", to->blind_cone,
-                "also give sh_visible: the SH without the directions within DEG of -Z (a mirror-ball sequence's dead angle)");
+                "also give sh_visible: the SH without the directions within DEG of --blind-axis (a mirror-ball sequence's dead angle)");
+  t->add_option("--blind-axis", to->blind_axis, "world axis of --blind-cone (a ball with --look L has its dead angle around -L)")
+      ->capture_default_str();
   t->add_option("-o,--out", to->out, "folder for radiance.exr/.png, sh.json, truth.json");
   t->footer("Example:\n  iblkit lab truth low-scene1 --at 0,1,0 --size 256 --out truth");
   t->callback([to] { run_truth(*to); });

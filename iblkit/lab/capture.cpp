@@ -38,10 +38,10 @@ bool ball_ray(const sphere::Mapping& m, double px, double py, Vec3* n, Vec3* d) 
 constexpr int kApertureRings = 16, kApertureSectors = 16;  // 256 equal-area strata of the disc
 constexpr double kShadowShorten = 1e-4;  // relative: as radiance.cpp, stop short of the aperture
 
-// Whether a probe-frame direction carries light under desc.cone.
+// Whether a world direction carries light under desc.cone.
 bool cone_selects(const CaptureDesc& desc, Vec3 d) {
   if (desc.cone == CaptureDesc::Cone::All) return true;
-  bool inside = -d.z > std::cos(desc.cone_deg * kPi / 180);
+  bool inside = dot(d, desc.cone_axis) > std::cos(desc.cone_deg * kPi / 180);
   return inside == (desc.cone == CaptureDesc::Cone::Inside);
 }
 
@@ -88,7 +88,7 @@ void add_aperture(const Scene& scene, const Emitter& e, Vec3 o, const CaptureDes
       if (max_component(I) <= 0 || scene.tracer().occluded(o, w, 0, dist * (1 - kShadowShorten))) continue;
       double px, py;
       Vec3 local = to_probe * w;
-      if (!cone_selects(desc, local)) continue;
+      if (!cone_selects(desc, w)) continue;
       if (!m.to_pixel(local, &px, &py)) continue;  // a direction without data (dead angle)
       int x = std::clamp(static_cast<int>(px), 0, m.width() - 1), y = std::clamp(static_cast<int>(py), 0, m.height() - 1);
       double sa = m.solid_angle(x, y);
@@ -140,7 +140,7 @@ Capture capture_probe(const Scene& scene, Vec3 position, const CaptureDesc& desc
         } else {
           if (!m.to_direction(px, py, &d)) continue;
           ++used;
-          if (!cone_selects(desc, d)) continue;
+          if (!cone_selects(desc, desc.rotation * d)) continue;
           sum += radiance(scene, o, desc.rotation * d, rng, desc.render, hidden);
         }
       }

@@ -31,11 +31,12 @@ struct CaptureDesc {
                                  // not point-sampled by the sub-pixel rays (which alias it)
   RenderDesc render;             // light estimation settings and seed
   // Ideal camera: with Outside (Inside) only the sub-samples and aperture points whose direction lies
-  // outside (inside) the cone of `cone_deg` around the probe's −Z carry light; the rest count as
+  // outside (inside) the cone of `cone_deg` around `cone_axis` carry light; the rest count as
   // black. ground_truth uses Inside to leave a mirror ball's dead angle out of its answer exactly.
   enum class Cone { All, Outside, Inside };
   Cone cone = Cone::All;
   double cone_deg = 0;           // half-angle of that cone, degrees
+  Vec3 cone_axis{0, 0, -1};      // its axis in the world (unit)
 };
 
 // A spot/projector aperture whose solid angle is below this many pixels (at the pixel it falls in)

@@ -57,6 +57,8 @@ Truth ground_truth(const Scene& scene, Vec3 position, const TruthDesc& desc, con
     if (!(desc.blind_cone_deg < 180)) fail(ErrorKind::Value, "blind cone {}° must lie in (0, 180)", desc.blind_cone_deg);
     cd.cone = CaptureDesc::Cone::Inside;
     cd.cone_deg = desc.blind_cone_deg;
+    if (length(desc.blind_axis) == 0) fail(ErrorKind::Value, "blind cone axis (0,0,0) has no direction");
+    cd.cone_axis = normalize(desc.blind_axis);
     Capture inside = capture_probe(scene, position, cd, 0);
     sphere::EnvMap vis = t.radiance;
     for (size_t i = 0; i < vis.image.size(); ++i) vis.image.data()[i] = std::max(0.0f, vis.image.data()[i] - inside.radiance.data()[i]);

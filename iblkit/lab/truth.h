@@ -18,7 +18,8 @@ struct TruthDesc {
   std::vector<Vec3> normals;  // irradiance is computed for each (normalised here)
   uint64_t seed = 1;       // random streams
   double blind_cone_deg = 0;  // > 0: also project `sh_visible`, the map without the directions within
-                              // this angle of −Z (a mirror-ball sequence's dead angle, identity rotation)
+                              // this angle of blind_axis (a mirror-ball sequence's dead angle)
+  Vec3 blind_axis{0, 0, -1};  // world axis of that cone (−Z: a ball seen along −Z, identity rotation)
 };
 
 struct Truth {
