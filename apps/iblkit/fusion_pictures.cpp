@@ -44,13 +44,13 @@ Image tone(const Image& img, double scale) {
 Image fused_sheet(const ibl::fusion::LocalMap& ll, int probes, const ibl::lights::LightSet* lights, const std::string& title) {
   std::vector<std::pair<std::string, Image>> pics;
   pics.push_back({"fused map", ibl::io::tonemap(ll.radiance.image).with_channels(3)});
-  pics.push_back({fmt::format("coverage: fused {:.1f}% (green, brighter = more probes), left proxy {:.1f}% (blue), "
-                              "unseen {:.1f}% (red)", 100 * ll.stats.fused, 100 * ll.stats.left_proxy, 100 * ll.stats.unseen),
+  pics.push_back({fmt::format("coverage: fused {:.1f}% / left {:.1f}% / unseen {:.1f}%", 100 * ll.stats.fused,
+                              100 * ll.stats.left_proxy, 100 * ll.stats.unseen),
                   coverage_picture(ll, probes)});
   if (lights) {
     int positioned = 0;
     for (const auto& l : lights->lights) positioned += l.position.has_value();
-    pics.push_back({fmt::format("{} lights ({} localised), 8 brightest-per-area numbered", lights->lights.size(), positioned),
+    pics.push_back({fmt::format("{} lights, {} localised", lights->lights.size(), positioned),
                     light_overlay(ll.radiance, *lights, 512, 8)});
   }
   return ibl::io::contact_sheet(pics, static_cast<int>(pics.size()), 512, 256, title);

@@ -76,8 +76,9 @@ struct Lut {
     int ix = std::clamp(static_cast<int>(px), 0, w - 1), iy = std::clamp(static_cast<int>(py), 0, h - 1);
     return depth[static_cast<size_t>(iy) * w + ix];
   }
-  // Bilinear radiance towards the local direction d.
-  Vec3 radiance_at(Vec3 d) const {
+  // Bilinear radiance towards the local direction d. With tol > 0 (a lat-long probe) only the taps whose
+  // depth lies within tol of r take part: the lookup does not bleed across depth edges.
+  Vec3 radiance_at(Vec3 d, double r = 0, double tol = 0) const {
     if (!latlong) return probe->radiance.sample_rgb(d);
     float px, py;
     ll_pixel(d, &px, &py);
@@ -95,6 +96,14 @@ struct Lut {
     const float* c = rgb + (static_cast<size_t>(y1) * w + x0) * 3;
     const float* e = rgb + (static_cast<size_t>(y1) * w + x1) * 3;
     float w00 = (1 - tx) * (1 - ty), w10 = tx * (1 - ty), w01 = (1 - tx) * ty, w11 = tx * ty;
+    if (tol > 0) {
+      auto ok = [&](int xx, int yy) { return std::abs(depth[static_cast<size_t>(yy) * w + xx] - r) <= tol; };
+      float m00 = ok(x0, y0) ? w00 : 0, m10 = ok(x1, y0) ? w10 : 0, m01 = ok(x0, y1) ? w01 : 0, m11 = ok(x1, y1) ? w11 : 0;
+      float sum = m00 + m10 + m01 + m11;
+      if (sum > 0 && sum < 1) {
+        w00 = m00 / sum; w10 = m10 / sum; w01 = m01 / sum; w11 = m11 / sum;
+      }
+    }
     return {w00 * a[0] + w10 * b[0] + w01 * c[0] + w11 * e[0], w00 * a[1] + w10 * b[1] + w01 * c[1] + w11 * e[1],
             w00 * a[2] + w10 * b[2] + w01 * c[2] + w11 * e[2]};
   }
@@ -156,11 +165,12 @@ class Fuser {
       int i;
       double wgt;
       Vec3 local;
+      double r, tol;  // distance to p and the depth tolerance of its lookup taps (0: plain bilinear)
     };
     thread_local std::vector<Cand> cand;
     cand.clear();
     int best = -1;
-    double best_s = -2;
+    double best_s = -2, best_r = 0, best_tol = 0;
     Vec3 best_local;
     for (size_t i = 0; i < luts_.size(); ++i) {
       const Lut& l = luts_[i];
@@ -168,12 +178,15 @@ class Fuser {
       double r = length(v);
       if (r <= 0) continue;
       Vec3 u = v / r, local = l.to_local * u;
-      double cos_a = dot(n, u);
+      double cos_a = dot(n, u), tol = 0;
       if (desc_.visibility) {
         if (cos_a * side_x <= 0) continue;  // the probe is behind p's face (x is in front of it)
         double d = l.depth_at(local);
         double ca = std::abs(cos_a), tan_a = std::min(std::sqrt(std::max(0.0, 1 - ca * ca)) / std::max(ca, 1e-9), kMaxTan);
-        if (!(d > 0) || r > d * (1 + desc_.depth_bias + desc_.slope_bias * l.delta * tan_a)) continue;
+        double rel = desc_.depth_bias + desc_.slope_bias * l.delta * tan_a;
+        if (!(d > 0) || r > d * (1 + rel)) continue;
+        // Taps one texel further away may see the surface at most ~2× the slope term off.
+        if (desc_.edge_aware) tol = r * (desc_.depth_bias + 2 * desc_.slope_bias * l.delta * tan_a);
       }
       double s = dot(w, u);
       double wgt = 0;
@@ -184,8 +197,8 @@ class Fuser {
           wgt = std::pow(0.5 * (1 + s), desc_.angle_power) * std::max(std::abs(cos_a), kMinCos) * l.inv_omega / (r * r);
           break;
       }
-      if (s > best_s) { best_s = s; best = static_cast<int>(i); best_local = local; }
-      if (wgt > 0) cand.push_back({static_cast<int>(i), wgt, local});
+      if (s > best_s) { best_s = s; best = static_cast<int>(i); best_local = local; best_r = r; best_tol = tol; }
+      if (wgt > 0) cand.push_back({static_cast<int>(i), wgt, local, r, tol});
       ++out.seen;
     }
     if (best < 0) {
@@ -196,13 +209,13 @@ class Fuser {
     out.status = PixelStatus::Fused;
     // Pass 2: radiance lookups of the probes that carry weight (the nearest alone when none does).
     if (desc_.blend == Blend::Nearest || cand.empty()) {
-      out.L = luts_[best].radiance_at(best_local);
+      out.L = luts_[best].radiance_at(best_local, best_r, best_tol);
       return out;
     }
     Vec3 sum;
     double wsum = 0;
     for (const Cand& c : cand) {
-      sum += luts_[c.i].radiance_at(c.local) * c.wgt;
+      sum += luts_[c.i].radiance_at(c.local, c.r, c.tol) * c.wgt;
       wsum += c.wgt;
     }
     out.L = sum / wsum;

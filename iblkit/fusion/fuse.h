@@ -23,6 +23,10 @@
 //                          │ cos α/(r² Ω): texels of probe i per m² of surface at p —     │
 //                          │ the probe that sees p sharpest counts most                   │
 //                          └──────────────────────────────────────────────────────────────┘
+// With visibility on, a probe's bilinear lookup is also depth-aware (edge_aware): of its four taps only
+// those whose depth is within r_i·(ε + 2κ·δ_i·tan α_i) of r_i count (weights renormalised), so that a
+// bright surface behind a depth edge does not bleed onto the near one (e.g. a lit hall seen past a
+// corridor's corner: 100× brighter, one texel of smear is a wide band in the fused view).
 // Rays that hit nothing (windows, open ends) or whose p no probe sees fall back to the distant lookup
 // L = Σ v_i L_i(ω) / Σ v_i with v_i = 1/(|x − x_i|² + h²) (h = 0.1 m), over the probes whose own ray
 // along ω leaves the proxy too when the ray left it (all probes when none does); the coverage map
@@ -55,6 +59,7 @@ struct FuseDesc {
   double slope_bias = 1.5;        // κ: multiplies δ_i·tan α_i, the slope-scaled part of the bias
   double angle_threshold = 0.0;   // angle blend: probes with ω·ω'_i below this cosine are left out
   double angle_power = 4.0;       // footprint blend: k of the angular term ((1 + s)/2)^k
+  bool edge_aware = true;         // with visibility: bilinear probe lookups skip taps at another depth
   int samples = 1;                // n×n rays per output pixel (radiance averaged; depth from the centre)
   bool check_point = true;        // throw when x is inside geometry or outside the proxy
   ProgressFn progress;            // stage "fuse", by rows

@@ -276,7 +276,7 @@ TEST(FusionProbeSet, DepthIsTracedOnceAndCachedBesideTheProbe) {
   auto manifest = write_set(dir, box_room(), {{0, 1.5, 0}, {1, 1, 1}});
   ProbeSet a = load_probe_set(manifest);
   EXPECT_EQ(a.probes[0].depth_source, DepthSource::Computed);
-  EXPECT_TRUE(fs::exists(dir / "p0_depth.exr"));
+  EXPECT_TRUE(fs::exists(dir / "p0_proxydepth.exr"));
   ProbeSet b = load_probe_set(manifest);
   EXPECT_EQ(b.probes[1].depth_source, DepthSource::Cache);
   EXPECT_EQ(b.probes[1].depth.at(5, 7, 0), a.probes[1].depth.at(5, 7, 0));

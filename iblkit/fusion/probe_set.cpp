@@ -83,7 +83,7 @@ std::string probe_name(const Probe& p, size_t k) {
 
 std::string depth_cache_path(const std::string& image) {
   fs::path p(image);
-  return (p.parent_path() / (p.stem().string() + "_depth.exr")).string();
+  return (p.parent_path() / (p.stem().string() + "_proxydepth.exr")).string();
 }
 
 Image trace_depth(const geometry::RayTracer& tracer, const sphere::Mapping& m, Vec3 position, const Mat3& rotation) {

@@ -25,7 +25,7 @@ namespace ibl::fusion {
 
 enum class DepthSource {
   File,      // named by the manifest's "depth"
-  Cache,     // read from the cache beside the probe (<image stem>_depth.exr)
+  Cache,     // read from the cache beside the probe (<image stem>_proxydepth.exr)
   Computed,  // traced on the proxy now
 };
 
@@ -51,7 +51,7 @@ struct ProbeSet {
 
 struct LoadDesc {
   bool use_depth_files = true;   // false: ignore the manifest's depth maps and trace the proxy
-  bool use_cache = true;         // read <stem>_depth.exr beside a probe when the manifest names none
+  bool use_cache = true;         // read <stem>_proxydepth.exr beside a probe when the manifest names none
   bool write_cache = true;       // write depth maps that had to be traced beside their probes
   bool force_depth = false;      // trace every depth map again (and rewrite the cache)
   ProgressFn progress;           // stages "load", "depth"
@@ -80,7 +80,8 @@ struct PointCheck {
 };
 PointCheck check_point(const ProbeSet& set, Vec3 x, int rays = 256);
 
-// The cache path of a probe's traced depth map: <image without extension>_depth.exr.
+// The cache path of a probe's traced depth map: <image without extension>_proxydepth.exr (not _depth:
+// that name is the lab's depth of the real scene).
 std::string depth_cache_path(const std::string& image);
 
 }  // namespace ibl::fusion
