@@ -1,0 +1,115 @@
+#include "render_setup.h"
+#ifdef IBLKIT_HAVE_GEOMETRY
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "iblkit/core/error.h"
+#include "iblkit/geometry/mesh_io.h"
+#include "iblkit/ilf/shgrid.h"
+#include "iblkit/lights/light_set.h"
+#include "iblkit/render/prefilter.h"
+#include "iblkit/sh/project.h"
+
+namespace iblcli {
+
+namespace fs = std::filesystem;
+using namespace ibl;
+using namespace ibl::render;
+
+void load_lighting(const std::string& path, int bands, int shadows, const io::EnvReadDesc& rd, double glossy_exponent, Lighting* L,
+                   std::string* kind) {
+  std::string ext = fs::path(path).extension().string();
+  if (ext == ".shgrid") {
+    ilf::SHGrid g = ilf::read_shgrid(path);
+    SHGridData d;
+    d.bands = g.bands();
+    d.nx = g.grid().nx;
+    d.ny = g.grid().ny;
+    d.nz = g.grid().nz;
+    d.min = g.grid().volume.min;
+    d.max = g.grid().volume.max;
+    d.data = g.data();
+    L->grid = std::move(d);
+    *kind = fmt::format("SH grid {}x{}x{}, {} bands", g.grid().nx, g.grid().ny, g.grid().nz, g.bands());
+    return;
+  }
+  if (ext == ".json") {
+    std::ifstream in(path);
+    if (!in) fail(ErrorKind::Io, "{}: cannot open", path);
+    nlohmann::json j;
+    try {
+      in >> j;
+    } catch (const std::exception& e) {
+      fail(ErrorKind::Format, "{}: not valid JSON ({})", path, e.what());
+    }
+    std::string format = j.value("format", "");
+    if (format == "iblkit.lights/1") {
+      lights::LightSet set = lights::from_json(j, path);
+      // Lights come in shadow-map priority order (docs/formats.md): the first `shadows` get maps,
+      // unless a light says "shadow" itself. A light with a position (fusion's localised lights)
+      // is a point light of intensity irradiance·|position − origin|².
+      int points = 0;
+      for (size_t i = 0; i < set.lights.size(); ++i) {
+        const lights::Light& l = set.lights[i];
+        bool shadow = static_cast<int>(i) < shadows;
+        if (j["lights"][i].contains("shadow")) shadow = j["lights"][i]["shadow"].get<bool>();
+        if (l.position && set.origin) {
+          Vec3 q = *l.position - *set.origin;
+          L->point_lights.push_back({*l.position, l.irradiance * dot(q, q), shadow});
+          ++points;
+        } else {
+          L->lights.push_back({normalize(l.direction), l.irradiance, shadow});
+        }
+      }
+      *kind = points ? fmt::format("{} point lights and {} directional lights", points, set.lights.size() - points)
+                     : fmt::format("{} directional lights", set.lights.size());
+      return;
+    }
+    if (format == "iblkit.sh/1") {
+      sh::Coeffs c;
+      c.bands = j.at("bands").get<int>();
+      for (const auto& v : j.at("coefficients")) c.c.push_back({v[0].get<double>(), v[1].get<double>(), v[2].get<double>()});
+      if (static_cast<int>(c.c.size()) != c.bands * c.bands)
+        fail(ErrorKind::Format, "{}: {} bands need {} coefficients, found {}", path, c.bands, c.bands * c.bands, c.c.size());
+      L->environment = c;
+      *kind = fmt::format("SH environment, {} bands", c.bands);
+      return;
+    }
+    fail(ErrorKind::Format, "{}: \"format\" is '{}'; expected iblkit.lights/1 or iblkit.sh/1", path, format);
+  }
+  auto env = io::read_envmap(path, rd);
+  L->environment = sh::project(env, bands);
+  *kind = fmt::format("probe projected to {} SH bands", bands);
+  if (glossy_exponent > 0) {
+    L->glossy_maps.push_back(prefilter_phong(env, glossy_exponent));
+    const Image& g = L->glossy_maps.back().latlong;
+    *kind += fmt::format(", glossy from a prefiltered {}x{} Phong map (s = {:g})", g.width(), g.height(), glossy_exponent);
+  }
+}
+
+Mesh make_object(const std::string& scene, double size, int triangles, Vec3 at) {
+  Mesh object;
+  if (scene == "blob") {
+    object = make_blob(triangles, size);
+  } else if (scene == "sphere") {
+    object = make_sphere(size / 2, 128, 256);
+  } else {
+    object = from_trimesh(geometry::read_mesh(scene));
+    // Centre the file's mesh on the origin and scale its largest extent to `size`.
+    Vec3 lo, hi;
+    object.bounds(&lo, &hi);
+    double extent = std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
+    if (!(extent > 0)) fail(ErrorKind::Value, "{}: the mesh has no extent", scene);
+    object.transform(1.0, (lo + hi) * -0.5);
+    object.transform(size / extent, {0, 0, 0});
+  }
+  object.transform(1.0, at);
+  return object;
+}
+
+}  // namespace iblcli
+#endif
