@@ -43,6 +43,7 @@ void add_fuse_options(CLI::App& c, FuseOpts& o) {
   c.add_option("--blend", o.blend, "nearest (Eq. 5.3), angle (Eq. 5.5) or footprint (ours)")->capture_default_str();
   c.add_flag("--no-visibility", o.no_visibility, "skip the per-probe depth test (reproduces the thesis's Fig. 7.8)");
   c.add_option("--bias", o.bias, "relative depth tolerance ε of the visibility test")->capture_default_str();
+  c.add_option("--tolerance", o.tolerance, "absolute depth tolerance τ (metres) of the visibility test")->capture_default_str();
   c.add_option("--samples", o.samples, "n×n rays per output pixel")->capture_default_str();
   c.add_option("--threshold", o.threshold, "angle blend: leave out probes with ω·ω' below this cosine")->capture_default_str();
   c.add_flag("--proxy-depth", o.proxy_depth, "ignore the manifest's depth maps: trace the proxy");
@@ -55,6 +56,7 @@ ibl::fusion::FuseDesc fuse_desc(const FuseOpts& o) {
   d.blend = fu::parse_blend(o.blend);
   d.visibility = !o.no_visibility;
   d.depth_bias = o.bias;
+  d.depth_tolerance = o.tolerance;
   d.samples = o.samples;
   d.angle_threshold = o.threshold;
   return d;

@@ -13,7 +13,7 @@ namespace iblcli {
 struct FuseOpts {
   std::string mapping = "latlong", blend = "footprint";
   int size = 128, samples = 1;
-  double bias = 0.02, threshold = 0.0;
+  double bias = 0.01, tolerance = 0.10, threshold = 0.0;
   bool no_visibility = false, proxy_depth = false;
 };
 void add_fuse_options(CLI::App& app, FuseOpts& o);

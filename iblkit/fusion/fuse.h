@@ -5,10 +5,12 @@
 // For each output direction ω: trace x + tω against the proxy to the hit point p (normal n). For every
 // probe i at x_i, with r_i = |p − x_i| and ω'_i = (p − x_i)/r_i, the probe sees p when
 //
-//   d_i(ω'_i) > 0  and  r_i ≤ d_i(ω'_i) · (1 + ε + κ·δ_i·min(tan α_i, 20))          (the shadow-map test)
+//   d_i(ω'_i) > 0  and  r_i ≤ d_i(ω'_i) · (1 + ε + κ·δ_i·min(tan α_i, 20)) + τ     (the shadow-map test)
 //
-// d_i: the probe's depth at the texel nearest ω'_i; ε = depth_bias (a relative tolerance for depth
-// maps from another source than the proxy, e.g. the lab's real scene); δ_i = √(4π/N_i) the probe's
+// d_i: the probe's depth at the texel nearest ω'_i; ε = depth_bias (relative: depth precision);
+// τ = depth_tolerance (absolute: how far the real surfaces a probe's depth map may show stand in front of
+// the proxy — a lamp 5 cm before its wall, a coarse model; occluders nearer than τ to the surface they
+// hide go undetected); δ_i = √(4π/N_i) the probe's
 // texel angle (N_i pixels); α_i the angle between ω'_i and n. The slope term is the usual slope-scaled
 // shadow-map bias: across one texel the depth of a surface seen at incidence α changes by ≈ d·δ·tan α,
 // so a nearest-texel lookup needs that much slack; κ = slope_bias. The visible probes' radiances
@@ -24,7 +26,7 @@
 //                          │ the probe that sees p sharpest counts most                   │
 //                          └──────────────────────────────────────────────────────────────┘
 // With visibility on, a probe's bilinear lookup is also depth-aware (edge_aware): of its four taps only
-// those whose depth is within r_i·(ε + 2κ·δ_i·tan α_i) of r_i count (weights renormalised), so that a
+// those whose depth is within r_i·(ε + 2κ·δ_i·tan α_i) + τ of r_i count (weights renormalised), so that a
 // bright surface behind a depth edge does not bleed onto the near one (e.g. a lit hall seen past a
 // corridor's corner: 100× brighter, one texel of smear is a wide band in the fused view).
 // Rays that hit nothing (windows, open ends) or whose p no probe sees fall back to the distant lookup
@@ -55,7 +57,8 @@ struct FuseDesc {
   int size = 64;                  // lat-long height, cube face edge, or disc/octahedral diameter (pixels)
   Blend blend = Blend::Footprint; // how the probes that see a point are combined
   bool visibility = true;         // the per-probe depth test; false reproduces the thesis's Fig. 7.8
-  double depth_bias = 0.02;       // ε: relative depth tolerance of the visibility test
+  double depth_bias = 0.01;       // ε: relative depth tolerance of the visibility test
+  double depth_tolerance = 0.10;  // τ: absolute tolerance (metres) for depth maps that show more than the proxy
   double slope_bias = 1.5;        // κ: multiplies δ_i·tan α_i, the slope-scaled part of the bias
   double angle_threshold = 0.0;   // angle blend: probes with ω·ω'_i below this cosine are left out
   double angle_power = 4.0;       // footprint blend: k of the angular term ((1 + s)/2)^k
