@@ -147,6 +147,7 @@ void run_path(const FuseOpts& o, const std::string& probes, const std::string& p
   fs::create_directories(dir / "lights");
   fu::LightTracker raw_tr({false, tau}), filt_tr({!no_filter, tau});
   std::vector<ibl::lights::LightSet> raw_sets, filt_sets;
+  std::vector<std::vector<int>> raw_ids, filt_ids;
   std::vector<ibl::sphere::EnvMap> maps;
   std::vector<std::pair<std::string, ibl::Image>> pics;
   auto bar = progress_bar();
@@ -158,8 +159,10 @@ void run_path(const FuseOpts& o, const std::string& probes, const std::string& p
     auto raw = fu::localize_lights(m, {nlights});
     double dt = k == 0 ? 0.0 : path[k].time - path[k - 1].time;
     raw_sets.push_back(raw_tr.update(raw, dt));
+    raw_ids.push_back(raw_tr.ids());
     auto filt = filt_tr.update(raw, dt);
     filt_sets.push_back(filt);
+    filt_ids.push_back(filt_tr.ids());
     maps.push_back(m.radiance);
     std::string name = fmt::format("{:04d}", k);
     ibl::io::write_image((dir / "frames" / (name + ".exr")).string(), m.radiance.image);
@@ -180,6 +183,10 @@ void run_path(const FuseOpts& o, const std::string& probes, const std::string& p
   double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   auto fr = fu::light_flicker(raw_sets), ff = fu::light_flicker(filt_sets), fm = fu::map_flicker(maps);
   double err_raw = fu::lights_vs_maps(raw_sets, maps), err_filt = fu::lights_vs_maps(filt_sets, maps);
+  double ex_raw = fu::excess_flicker(raw_sets, maps), ex_filt = fu::excess_flicker(filt_sets, maps);
+  constexpr int kShadowLights = 4;  // the lights a renderer would give shadow maps
+  double jit_raw = fu::shadow_light_jitter(raw_sets, raw_ids, kShadowLights);
+  double jit_filt = fu::shadow_light_jitter(filt_sets, filt_ids, kShadowLights);
   nlohmann::json j = {{"frames", path.size()},
                       {"lights", nlights},
                       {"time_constant", tau},
@@ -188,6 +195,8 @@ void run_path(const FuseOpts& o, const std::string& probes, const std::string& p
                       {"flicker", {{"map", {{"mean", fm.mean}, {"max", fm.max}}},
                                    {"lights_unfiltered", {{"mean", fr.mean}, {"max", fr.max}}},
                                    {"lights_filtered", {{"mean", ff.mean}, {"max", ff.max}}}}},
+                      {"excess_flicker", {{"unfiltered", ex_raw}, {"filtered", ex_filt}}},
+                      {"shadow_light_jitter_deg", {{"unfiltered", jit_raw * 180 / ibl::kPi}, {"filtered", jit_filt * 180 / ibl::kPi}}},
                       {"lights_vs_map", {{"unfiltered", err_raw}, {"filtered", err_filt}}},
                       {"out", out}};
   std::ofstream(dir / "path_summary.json") << j.dump(1) << "\n";
@@ -201,6 +210,9 @@ void run_path(const FuseOpts& o, const std::string& probes, const std::string& p
     fmt::print("    the fused maps themselves   {:7.4f} / {:7.4f}\n", fm.mean, fm.max);
     fmt::print("    lights, unfiltered          {:7.4f} / {:7.4f}\n", fr.mean, fr.max);
     fmt::print("    lights, filtered            {:7.4f} / {:7.4f}\n", ff.mean, ff.max);
+    fmt::print("  change the maps do not make (RMS / mean): unfiltered {:.4f}, filtered {:.4f}\n", ex_raw, ex_filt);
+    fmt::print("  shadow lights' jump per frame (first {}, luminance-weighted): unfiltered {:.2f}°, filtered {:.2f}°\n",
+               kShadowLights, jit_raw * 180 / ibl::kPi, jit_filt * 180 / ibl::kPi);
     fmt::print("  lights vs their map's irradiance (RMS / mean): unfiltered {:.4f}, filtered {:.4f}\n", err_raw, err_filt);
     fmt::print("  wrote {}/frames/NNNN.exr (+_depth), {}/lights/NNNN.json, {}/path_summary.json, {}\n", out, out, out, png);
   });

@@ -266,6 +266,42 @@ FlickerStats map_flicker(const std::vector<sphere::EnvMap>& maps) {
   return flicker_of(fields);
 }
 
+double excess_flicker(const std::vector<lights::LightSet>& frames, const std::vector<sphere::EnvMap>& maps) {
+  if (frames.size() != maps.size()) fail(ErrorKind::Internal, "excess_flicker: {} light sets for {} maps", frames.size(), maps.size());
+  std::vector<std::vector<double>> e, m;
+  for (size_t k = 0; k < frames.size(); ++k) {
+    e.push_back(lum(lights::irradiance_from_lights(frames[k].lights, flicker_normals())));
+    m.push_back(lum(lights::irradiance_ground_truth(maps[k], flicker_normals())));
+  }
+  double sum = 0;
+  for (size_t k = 1; k < frames.size(); ++k) {
+    std::vector<double> a(e[k].size()), b(e[k].size(), 0.0);
+    for (size_t i = 0; i < a.size(); ++i) a[i] = (e[k][i] - e[k - 1][i]) - (m[k][i] - m[k - 1][i]);
+    sum += rel_rms(a, b, m[k]);
+  }
+  return frames.size() > 1 ? sum / (frames.size() - 1) : 0.0;
+}
+
+double shadow_light_jitter(const std::vector<lights::LightSet>& frames, const std::vector<std::vector<int>>& ids, int count) {
+  if (frames.size() != ids.size()) fail(ErrorKind::Internal, "shadow_light_jitter: {} light sets for {} id lists", frames.size(), ids.size());
+  double sum = 0;
+  int pairs = 0;
+  for (size_t k = 1; k < frames.size(); ++k) {
+    double a = 0, w = 0;
+    for (int j = 0; j < count && j < static_cast<int>(frames[k].lights.size()); ++j) {
+      for (size_t q = 0; q < ids[k - 1].size(); ++q) {
+        if (ids[k - 1][q] != ids[k][j]) continue;
+        double y = luminance(frames[k].lights[j].irradiance);
+        double c = std::clamp(dot(frames[k].lights[j].direction, frames[k - 1].lights[q].direction), -1.0, 1.0);
+        a += y * std::acos(c);
+        w += y;
+      }
+    }
+    if (w > 0) { sum += a / w; ++pairs; }
+  }
+  return pairs ? sum / pairs : 0.0;
+}
+
 double lights_vs_maps(const std::vector<lights::LightSet>& frames, const std::vector<sphere::EnvMap>& maps) {
   if (frames.size() != maps.size()) fail(ErrorKind::Internal, "lights_vs_maps: {} light sets for {} maps", frames.size(), maps.size());
   double sum = 0;

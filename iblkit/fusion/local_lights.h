@@ -86,6 +86,13 @@ struct FlickerStats {
 FlickerStats light_flicker(const std::vector<lights::LightSet>& frames);
 // The same measure for a sequence of maps (their exact irradiance fields): the change the scene itself makes.
 FlickerStats map_flicker(const std::vector<sphere::EnvMap>& maps);
+// The part of the lights' change that the maps do not make: mean over frame pairs of
+// RMS_n |(E_k − E_{k−1}) − (M_k − M_{k−1})| / mean_n M_k (E: the lights' field, M: the map's).
+double excess_flicker(const std::vector<lights::LightSet>& frames, const std::vector<sphere::EnvMap>& maps);
+// How far the shadow-casting lights jump: mean over frame pairs of the luminance-weighted angle (radians)
+// between each of the first `count` lights of frame k (shadow-map priority order) and the light with
+// the same track id in frame k−1 (lights without one there are skipped).
+double shadow_light_jitter(const std::vector<lights::LightSet>& frames, const std::vector<std::vector<int>>& ids, int count);
 // Mean over frames of RMS_n |E_lights(n) − E_map(n)| / mean_n E_map(n): how far filtered lights lag
 // behind (or raw lights miss) the map they stand for.
 double lights_vs_maps(const std::vector<lights::LightSet>& frames, const std::vector<sphere::EnvMap>& maps);
