@@ -264,6 +264,7 @@ void setup(CLI::App& app) {
   auto* dep = app.add_subcommand("depth", "Trace the probes' missing depth maps on the proxy and cache them beside the probes");
   dep->add_option("probes", o->depth_probes, "probe set (iblkit.probes/1)")->required();
   dep->add_flag("--force", o->force, "trace every depth map again (overwrites the manifest's depth files too)");
+  dep->footer("Example:\n  iblkit fuse depth tc/probes.json\n  iblkit fuse depth tc/probes.json --force");
   dep->callback([o] { run_depth(o->depth_probes, o->force); });
   setup_eval(app);
   app.require_subcommand(0, 1);

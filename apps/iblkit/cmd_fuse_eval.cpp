@@ -221,6 +221,8 @@ void setup_eval(CLI::App& fuse) {
   c->add_option("--view", o->view, "also a pinhole view (90°) from each point along this direction x,y,z");
   c->add_option("-o,--out", o->out, "folder for eval.json and pictures")->required();
   add_fuse_options(*c, o->f);
+  c->footer("Example:\n  iblkit lab capture t-corridor --fusion --probe 0,1.5,-1 --probe 0,1.5,5 --size 128 --out tc\n"
+            "  iblkit fuse eval tc/probes.json --scene t-corridor --at -2,1.5,-1 --view 1,0,0 --out eval");
   c->callback([o] { run_eval(*o); });
 }
 
