@@ -236,7 +236,8 @@ void demo_step(DemoContext& ctx) {
   fs::create_directories(dir);
   auto scene = ibl::lab::load_scene("t-corridor");
   ibl::lab::SequenceDesc sd;
-  sd.capture.size = 64;
+  sd.capture.size = 128;
+  sd.capture.samples = 2;  // anti-aliased probes: a point-sampled light's edge aliases in every fused map
   sd.capture.render = scene.render;
   sd.out_dir = (dir / "probes").string();
   sd.sheet_probes = 0;
