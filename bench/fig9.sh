@@ -4,16 +4,17 @@
 # beside renderings lit by SH grids of 8³, 16³, 32³ and 64³ built from a mirror-ball sequence of the
 # same scene captured without the object and the table. Prints the error table and writes
 # OUT/fig9_compare.png.
-#   bench/fig9.sh BUILD_DIR/iblkit [OUT] [PROBES]
+#   bench/fig9.sh BUILD_DIR/iblkit [OUT] [PROBES] [PROBE_SIZE]
 set -euo pipefail
 BIN=${1:?usage: fig9.sh path/to/iblkit [out-dir] [probes]}
 OUT=${2:-fig9-out}
 PROBES=${3:-4000}
+SIZE=${4:-48}
 SCENE="$(dirname "$0")/../examples/low-scene2.json"
 mkdir -p "$OUT"
 if [ ! -f "$OUT/seq/sequence.json" ]; then
   /usr/bin/time -f "capture: %e s wall, %M KB peak" "$BIN" lab capture "$SCENE" --random "$PROBES" --mapping mirrorball \
-    --size 48 --samples 2 --out "$OUT/seq" --quiet
+    --size "$SIZE" --samples 2 --out "$OUT/seq" --quiet
 fi
 lights=()
 for g in 8 16 32 64; do

@@ -46,6 +46,7 @@ void setup(CLI::App& app) {
     std::string truth;
     int truth_samples = 4, truth_bounces = 0;
     double floor_size = 6;
+    std::string luminaire = "0,1,0", luminaire_dir = "0,0,1";
   };
   auto* o = new Opts();
   app.add_option("scene", o->scene,
@@ -57,7 +58,9 @@ void setup(CLI::App& app) {
                  "frame each (OUT_<name>.ext)")
       ->required();
   app.add_option("--at", o->at, "place the object's centre here, x,y,z (e.g. inside an SH grid's volume)")->capture_default_str();
-  app.add_option("--object-size", o->object_size, "object size in metres")->check(CLI::Range(0.001, 1000.0))->capture_default_str();
+  app.add_option("--object-size", o->object_size, "object size in metres; 0 keeps a mesh file's own size and place (a room)")
+      ->check(CLI::Range(0.0, 1000.0))
+      ->capture_default_str();
   app.add_option("-o,--out", o->out, "output .png (tone mapped) or .exr (linear)")->capture_default_str();
   app.add_option("--backend", o->backend, "cpu, gl or auto (gl when available)")->check(CLI::IsMember({"cpu", "gl", "auto"}))->capture_default_str();
   app.add_option("--size", o->size, "frame size WxH")->capture_default_str();
@@ -74,7 +77,7 @@ void setup(CLI::App& app) {
                  "or from its --bands SH (sh, band-limited)")
       ->check(CLI::IsMember({"map", "sh"}))
       ->capture_default_str();
-  app.add_option("--floor-size", o->floor_size, "side of the square floor under the object, metres (a table top when small)")
+  app.add_option("--floor-size", o->floor_size, "side of the square floor under the object, metres (a table top when small; 0: no floor)")
       ->check(CLI::Range(0.0, 1000.0))
       ->capture_default_str();
   app.add_option("--truth", o->truth,
@@ -84,6 +87,9 @@ void setup(CLI::App& app) {
   app.add_option("--truth-bounces", o->truth_bounces, "--truth: indirect bounces (match the capture's: lab capture --bounces)")
       ->check(CLI::Range(0, 16))
       ->capture_default_str();
+  app.add_option("--luminaire", o->luminaire, "a near-field dataset's luminaire: centre of its sampling plane, x,y,z")
+      ->capture_default_str();
+  app.add_option("--luminaire-dir", o->luminaire_dir, "the direction the luminaire shines, x,y,z")->capture_default_str();
   app.add_option("--eye", o->eye, "camera position x,y,z")->capture_default_str();
   app.add_option("--target", o->target, "camera target x,y,z")->capture_default_str();
   auto& rd = iblcli::add_probe_read_options(app);
@@ -105,7 +111,8 @@ void setup(CLI::App& app) {
     object.bounds(&lo, &hi);
     Mesh floor = make_floor(o->floor_size, lo.y - 1e-3);  // just under the object's lowest point
     Material mat{{0.75, 0.75, 0.75}, Vec3{1, 1, 1} * o->gloss, o->exponent};
-    d.objects = {{&object, mat}, {&floor, Material{{0.5, 0.5, 0.5}, {0, 0, 0}, 1}}};
+    d.objects = {{&object, mat}};
+    if (o->floor_size > 0) d.objects.push_back({&floor, Material{{0.5, 0.5, 0.5}, {0, 0, 0}, 1}});
     std::string backend = o->backend;
 #ifdef IBLKIT_HAVE_GL
     std::unique_ptr<gl::Context> ctx;
@@ -137,12 +144,19 @@ void setup(CLI::App& app) {
     const fs::path out_path(o->out), stem = fs::path(o->out).replace_extension();
     const std::string ext = out_path.extension().string();
     std::vector<std::pair<std::string, Image>> sheet, errors;
+    iblcli::LightingOptions lopt;
+    lopt.bands = o->bands;
+    lopt.shadows = o->shadows;
+    lopt.glossy_exponent = o->gloss > 0 && o->glossy == "map" ? o->exponent : 0.0;
+    lopt.read = rd;
+    lopt.luminaire.position = iblcli::parse_vec3(o->luminaire, "--luminaire");
+    lopt.luminaire.forward = normalize(iblcli::parse_vec3(o->luminaire_dir, "--luminaire-dir"));
     if (photo) sheet.push_back({"lab photograph (truth)", io::tonemap(photo->radiance, td)});
     nlohmann::json renders = nlohmann::json::array();
     for (const std::string& light : o->lights) {
       d.lighting = Lighting{};
       std::string kind;
-      iblcli::load_lighting(light, o->bands, o->shadows, rd, o->gloss > 0 && o->glossy == "map" ? o->exponent : 0.0, &d.lighting, &kind);
+      iblcli::load_lighting(light, lopt, &d.lighting, &kind);
       nlohmann::json j = {{"scene", o->scene}, {"light", light}, {"lighting", kind}, {"size", o->size}};
       RenderResult f;
 #ifdef IBLKIT_HAVE_GL

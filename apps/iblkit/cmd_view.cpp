@@ -58,10 +58,15 @@ void run(const ViewOpts& o, const ibl::io::EnvReadDesc& rd) {
   if (std::sscanf(o.size.c_str(), "%dx%d", &w, &h) != 2 || w < 16 || h < 16 || w > 8192 || h > 8192)
     fail(ErrorKind::Value, "--size '{}': expected WxH, e.g. 960x720", o.size);
   // Everything that can fail on input is read before a window opens.
+  iblcli::LightingOptions lopt;
+  lopt.bands = o.bands;
+  lopt.shadows = o.shadows;
+  lopt.glossy_exponent = o.gloss > 0 ? o.exponent : 0.0;
+  lopt.read = rd;
   std::vector<Lighting> lightings(o.lights.size());
   std::vector<std::string> kinds(o.lights.size());
   for (size_t i = 0; i < o.lights.size(); ++i)
-    iblcli::load_lighting(o.lights[i], o.bands, o.shadows, rd, o.gloss > 0 ? o.exponent : 0.0, &lightings[i], &kinds[i]);
+    iblcli::load_lighting(o.lights[i], lopt, &lightings[i], &kinds[i]);
   const Vec3 at = iblcli::parse_vec3(o.at, "--at");
   const Mesh base = iblcli::make_object(o.scene, o.object_size, o.triangles, {0, 0, 0});
 

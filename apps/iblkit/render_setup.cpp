@@ -11,6 +11,7 @@
 #include "iblkit/geometry/mesh_io.h"
 #include "iblkit/ilf/shgrid.h"
 #include "iblkit/lights/light_set.h"
+#include "iblkit/nearfield/dataset.h"
 #include "iblkit/render/prefilter.h"
 #include "iblkit/sh/project.h"
 
@@ -20,8 +21,10 @@ namespace fs = std::filesystem;
 using namespace ibl;
 using namespace ibl::render;
 
-void load_lighting(const std::string& path, int bands, int shadows, const io::EnvReadDesc& rd, double glossy_exponent, Lighting* L,
-                   std::string* kind) {
+void load_lighting(const std::string& path, const LightingOptions& o, Lighting* L, std::string* kind) {
+  const int bands = o.bands, shadows = o.shadows;
+  const double glossy_exponent = o.glossy_exponent;
+  const io::EnvReadDesc& rd = o.read;
   std::string ext = fs::path(path).extension().string();
   if (ext == ".shgrid") {
     ilf::SHGrid g = ilf::read_shgrid(path);
@@ -69,6 +72,12 @@ void load_lighting(const std::string& path, int bands, int shadows, const io::En
                      : fmt::format("{} directional lights", set.lights.size());
       return;
     }
+    if (format == "iblkit.nearfield/1") {
+      nearfield::Dataset ds = nearfield::read_dataset(path);
+      L->spotlights = nearfield::spotlights(ds, o.luminaire, shadows > 0);
+      *kind = fmt::format("near-field luminaire {} ({}x{} textured spotlights{})", ds.name, ds.nx, ds.ny, shadows > 0 ? ", shadows" : "");
+      return;
+    }
     if (format == "iblkit.sh/1") {
       sh::Coeffs c;
       c.bands = j.at("bands").get<int>();
@@ -79,7 +88,7 @@ void load_lighting(const std::string& path, int bands, int shadows, const io::En
       *kind = fmt::format("SH environment, {} bands", c.bands);
       return;
     }
-    fail(ErrorKind::Format, "{}: \"format\" is '{}'; expected iblkit.lights/1 or iblkit.sh/1", path, format);
+    fail(ErrorKind::Format, "{}: \"format\" is '{}'; expected iblkit.lights/1, iblkit.sh/1 or iblkit.nearfield/1", path, format);
   }
   auto env = io::read_envmap(path, rd);
   L->environment = sh::project(env, bands);
@@ -93,12 +102,14 @@ void load_lighting(const std::string& path, int bands, int shadows, const io::En
 
 Mesh make_object(const std::string& scene, double size, int triangles, Vec3 at) {
   Mesh object;
+  if (!(size > 0) && (scene == "blob" || scene == "sphere")) fail(ErrorKind::Value, "--object-size must be > 0 for the {}", scene);
   if (scene == "blob") {
     object = make_blob(triangles, size);
   } else if (scene == "sphere") {
     object = make_sphere(size / 2, 128, 256);
   } else {
     object = from_trimesh(geometry::read_mesh(scene));
+    if (size == 0) return object;  // as the file has it
     // Centre the file's mesh on the origin and scale its largest extent to `size`.
     Vec3 lo, hi;
     object.bounds(&lo, &hi);

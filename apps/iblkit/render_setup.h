@@ -5,20 +5,31 @@
 #include <string>
 
 #include "iblkit/io/envmap_io.h"
+#include "iblkit/nearfield/spotlight.h"
 #include "iblkit/render/mesh.h"
 #include "iblkit/render/shading.h"
 
 namespace iblcli {
 
+// How --light files are read (render and view share the options).
+struct LightingOptions {
+  int bands = 5;                  // SH bands when projecting a probe
+  int shadows = 4;                // lights of a light set (priority order) that cast shadows
+  double glossy_exponent = 0;     // > 0: also a prefiltered Phong map of a probe for this exponent
+  ibl::io::EnvReadDesc read;      // probe reading (--mapping, --dead-angle, --sanitize)
+  ibl::nearfield::Placement luminaire;  // where a near-field dataset's luminaire sits and shines
+};
+
 // Reads a --light file into L: an SH grid (.shgrid), an iblkit.lights/1 file (lights with a
-// position and a set origin become point lights; the first `shadows` cast shadows), an iblkit.sh/1
-// file, or a probe image (projected to `bands` SH bands, plus a prefiltered Phong map for
-// `glossy_exponent` when it is > 0). *kind receives a one-line description.
-void load_lighting(const std::string& path, int bands, int shadows, const ibl::io::EnvReadDesc& rd, double glossy_exponent,
-                   ibl::render::Lighting* L, std::string* kind);
+// position and a set origin become point lights), an iblkit.nearfield/1 dataset (a textured
+// spotlight per filter position, Granier et al. Eq. 14, placed by o.luminaire), an iblkit.sh/1
+// file, or a probe image (projected to SH, plus a prefiltered Phong map). *kind gets a one-line
+// description.
+void load_lighting(const std::string& path, const LightingOptions& o, ibl::render::Lighting* L, std::string* kind);
 
 // "blob" (the procedural bunny stand-in, `triangles`), "sphere", or a mesh file centred and scaled
-// to `size` (its largest extent), then moved to `at`.
+// to `size` (its largest extent), then moved to `at`; size 0 keeps a mesh file where and as large
+// as it is (a room such as examples/crypt.obj).
 ibl::render::Mesh make_object(const std::string& scene, double size, int triangles, ibl::Vec3 at);
 
 }  // namespace iblcli
