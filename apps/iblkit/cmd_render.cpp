@@ -47,6 +47,8 @@ void setup(CLI::App& app) {
     int truth_samples = 4, truth_bounces = 0;
     double floor_size = 6;
     std::string luminaire = "0,1,0", luminaire_dir = "0,0,1";
+    std::string texture, lobe = "phong";
+    double exposure = 0;
   };
   auto* o = new Opts();
   app.add_option("scene", o->scene,
@@ -72,6 +74,11 @@ void setup(CLI::App& app) {
   app.add_option("--triangles", o->triangles, "triangles of the blob")->check(CLI::Range(100, 5000000))->capture_default_str();
   app.add_option("--gloss", o->gloss, "weight of the glossy Phong lobe (0..1)")->check(CLI::Range(0.0, 1.0));
   app.add_option("--exponent", o->exponent, "Phong exponent of the glossy lobe")->check(CLI::Range(1.0, 10000.0));
+  app.add_option("--lobe", o->lobe, "glossy lobe: phong, or blinn (Blinn-Phong for lights; SH and maps use Phong of exponent/4)")
+      ->check(CLI::IsMember({"phong", "blinn"}))
+      ->capture_default_str();
+  app.add_option("--texture", o->texture, "albedo texture of the object (sRGB PNG/JPG or linear EXR), at the mesh's UVs");
+  app.add_option("--exposure", o->exposure, "stops added to the auto exposure of PNG output")->capture_default_str();
   app.add_option("--glossy", o->glossy,
                  "probe lighting with --gloss > 0: the glossy lobe from a prefiltered Phong map of the probe (map) "
                  "or from its --bands SH (sh, band-limited)")
@@ -110,7 +117,11 @@ void setup(CLI::App& app) {
     Vec3 lo, hi;
     object.bounds(&lo, &hi);
     Mesh floor = make_floor(o->floor_size, lo.y - 1e-3);  // just under the object's lowest point
-    Material mat{{0.75, 0.75, 0.75}, Vec3{1, 1, 1} * o->gloss, o->exponent};
+    Material mat{{0.75, 0.75, 0.75}, Vec3{1, 1, 1} * o->gloss, o->exponent, o->lobe == "blinn" ? Lobe::BlinnPhong : Lobe::Phong};
+    if (!o->texture.empty()) {
+      mat.albedo = {1, 1, 1};
+      mat.texture = std::make_shared<Image>(io::read_image(o->texture).with_channels(3));
+    }
     d.objects = {{&object, mat}};
     if (o->floor_size > 0) d.objects.push_back({&floor, Material{{0.5, 0.5, 0.5}, {0, 0, 0}, 1}});
     std::string backend = o->backend;
@@ -133,13 +144,14 @@ void setup(CLI::App& app) {
     // The lab photograph, once for every lighting.
     std::optional<iblcli::LabPhotograph> photo;
     io::ToneMapDesc td;  // pictures: auto exposure, or with --truth one exposure for all (the truth's)
+    td.exposure_stops = o->exposure;
     if (!o->truth.empty()) {
       auto t0 = std::chrono::steady_clock::now();
       photo = iblcli::photograph_frame(o->truth, d, o->truth_samples, o->truth_bounces, iblcli::progress_bar());
       iblcli::progress_done();
       photo->ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
       td.auto_exposure = false;
-      td.exposure_stops = std::log2(photo->median > 0 ? 0.25 / photo->median : 1.0);
+      td.exposure_stops = o->exposure + std::log2(photo->median > 0 ? 0.25 / photo->median : 1.0);
     }
     const fs::path out_path(o->out), stem = fs::path(o->out).replace_extension();
     const std::string ext = out_path.extension().string();
@@ -147,7 +159,7 @@ void setup(CLI::App& app) {
     iblcli::LightingOptions lopt;
     lopt.bands = o->bands;
     lopt.shadows = o->shadows;
-    lopt.glossy_exponent = o->gloss > 0 && o->glossy == "map" ? o->exponent : 0.0;
+    lopt.glossy_exponent = o->gloss > 0 && o->glossy == "map" ? mat.environment_exponent() : 0.0;
     lopt.read = rd;
     lopt.luminaire.position = iblcli::parse_vec3(o->luminaire, "--luminaire");
     lopt.luminaire.forward = normalize(iblcli::parse_vec3(o->luminaire_dir, "--luminaire-dir"));

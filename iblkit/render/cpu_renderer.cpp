@@ -185,7 +185,14 @@ RenderResult render_cpu(const FrameDesc& d, const ProgressFn& progress) {
       VisibilityFn vis;
       if (shadows)
         vis = [&](Vec3 q, Vec3 l, double dist) { return !shadows->occluded(q + n * d.shadow_bias, l, dist); };
-      f.color.set_rgb(x, y, shade(d.lighting, o.material, p, n, v, vis));
+      if (o.material.texture) {
+        Vec2 uv = m.has_uvs() ? m.uv(i0) * b0 + m.uv(i1) * h.b1 + m.uv(i2) * h.b2 : Vec2{0, 0};
+        Material tm = o.material;
+        tm.albedo = tm.albedo * texture_albedo(*o.material.texture, uv);
+        f.color.set_rgb(x, y, shade(d.lighting, tm, p, n, v, vis));
+      } else {
+        f.color.set_rgb(x, y, shade(d.lighting, o.material, p, n, v, vis));
+      }
       f.coverage.at(x, y, 0) = 1.0f;
     }
     report(progress, "shade", static_cast<double>(++rows_done) / H);

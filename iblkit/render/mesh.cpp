@@ -21,6 +21,9 @@ void Mesh::bounds(Vec3* lo, Vec3* hi) const {
 
 void Mesh::append(const Mesh& o) {
   uint32_t base = static_cast<uint32_t>(vertex_count());
+  const bool keep_uvs = (has_uvs() || vertex_count() == 0) && o.has_uvs();
+  if (keep_uvs) uvs.insert(uvs.end(), o.uvs.begin(), o.uvs.end());
+  else uvs.clear();
   positions.insert(positions.end(), o.positions.begin(), o.positions.end());
   normals.insert(normals.end(), o.normals.begin(), o.normals.end());
   for (uint32_t i : o.indices) indices.push_back(base + i);
@@ -62,6 +65,7 @@ Mesh sphere_grid(int rings, int segments, R&& r) {
       Vec3 d{std::sin(th) * std::cos(ph), std::cos(th), -std::sin(th) * std::sin(ph)};
       Vec3 p = d * r(d);
       m.positions.insert(m.positions.end(), {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z)});
+      m.uvs.insert(m.uvs.end(), {static_cast<float>(static_cast<double>(j) / segments), static_cast<float>(1.0 - static_cast<double>(i) / rings)});
     }
   }
   auto id = [&](int i, int j) { return static_cast<uint32_t>(i * (segments + 1) + j); };
@@ -81,6 +85,8 @@ Mesh from_trimesh(const geometry::TriMesh& m) {
     out.positions.insert(out.positions.end(), {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z)});
   out.indices.reserve(m.triangles.size() * 3);
   for (const auto& t : m.triangles) out.indices.insert(out.indices.end(), t.begin(), t.end());
+  if (m.uvs.size() == m.positions.size())
+    for (Vec2 uv : m.uvs) out.uvs.insert(out.uvs.end(), {static_cast<float>(uv.x), static_cast<float>(uv.y)});
   out.compute_normals();
   return out;
 }
@@ -120,6 +126,7 @@ Mesh make_floor(double size, double height) {
   float h = static_cast<float>(size / 2), y = static_cast<float>(height);
   m.positions = {-h, y, -h, h, y, -h, h, y, h, -h, y, h};
   m.normals = {0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0};
+  m.uvs = {0, 1, 1, 1, 1, 0, 0, 0};
   m.indices = {0, 2, 1, 0, 3, 2};
   return m;
 }

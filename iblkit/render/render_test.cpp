@@ -352,6 +352,55 @@ TEST_F(RenderGl, TexturedSpotlightsWithShadowsAgreeWithCpu) {
   }
 }
 
+// Albedo textures at the meshes' UVs and the Blinn-Phong lobe (lights exact; SH and maps through the
+// Phong lobe of s/4), on both renderers.
+TEST_F(RenderGl, TexturedBlinnPhongAgreesWithCpu) {
+  gl::Context ctx;
+  Mesh blob = make_blob(6000, 0.5), floor = make_floor(3, -0.25);
+  ASSERT_TRUE(blob.has_uvs());
+  ASSERT_TRUE(floor.has_uvs());
+  auto tex = std::make_shared<Image>(64, 32, 3);
+  for (int y = 0; y < 32; ++y)
+    for (int x = 0; x < 64; ++x) tex->set_rgb(x, y, ((x / 8 + y / 8) % 2) ? Vec3{0.9, 0.8, 0.2} : Vec3{0.1, 0.3, 0.8});
+  FrameDesc d;
+  d.camera.eye = {0.3, 0.9, 1.4};
+  d.camera.target = {0, 0, 0};
+  d.camera.width = 128;
+  d.camera.height = 96;
+  Material shiny{{1, 1, 1}, {0.3, 0.3, 0.3}, 80, Lobe::BlinnPhong, tex};
+  Material matte{{0.6, 0.6, 0.6}, {0, 0, 0}, 1, Lobe::Phong, tex};
+  d.objects = {{&blob, shiny}, {&floor, matte}};
+  d.lighting.lights = {{normalize(Vec3{0.5, 1, 0.3}), {2, 2, 2}, false}};
+  sh::Coeffs env(3);
+  env.c[0] = Vec3{1, 1, 1} * std::sqrt(4 * kPi) * 0.4;
+  env.c[2] = Vec3{0.3, 0.3, 0.3};
+  d.lighting.environment = env;
+  RenderResult cpu = render_cpu(d);
+  // The texture shows: the floor's two colours differ by far more than the tolerance.
+  double lo = 1e9, hi = 0;
+  for (int x = 0; x < 128; ++x) {
+    double v = cpu.color.at(x, 90, 2);
+    lo = std::min(lo, v);
+    hi = std::max(hi, v);
+  }
+  EXPECT_GT(hi, 2 * lo);
+  for (bool deferred : {false, true}) {
+    gl::Renderer r({deferred});
+    RenderResult g = r.render(d);
+    if (const char* dir = std::getenv("IBLKIT_TEST_PICTURES")) {
+      io::write_image(std::string(dir) + "/textured_cpu.png", io::tonemap(cpu.color));
+      io::write_image(std::string(dir) + "/textured_gl.png", io::tonemap(g.color));
+    }
+    Agreement a = compare(cpu, g);
+    constexpr double kTexMedianTol = 2e-3;  // float shading and GL's 8-bit bilinear weights
+    constexpr double kTexP99Tol = 0.1;      // texels at the checker's edges, where the weights' rounding shows
+    EXPECT_GT(a.pixels, 4000) << "deferred " << deferred;
+    EXPECT_LT(a.coverage_mismatch, kCoverageTol) << "deferred " << deferred;
+    EXPECT_LT(a.median, kTexMedianTol) << "deferred " << deferred;
+    EXPECT_LT(a.p99, kTexP99Tol) << "deferred " << deferred;
+  }
+}
+
 // A probe's glossy reflection through a prefiltered Phong map (render/prefilter.h): both renderers
 // read the same texels with the same bilinear filter.
 TEST_F(RenderGl, GlossyMapAgreesWithCpu) {

@@ -45,12 +45,13 @@ Vec3 shade(const Lighting& lighting, const Material& m, Vec3 p, Vec3 n, Vec3 v, 
   } else if (lighting.environment) {
     c = &*lighting.environment;
   }
-  const GlossyMap* gmap = lighting.grid ? nullptr : lighting.glossy_map(m.exponent);
+  const double s_env = m.environment_exponent();
+  const GlossyMap* gmap = lighting.grid ? nullptr : lighting.glossy_map(s_env);
   if (gmap) G += lookup(*gmap, r);
   if (c && c->bands > 0) {
     int bands = c->bands;
     auto diffuse = sh::clamped_cosine_zh(bands);
-    auto glossy = sh::phong_zh(bands, m.exponent);
+    auto glossy = sh::phong_zh(bands, s_env);
     std::vector<double> yn(bands * bands), yr(bands * bands);
     sh::eval_basis(bands, n, yn.data());
     sh::eval_basis(bands, r, yr.data());
@@ -61,15 +62,21 @@ Vec3 shade(const Lighting& lighting, const Material& m, Vec3 p, Vec3 n, Vec3 v, 
         if (!gmap) G += c->c[k] * (glossy[l] * yr[k]);
       }
   }
-  const double lobe_norm = (m.exponent + 1) / kTwoPi;
+  const bool blinn = m.lobe == Lobe::BlinnPhong;
+  const double lobe_norm = blinn ? (m.exponent + 8) / (8 * kPi) : (m.exponent + 1) / kTwoPi;
   auto add_light = [&](Vec3 l, Vec3 irradiance, bool shadow, double distance) {
     double ndl = dot(n, l);
     if (ndl <= 0) return;
     if (irradiance.x == 0 && irradiance.y == 0 && irradiance.z == 0) return;  // no shadow ray for no light
     if (shadow && visible && !visible(p, l, distance)) return;
     E += irradiance * ndl;
-    double rdl = dot(r, l);
-    if (rdl > 0) G += irradiance * (lobe_norm * std::pow(rdl, m.exponent));
+    if (blinn) {
+      double ndh = dot(n, normalize(l + v));
+      if (ndh > 0) G += irradiance * (lobe_norm * std::pow(ndh, m.exponent) * ndl);
+    } else {
+      double rdl = dot(r, l);
+      if (rdl > 0) G += irradiance * (lobe_norm * std::pow(rdl, m.exponent));
+    }
   };
   for (const DirectionalLight& L : lighting.lights) add_light(L.direction, L.irradiance, L.shadow, std::numeric_limits<double>::infinity());
   for (const PointLight& L : lighting.point_lights) {
@@ -91,6 +98,10 @@ Vec3 shade(const Lighting& lighting, const Material& m, Vec3 p, Vec3 n, Vec3 v, 
   Vec3 out = m.albedo * E * (1.0 / kPi) + m.specular * G;
   // SH ringing can make a few values negative; light is never negative.
   return {std::max(0.0, out.x), std::max(0.0, out.y), std::max(0.0, out.z)};
+}
+
+Vec3 texture_albedo(const Image& texture, Vec2 uv) {
+  return texture.view().sample_rgb_uv(uv.x, 1.0 - uv.y, Wrap::Repeat);
 }
 
 }  // namespace ibl::render

@@ -16,9 +16,11 @@
 // A distant probe may instead give G(r) through a prefiltered map (render/prefilter.h): G(r) = G_s(r).
 #pragma once
 #include <functional>
+#include <memory>
 #include <optional>
 #include <vector>
 
+#include "iblkit/core/image.h"
 #include "iblkit/core/vec.h"
 #include "iblkit/nearfield/spotlight.h"
 #include "iblkit/render/prefilter.h"
@@ -26,11 +28,26 @@
 
 namespace ibl::render {
 
+enum class Lobe {
+  Phong,       // (s+1)/2π (r·l)^s: the lobe Löw et al. filter SH with (zonal harmonics about r)
+  BlinnPhong,  // (s+8)/8π (n·h)^s (n·l) for lights (h the half vector); for SH and prefiltered maps,
+               // the Phong lobe of exponent s/4, its usual equivalent (Blinn's (n·h)^s ≈ (r·l)^(s/4))
+};
+
 struct Material {
   Vec3 albedo{0.8, 0.8, 0.8};  // Lambertian reflectance (RGB, 0..1)
-  Vec3 specular{0, 0, 0};      // weight of the normalised Phong lobe (RGB)
-  double exponent = 20.0;      // Phong exponent s of the glossy lobe
+  Vec3 specular{0, 0, 0};      // weight of the normalised glossy lobe (RGB)
+  double exponent = 20.0;      // exponent s of the glossy lobe
+  Lobe lobe = Lobe::Phong;     // shape of the glossy lobe
+  // Albedo texture (linear RGB), multiplying `albedo` at the mesh's UVs: bilinear, repeating, uv (0,0)
+  // at the image's bottom-left (OBJ/GL). Meshes without UVs read it at (0,0).
+  std::shared_ptr<const Image> texture;
+  // Exponent of the Phong lobe that filters SH and prefiltered maps for this material.
+  double environment_exponent() const { return lobe == Lobe::BlinnPhong ? exponent / 4 : exponent; }
 };
+
+// The albedo texture's value at uv (the lookup both renderers make).
+Vec3 texture_albedo(const Image& texture, Vec2 uv);
 
 struct DirectionalLight {
   Vec3 direction;       // unit direction towards the light

@@ -17,21 +17,29 @@ namespace ibl::render::gl {
 namespace {
 
 struct MeshBuffers {
-  GLuint vao = 0, vbo[2] = {0, 0}, ebo = 0;
+  GLuint vao = 0, vbo[3] = {0, 0, 0}, ebo = 0;
   GLsizei count = 0;
 };
+
+// UVs of a mesh for the GPU: its own, or zeros.
+std::vector<float> gpu_uvs(const Mesh& m) {
+  return m.has_uvs() ? m.uvs : std::vector<float>(2 * m.vertex_count(), 0.0f);
+}
 
 MeshBuffers upload(const Mesh& m) {
   MeshBuffers b;
   glCreateVertexArrays(1, &b.vao);
-  glCreateBuffers(2, b.vbo);
+  glCreateBuffers(3, b.vbo);
   glCreateBuffers(1, &b.ebo);
+  const std::vector<float> uv = gpu_uvs(m);
   glNamedBufferStorage(b.vbo[0], static_cast<GLsizeiptr>(m.positions.size() * sizeof(float)), m.positions.data(), 0);
   glNamedBufferStorage(b.vbo[1], static_cast<GLsizeiptr>(m.normals.size() * sizeof(float)), m.normals.data(), 0);
+  glNamedBufferStorage(b.vbo[2], static_cast<GLsizeiptr>(std::max<size_t>(1, uv.size()) * sizeof(float)), uv.data(), 0);
   glNamedBufferStorage(b.ebo, static_cast<GLsizeiptr>(m.indices.size() * sizeof(uint32_t)), m.indices.data(), 0);
-  for (int a = 0; a < 2; ++a) {
-    glVertexArrayVertexBuffer(b.vao, a, b.vbo[a], 0, 3 * sizeof(float));
-    glVertexArrayAttribFormat(b.vao, a, 3, GL_FLOAT, GL_FALSE, 0);
+  for (int a = 0; a < 3; ++a) {
+    const int n = a == 2 ? 2 : 3;
+    glVertexArrayVertexBuffer(b.vao, a, b.vbo[a], 0, n * sizeof(float));
+    glVertexArrayAttribFormat(b.vao, a, n, GL_FLOAT, GL_FALSE, 0);
     glVertexArrayAttribBinding(b.vao, a, a);
     glEnableVertexArrayAttrib(b.vao, a);
   }
@@ -42,7 +50,7 @@ MeshBuffers upload(const Mesh& m) {
 
 void release(MeshBuffers& b) {
   glDeleteVertexArrays(1, &b.vao);
-  glDeleteBuffers(2, b.vbo);
+  glDeleteBuffers(3, b.vbo);
   glDeleteBuffers(1, &b.ebo);
 }
 
@@ -165,7 +173,9 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing)
     const int tw = (*first.mips)[0].width(), th = (*first.mips)[0].height();
     spot_levels = static_cast<int>(first.mips->size());
     glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, &spot_tex);
-    glTextureStorage3D(spot_tex, spot_levels, GL_RGBA32F, tw, th, static_cast<GLsizei>(L.spotlights.size()));
+    // Half floats: half the memory of RGBA32F (the paper stored sRGBE, 4 bytes a texel, for the same
+    // reason); 11-bit mantissas, well inside the agreement test's tolerance.
+    glTextureStorage3D(spot_tex, spot_levels, GL_RGBA16F, tw, th, static_cast<GLsizei>(L.spotlights.size()));
     std::vector<float> rgba;
     for (size_t i = 0; i < L.spotlights.size(); ++i) {
       const auto& sp = L.spotlights[i];
@@ -289,7 +299,7 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing)
 
   // Colour target (the forward pass renders into it; the deferred pass writes it as an image), and
   // the deferred G-buffer.
-  GLuint color_tex, depth_rb, fbo, vis_tex = 0, geom_ssbo[4] = {0, 0, 0, 0};
+  GLuint color_tex, depth_rb, fbo, vis_tex = 0, geom_ssbo[4] = {0, 0, 0, 0}, uv_ssbo = 0;
   glCreateTextures(GL_TEXTURE_2D, 1, &color_tex);
   glTextureStorage2D(color_tex, 1, GL_RGBA32F, W, H);
   glCreateRenderbuffers(1, &depth_rb);
@@ -303,13 +313,15 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing)
     glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, vis_tex, 0);
     // Geometry for the compute pass: all objects' vertices and indices, and where each starts.
     std::vector<uint32_t> object_table;
-    std::vector<float> pos, nrm;
+    std::vector<float> pos, nrm, uvs;
     std::vector<uint32_t> idx;
     for (const auto& o : d.objects) {
       if (o.mesh->triangle_count() >= (1u << 24)) fail(ErrorKind::Value, "a mesh of {} triangles is over the deferred path's 2^24", o.mesh->triangle_count());
       object_table.insert(object_table.end(), {static_cast<uint32_t>(pos.size() / 3), static_cast<uint32_t>(idx.size()), 0u, 0u});
       pos.insert(pos.end(), o.mesh->positions.begin(), o.mesh->positions.end());
       nrm.insert(nrm.end(), o.mesh->normals.begin(), o.mesh->normals.end());
+      const std::vector<float> uv = gpu_uvs(*o.mesh);
+      uvs.insert(uvs.end(), uv.begin(), uv.end());
       idx.insert(idx.end(), o.mesh->indices.begin(), o.mesh->indices.end());
     }
     if (d.objects.size() > 255) fail(ErrorKind::Value, "the deferred path draws at most 255 objects ({} given)", d.objects.size());
@@ -319,6 +331,9 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing)
     glNamedBufferStorage(geom_ssbo[2], static_cast<GLsizeiptr>(std::max<size_t>(1, nrm.size()) * 4), nrm.data(), 0);
     glNamedBufferStorage(geom_ssbo[3], static_cast<GLsizeiptr>(std::max<size_t>(1, idx.size()) * 4), idx.data(), 0);
     for (int i = 0; i < 4; ++i) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3 + i, geom_ssbo[i]);
+    glCreateBuffers(1, &uv_ssbo);
+    glNamedBufferStorage(uv_ssbo, static_cast<GLsizeiptr>(std::max<size_t>(1, uvs.size()) * 4), uvs.data(), 0);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 10, uv_ssbo);
   } else {
     glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, color_tex, 0);
   }
@@ -331,7 +346,7 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing)
   std::vector<const GlossyMap*> gmaps;
   std::vector<int> material_layer;
   for (const auto& o : d.objects) {
-    const GlossyMap* g = L.grid ? nullptr : L.glossy_map(o.material.exponent);
+    const GlossyMap* g = L.grid ? nullptr : L.glossy_map(o.material.environment_exponent());
     int layer = -1;
     if (g) {
       auto it = std::find(gmaps.begin(), gmaps.end(), g);
@@ -363,18 +378,56 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing)
   }
 
   // Materials (deferred: a table indexed from the G-buffer; forward: uniforms per object).
+  // Albedo textures: one 2D array, a layer per distinct texture (all of one size).
+  std::vector<const Image*> albedo_images;
+  std::vector<int> albedo_layer;
+  for (const auto& o : d.objects) {
+    int layer = -1;
+    if (o.material.texture) {
+      const Image* im = o.material.texture.get();
+      auto it = std::find(albedo_images.begin(), albedo_images.end(), im);
+      layer = static_cast<int>(it - albedo_images.begin());
+      if (it == albedo_images.end()) albedo_images.push_back(im);
+    }
+    albedo_layer.push_back(layer);
+  }
+  GLuint albedo_tex = 0;
+  if (!albedo_images.empty()) {
+    const int aw = albedo_images[0]->width(), ah = albedo_images[0]->height();
+    for (const Image* im : albedo_images)
+      if (im->width() != aw || im->height() != ah || im->channels() < 3)
+        fail(ErrorKind::Unsupported, "the GL renderer takes RGB albedo textures of one size per frame ({}x{} and {}x{}x{} given)", aw, ah,
+             im->width(), im->height(), im->channels());
+    glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, &albedo_tex);
+    glTextureStorage3D(albedo_tex, 1, GL_RGBA32F, aw, ah, static_cast<GLsizei>(albedo_images.size()));
+    std::vector<float> rgba(static_cast<size_t>(aw) * ah * 4);
+    for (size_t li = 0; li < albedo_images.size(); ++li) {
+      const Image& im = *albedo_images[li];
+      for (size_t i = 0; i < im.pixel_count(); ++i)
+        for (int c = 0; c < 4; ++c) rgba[i * 4 + c] = c < 3 ? im.data()[i * im.channels() + c] : 1.0f;
+      glTextureSubImage3D(albedo_tex, 0, 0, 0, static_cast<GLint>(li), aw, ah, 1, GL_RGBA, GL_FLOAT, rgba.data());
+    }
+    glTextureParameteri(albedo_tex, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTextureParameteri(albedo_tex, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTextureParameteri(albedo_tex, GL_TEXTURE_WRAP_S, GL_REPEAT);
+    glTextureParameteri(albedo_tex, GL_TEXTURE_WRAP_T, GL_REPEAT);
+  }
+
   std::vector<float> materials;
+  constexpr int kMaterialFloats = 24;  // MaterialGpu in shade.comp
   for (size_t oi = 0; oi < d.objects.size(); ++oi) {
     const Material& m = d.objects[oi].material;
-    float row[20] = {static_cast<float>(m.albedo.x),   static_cast<float>(m.albedo.y),   static_cast<float>(m.albedo.z),
+    float row[kMaterialFloats] = {static_cast<float>(m.albedo.x),   static_cast<float>(m.albedo.y),   static_cast<float>(m.albedo.z),
                      static_cast<float>(material_layer[oi]),
                      static_cast<float>(m.specular.x), static_cast<float>(m.specular.y), static_cast<float>(m.specular.z),
                      static_cast<float>(m.exponent)};
     if (bands > 0) {
-      auto gz = sh::phong_zh(bands, m.exponent);
+      auto gz = sh::phong_zh(bands, m.environment_exponent());
       for (int l = 0; l < std::min(bands, 12); ++l) row[8 + l] = static_cast<float>(gz[l]);
     }
-    materials.insert(materials.end(), row, row + 20);
+    row[20] = static_cast<float>(albedo_layer[oi]);
+    row[21] = m.lobe == Lobe::BlinnPhong ? 1.0f : 0.0f;
+    materials.insert(materials.end(), row, row + kMaterialFloats);
   }
   GLuint material_ssbo;
   glCreateBuffers(1, &material_ssbo);
@@ -422,9 +475,11 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing)
   // Every sampler gets its own unit even when unused: two sampler types on one unit is an error.
   glProgramUniform1i(prog, glGetUniformLocation(prog, "u_grid"), 1);
   glProgramUniform1i(prog, glGetUniformLocation(prog, "u_glossy_maps"), 3);
+  glProgramUniform1i(prog, glGetUniformLocation(prog, "u_albedo_textures"), 6);
   GLint loc_albedo = glGetUniformLocation(prog, "u_albedo"), loc_specular = glGetUniformLocation(prog, "u_specular"),
         loc_exponent = glGetUniformLocation(prog, "u_exponent"), loc_glossy = glGetUniformLocation(prog, "u_glossy_zh"),
         loc_glossy_layer = glGetUniformLocation(prog, "u_glossy_layer"),
+        loc_albedo_layer = glGetUniformLocation(prog, "u_albedo_layer"), loc_lobe = glGetUniformLocation(prog, "u_lobe"),
         loc_material = glGetUniformLocation(raster, "u_object"),
         loc_light_vp = glGetUniformLocation(impl_->shadow_program, "u_light_view_projection");
 
@@ -494,6 +549,7 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing)
     if (grid_tex) glBindTextureUnit(1, grid_tex);
     if (glossy_tex) glBindTextureUnit(3, glossy_tex);
     if (spot_tex) glBindTextureUnit(4, spot_tex);
+    if (albedo_tex) glBindTextureUnit(6, albedo_tex);
     if (spot_shadow_tex) glBindTextureUnit(5, spot_shadow_tex);
     for (size_t i = 0; i < meshes.size(); ++i) {
       if (deferred) {
@@ -504,7 +560,9 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing)
         glUniform3f(loc_specular, static_cast<float>(mat.specular.x), static_cast<float>(mat.specular.y), static_cast<float>(mat.specular.z));
         glUniform1f(loc_exponent, static_cast<float>(mat.exponent));
         glUniform1i(loc_glossy_layer, material_layer[i]);
-        if (bands > 0) glUniform1fv(loc_glossy, bands, materials.data() + i * 20 + 8);
+        if (bands > 0) glUniform1fv(loc_glossy, bands, materials.data() + i * kMaterialFloats + 8);
+        glUniform1i(loc_albedo_layer, albedo_layer[i]);
+        glUniform1i(loc_lobe, mat.lobe == Lobe::BlinnPhong ? 1 : 0);
       }
       glBindVertexArray(meshes[i].vao);
       glDrawElements(GL_TRIANGLES, meshes[i].count, GL_UNSIGNED_INT, nullptr);
@@ -547,6 +605,7 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing)
   if (deferred) {
     glDeleteTextures(1, &vis_tex);
     glDeleteBuffers(4, geom_ssbo);
+    glDeleteBuffers(1, &uv_ssbo);
   }
   glDeleteBuffers(1, &material_ssbo);
   glDeleteTextures(1, &color_tex);
@@ -554,6 +613,7 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing)
   if (grid_tex) glDeleteTextures(1, &grid_tex);
   if (glossy_tex) glDeleteTextures(1, &glossy_tex);
   if (spot_tex) glDeleteTextures(1, &spot_tex);
+  if (albedo_tex) glDeleteTextures(1, &albedo_tex);
   if (spot_shadow_tex) glDeleteTextures(1, &spot_shadow_tex);
   glDeleteBuffers(2, spot_ssbo);
   glDeleteBuffers(2, ssbo);

@@ -8,7 +8,8 @@ layout(rgba32f, binding = 0) writeonly uniform image2D u_out;
 struct MaterialGpu {
   vec4 albedo;          // rgb, w = layer of the prefiltered glossy map or −1
   vec4 specular;        // rgb, w = Phong exponent
-  float glossy_zh[12];  // ρ̂_l(s) for l < SH_BANDS (≤ 12)
+  float glossy_zh[12];  // ρ̂_l(s) for l < SH_BANDS (≤ 12), s the material's environment exponent
+  vec4 extra;           // x: albedo texture layer or −1, y: lobe (0 Phong, 1 Blinn-Phong)
 };
 struct ObjectGpu {
   uint first_vertex;  // into positions/normals (in vertices)
@@ -20,6 +21,7 @@ layout(std430, binding = 3) readonly buffer Objects { ObjectGpu objects[]; };
 layout(std430, binding = 4) readonly buffer Positions { float positions[]; };
 layout(std430, binding = 5) readonly buffer Normals { float normals[]; };
 layout(std430, binding = 6) readonly buffer Indices { uint indices[]; };
+layout(std430, binding = 10) readonly buffer Uvs { float uvs[]; };
 uniform vec3 u_background;
 // Camera ray through pixel (x, y): normalize(u_ray00 + (x + ½)·u_ray_dx + (y + ½)·u_ray_dy).
 uniform vec3 u_ray00;
@@ -68,5 +70,12 @@ void main() {
   vec3 p = b0 * p0 + b1 * p1 + b2 * p2;
   vec3 n = b0 * fetch3(i0, true) + b1 * fetch3(i1, true) + b2 * fetch3(i2, true);
   MaterialGpu m = materials[g_material];
-  imageStore(u_out, q, vec4(shade(p, n, m.albedo.rgb, m.specular.rgb, m.specular.w), 1.0));
+  vec3 albedo = m.albedo.rgb;
+  int layer = int(m.extra.x);
+  if (layer >= 0) {
+    vec2 uv = b0 * vec2(uvs[2u * i0], uvs[2u * i0 + 1u]) + b1 * vec2(uvs[2u * i1], uvs[2u * i1 + 1u]) +
+              b2 * vec2(uvs[2u * i2], uvs[2u * i2 + 1u]);
+    albedo *= albedo_texture(uv, layer);
+  }
+  imageStore(u_out, q, vec4(shade(p, n, albedo, m.specular.rgb, m.specular.w, int(m.extra.y)), 1.0));
 }

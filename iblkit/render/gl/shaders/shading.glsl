@@ -92,7 +92,15 @@ vec3 spot_irradiance(SpotGpu L, vec3 p, vec3 n) {
   return e * (L.extent.z * cos_l * cos_r / d2);
 }
 
-vec3 shade(vec3 p, vec3 n_in, vec3 albedo, vec3 specular, float exponent) {
+// Albedo textures (render::Material::texture), one layer each, all of one size: bilinear,
+// repeating, uv (0,0) at the image's bottom-left (render::texture_albedo).
+uniform sampler2DArray u_albedo_textures;
+vec3 albedo_texture(vec2 uv, int layer) {
+  return layer < 0 ? vec3(1.0) : texture(u_albedo_textures, vec3(uv.x, 1.0 - uv.y, float(layer))).rgb;
+}
+
+// lobe 0: Phong (s+1)/2π (r·l)^s; 1: Blinn-Phong (s+8)/8π (n·h)^s (n·l) for lights (render::Lobe).
+vec3 shade(vec3 p, vec3 n_in, vec3 albedo, vec3 specular, float exponent, int lobe) {
   vec3 n = normalize(n_in);
   vec3 v = normalize(u_eye - p);
   vec3 r = normalize(2.0 * dot(n, v) * n - v);
@@ -124,7 +132,8 @@ vec3 shade(vec3 p, vec3 n_in, vec3 albedo, vec3 specular, float exponent) {
 #endif
       }
   }
-  float lobe_norm = (exponent + 1.0) / (2.0 * PI);
+  bool blinn = lobe == 1;
+  float lobe_norm = blinn ? (exponent + 8.0) / (8.0 * PI) : (exponent + 1.0) / (2.0 * PI);
   for (int i = 0; i < u_light_count + u_point_light_count + u_spot_count; ++i) {
     vec3 l, irr;
     float layer;
@@ -157,8 +166,13 @@ vec3 shade(vec3 p, vec3 n_in, vec3 albedo, vec3 specular, float exponent) {
     if (ndl <= 0.0) continue;
     if (layer >= 0.0) irr *= spot ? spot_visibility(p, n, int(layer)) : visibility(p, n, int(layer));
     E += irr * ndl;
-    float rdl = dot(r, l);
-    if (rdl > 0.0) G += irr * (lobe_norm * pow(rdl, exponent));
+    if (blinn) {
+      float ndh = dot(n, normalize(l + v));
+      if (ndh > 0.0) G += irr * (lobe_norm * pow(ndh, exponent) * ndl);
+    } else {
+      float rdl = dot(r, l);
+      if (rdl > 0.0) G += irr * (lobe_norm * pow(rdl, exponent));
+    }
   }
   return max(albedo * E / PI + specular * G, vec3(0.0));
 }
