@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <vector>
 
 #include "iblkit/core/error.h"
 #include "iblkit/core/parallel.h"
@@ -35,7 +36,7 @@ bool ball_ray(const sphere::Mapping& m, double px, double py, Vec3* n, Vec3* d) 
   return true;
 }
 
-constexpr int kApertureRings = 16, kApertureSectors = 16;  // 256 equal-area strata of the disc
+constexpr int kMinAperturePoints = 256, kAperturePointsPerPixel = 16;  // equal-area strata of the disc
 constexpr double kShadowShorten = 1e-4;  // relative: as radiance.cpp, stop short of the aperture
 
 // Whether a world direction carries light under desc.cone.
@@ -45,9 +46,12 @@ bool cone_selects(const CaptureDesc& desc, Vec3 d) {
   return inside == (desc.cone == CaptureDesc::Cone::Inside);
 }
 
-// Lamps whose aperture is small in this capture (see kSmallApertureFactor): bit i = emitters[i].
-uint64_t small_apertures(const Scene& scene, Vec3 position, const CaptureDesc& desc, const sphere::Mapping& m) {
+// Lamps whose aperture is small in this capture (see kSmallApertureFactor): bit i = emitters[i];
+// rings[i] = the number of rings (and sectors) of its points.
+uint64_t small_apertures(const Scene& scene, Vec3 position, const CaptureDesc& desc, const sphere::Mapping& m,
+                         std::vector<int>& rings) {
   uint64_t mask = 0;
+  rings.assign(std::min<size_t>(scene.emitters.size(), 64), 0);
   if (!desc.integrate_apertures || desc.camera != Camera::Ideal) return mask;
   const double mean_pixel = 4 * kPi / (static_cast<double>(m.width()) * m.height());
   for (size_t i = 0; i < scene.emitters.size() && i < 64; ++i) {
@@ -63,7 +67,11 @@ uint64_t small_apertures(const Scene& scene, Vec3 position, const CaptureDesc& d
       int x = std::clamp(static_cast<int>(px), 0, m.width() - 1), y = std::clamp(static_cast<int>(py), 0, m.height() - 1);
       if (m.solid_angle_estimate(x, y) > 0) pixel = m.solid_angle_estimate(x, y);
     }
-    if (omega < kSmallApertureFactor * pixel) mask |= uint64_t{1} << i;
+    if (omega < kSmallApertureFactor * pixel) {
+      mask |= uint64_t{1} << i;
+      double points = std::max<double>(kMinAperturePoints, kAperturePointsPerPixel * omega / pixel);
+      rings[i] = static_cast<int>(std::ceil(std::sqrt(points)));
+    }
   }
   return mask;
 }
@@ -71,14 +79,15 @@ uint64_t small_apertures(const Scene& scene, Vec3 position, const CaptureDesc& d
 // Adds the light of lamp e's aperture to the pixels it falls in: K equal-area points q on the disc,
 // each visible one carrying E = I(−ω)/(K·|q − o|²) into the pixel of ω, divided by that pixel's solid
 // angle (a pixel holds the mean radiance over its solid angle).
-void add_aperture(const Scene& scene, const Emitter& e, Vec3 o, const CaptureDesc& desc, const sphere::Mapping& m, Image& img) {
+void add_aperture(const Scene& scene, const Emitter& e, int rings, Vec3 o, const CaptureDesc& desc, const sphere::Mapping& m,
+                  Image& img) {
   const Frame f = Frame::from_normal(e.direction);
   const Mat3 to_probe = desc.rotation.transposed();
-  constexpr int K = kApertureRings * kApertureSectors;
-  for (int i = 0; i < kApertureRings; ++i) {
-    double r = e.aperture_radius * std::sqrt((i + 0.5) / kApertureRings);
-    for (int j = 0; j < kApertureSectors; ++j) {
-      double phi = 2 * kPi * (j + 0.5) / kApertureSectors;
+  const int sectors = rings, K = rings * sectors;
+  for (int i = 0; i < rings; ++i) {
+    double r = e.aperture_radius * std::sqrt((i + 0.5) / rings);
+    for (int j = 0; j < sectors; ++j) {
+      double phi = 2 * kPi * (j + 0.5) / sectors;
       Vec3 q = e.position + (f.t * std::cos(phi) + f.b * std::sin(phi)) * r;
       Vec3 w = q - o;
       double d2 = dot(w, w), dist = std::sqrt(d2);
@@ -121,7 +130,8 @@ Capture capture_probe(const Scene& scene, Vec3 position, const CaptureDesc& desc
   const int W = m.width(), H = m.height(), n = desc.samples;
   cap.radiance = Image(W, H, 3);
   if (desc.depth) cap.depth = Image(W, H, 1);
-  const uint64_t hidden = small_apertures(scene, position, desc, m);
+  std::vector<int> rings;
+  const uint64_t hidden = small_apertures(scene, position, desc, m, rings);
   std::atomic<int> rows_done{0};
   parallel_for(0, H, [&](int64_t y) {
     for (int x = 0; x < W; ++x) {
@@ -158,7 +168,7 @@ Capture capture_probe(const Scene& scene, Vec3 position, const CaptureDesc& desc
     if (progress) report(progress, "capture", static_cast<double>(++rows_done) / H);
   });
   for (size_t i = 0; i < scene.emitters.size() && i < 64; ++i)
-    if ((hidden >> i) & 1) add_aperture(scene, scene.emitters[i], position, desc, m, cap.radiance);
+    if ((hidden >> i) & 1) add_aperture(scene, scene.emitters[i], rings[i], position, desc, m, cap.radiance);
   return cap;
 }
 

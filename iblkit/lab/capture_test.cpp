@@ -281,13 +281,13 @@ TEST(LabCapture, SmallApertureIsIntegratedPerPixel) {
 }
 
 TEST(LabTruth, SmallApertureSHAgreeAtAnyResolution) {
-  // The truth's SH must not depend on whether a map's pixels happen to hit the aperture: at 32, 64
-  // and 128 rows the spot's c00 is (I/d²)·Y00 (plus nothing else in this scene).
+  // The truth's SH must not depend on whether a map's pixels happen to hit the aperture: at 32, 64,
+  // 128 and 512 rows the spot's c00 is (I/d²)·Y00 (plus nothing else in this scene).
   constexpr double kSHTol = 2e-3;  // relative: Y00 is constant; float32 pixels and summation order
   const Vec3 p{0.3, 0.5, -0.2};
   Scene s = small_spot(false);
   double d2 = dot(Vec3{0, 2, 0} - p, Vec3{0, 2, 0} - p);
-  for (int size : {32, 64, 128}) {
+  for (int size : {32, 64, 128, 512}) {  // 512 rows: the disc covers ~17 pixels, 272 points
     TruthDesc td;
     td.size = size;
     td.samples = 2;
