@@ -49,8 +49,8 @@ struct Lut {
   Mat3 to_local;  // world -> probe frame (Rᵀ)
   bool latlong = false;
   int w = 0, h = 0;
-  const float* rgb = nullptr;    // 3 channels
-  const float* depth = nullptr;  // 1 channel
+  const float* rgbd = nullptr;   // lat-long: R, G, B, depth interleaved (Probe::rgbd)
+  const float* depth = nullptr;  // other mappings: 1 channel
   const Probe* probe = nullptr;
   double delta = 0;      // texel angle √(4π/N)
   double inv_omega = 0;  // 1/(4π/N)
@@ -82,7 +82,8 @@ struct Lut {
   float depth_at(const Px& p) const {
     if (!p.ok) return 0;
     int ix = std::clamp(static_cast<int>(p.x), 0, w - 1), iy = std::clamp(static_cast<int>(p.y), 0, h - 1);
-    return depth[static_cast<size_t>(iy) * w + ix];
+    size_t i = static_cast<size_t>(iy) * w + ix;
+    return latlong ? rgbd[4 * i + 3] : depth[i];
   }
   // Bilinear radiance towards the local direction d. With tol > 0 (a lat-long probe) only the taps whose
   // depth lies within tol of r take part: the lookup does not bleed across depth edges.
@@ -93,18 +94,18 @@ struct Lut {
     float tx = fx - x0f, ty = fy - y0f;
     int x0 = static_cast<int>(x0f), y0 = static_cast<int>(y0f);
     int x1 = x0 + 1, y1 = y0 + 1;
-    x0 = (x0 % w + w) % w;
-    x1 = (x1 % w + w) % w;
+    x0 = x0 < 0 ? x0 + w : (x0 >= w ? x0 - w : x0);  // |x0| ≤ w: one wrap at most
+    x1 = x1 < 0 ? x1 + w : (x1 >= w ? x1 - w : x1);
     y0 = std::clamp(y0, 0, h - 1);
     y1 = std::clamp(y1, 0, h - 1);
-    const float* a = rgb + (static_cast<size_t>(y0) * w + x0) * 3;
-    const float* b = rgb + (static_cast<size_t>(y0) * w + x1) * 3;
-    const float* c = rgb + (static_cast<size_t>(y1) * w + x0) * 3;
-    const float* e = rgb + (static_cast<size_t>(y1) * w + x1) * 3;
+    const float* a = rgbd + (static_cast<size_t>(y0) * w + x0) * 4;
+    const float* b = rgbd + (static_cast<size_t>(y0) * w + x1) * 4;
+    const float* c = rgbd + (static_cast<size_t>(y1) * w + x0) * 4;
+    const float* e = rgbd + (static_cast<size_t>(y1) * w + x1) * 4;
     float w00 = (1 - tx) * (1 - ty), w10 = tx * (1 - ty), w01 = (1 - tx) * ty, w11 = tx * ty;
     if (tol > 0) {
-      auto ok = [&](int xx, int yy) { return std::abs(depth[static_cast<size_t>(yy) * w + xx] - r) <= tol; };
-      float m00 = ok(x0, y0) ? w00 : 0, m10 = ok(x1, y0) ? w10 : 0, m01 = ok(x0, y1) ? w01 : 0, m11 = ok(x1, y1) ? w11 : 0;
+      auto ok = [&](const float* t) { return std::abs(t[3] - r) <= tol; };
+      float m00 = ok(a) ? w00 : 0, m10 = ok(b) ? w10 : 0, m01 = ok(c) ? w01 : 0, m11 = ok(e) ? w11 : 0;
       float sum = m00 + m10 + m01 + m11;
       if (sum > 0 && sum < 1) {
         w00 = m00 / sum; w10 = m10 / sum; w01 = m01 / sum; w11 = m11 / sum;
@@ -142,7 +143,9 @@ class Fuser {
       l.h = p.radiance.image.height();
       if (p.radiance.image.channels() != 3 || p.depth.width() != l.w || p.depth.height() != l.h || p.depth.channels() != 1)
         fail(ErrorKind::Value, "fuse: probe {} is not prepared (3-channel radiance and a 1-channel depth map of its size)", p.image);
-      l.rgb = p.radiance.image.data();
+      if (l.latlong && p.rgbd.size() != p.radiance.image.pixel_count() * 4)
+        fail(ErrorKind::Value, "fuse: probe {} is not prepared (call fusion::prepare)", p.image);
+      l.rgbd = p.rgbd.data();
       l.depth = p.depth.data();
       l.probe = &p;
       double n = 0;

@@ -328,6 +328,8 @@ TEST(FusionBadInput, OpenProxyWarnsAndFallsBackInsteadOfBlack) {
   for (int y = 0; y < p.radiance.image.height(); ++y)
     for (int x = 0; x < p.radiance.image.width(); ++x)
       if (p.depth.at(x, y, 0) == 0) p.radiance.image.set_rgb(x, y, {0.2, 0.4, 2.0});
+  set.warnings.clear();
+  prepare(set);  // images changed: prepare again (it interleaves radiance and depth for the lookups)
   ASSERT_FALSE(set.warnings.empty());
   EXPECT_NE(set.warnings[0].find("not closed"), std::string::npos) << set.warnings[0];
   EXPECT_GT(p.escape_fraction, 0.1);

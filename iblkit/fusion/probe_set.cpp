@@ -166,6 +166,18 @@ void prepare(ProbeSet& set, const ProgressFn& progress) {
            p.depth.height(), m.width(), m.height());
     }
     if (p.radiance.image.channels() != 3) p.radiance.image = p.radiance.image.with_channels(3);
+    p.rgbd.clear();
+    if (m.kind() == sphere::MappingKind::LatLong) {
+      p.rgbd.resize(p.radiance.image.pixel_count() * 4);
+      const float* rgb = p.radiance.image.data();
+      const float* dep = p.depth.data();
+      for (size_t i = 0; i < p.radiance.image.pixel_count(); ++i) {
+        p.rgbd[4 * i] = rgb[3 * i];
+        p.rgbd[4 * i + 1] = rgb[3 * i + 1];
+        p.rgbd[4 * i + 2] = rgb[3 * i + 2];
+        p.rgbd[4 * i + 3] = dep[i];
+      }
+    }
     p.escape_fraction = escape_share(p);
     constexpr double kEscapeWarn = 1e-3;  // a few stray texels through shared edges are not an opening
     if (p.escape_fraction > kEscapeWarn)

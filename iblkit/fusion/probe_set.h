@@ -38,6 +38,8 @@ struct Probe {
   Image depth;              // 1 channel, same size as `radiance`: metres from `position` to the proxy
                             // along each pixel centre's direction; 0 where the ray leaves the proxy
   DepthSource depth_source = DepthSource::Computed;
+  std::vector<float> rgbd;  // lat-long probes: radiance and depth interleaved (R,G,B,depth per pixel), built
+                            // by prepare() so that a fused lookup touches one cache line, not two
   double escape_fraction = 0;  // share of the probe's solid angle whose rays leave the proxy
 };
 
