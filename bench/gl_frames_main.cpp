@@ -1,14 +1,17 @@
 // GPU time per frame of the real-time renderer (issue 8 targets, on the device machine's H100):
 // SH-grid diffuse ≤ 0.5 ms and glossy ≤ 1 ms at 1024×768 for a 100k-triangle object; directional
-// lights with shadow maps. Built as the lean target iblkit_glbench (no OpenImageIO/Embree/…), so it
+// lights with shadow maps; the 9×7 near-field dataset's textured spotlights with shadows in a room
+// (≤ 4 ms). Built as the lean target iblkit_glbench (no OpenImageIO/Embree/…), so it
 // can be carried to a GPU machine with a handful of shared libraries. Prints one JSON object.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <string>
 
 #include "iblkit/render/gl/context.h"
 #include "iblkit/render/gl/renderer.h"
+#include "iblkit/nearfield/spotlight.h"
 #include "iblkit/render/mesh.h"
 
 using namespace ibl;
@@ -39,6 +42,57 @@ SHGridData make_grid(int n, int bands) {
             g.data[i] = static_cast<float>((k == 0 ? 2.0 : 0.3 / (1 + k)) * (1 + 0.3 * std::sin(0.3 * x + 0.2 * y - 0.1 * z + c)));
           }
   return g;
+}
+
+// A box room (inward-facing walls) of w × h × l metres with its floor at y = 0, and four pillars:
+// a stand-in for the crypt (examples/crypt.obj needs assimp, which the lean target leaves out).
+Mesh make_room(double w, double h, double l) {
+  Mesh room;
+  auto quad = [&](Vec3 a, Vec3 b, Vec3 c, Vec3 d) {  // counter-clockwise seen from the side it faces
+    Mesh q;
+    for (Vec3 p : {a, b, c, d}) q.positions.insert(q.positions.end(), {float(p.x), float(p.y), float(p.z)});
+    q.indices = {0, 1, 2, 0, 2, 3};
+    q.compute_normals();
+    room.append(q);
+  };
+  auto box = [&](Vec3 lo, Vec3 hi, bool inward) {
+    Vec3 c[8];
+    for (int i = 0; i < 8; ++i) c[i] = {i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z};
+    int f[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};  // outward
+    for (auto& q : f) inward ? quad(c[q[3]], c[q[2]], c[q[1]], c[q[0]]) : quad(c[q[0]], c[q[1]], c[q[2]], c[q[3]]);
+  };
+  box({-w / 2, 0, -l / 2}, {w / 2, h, l / 2}, true);
+  for (double x : {-1.5, 1.5})
+    for (double z : {-2.0, 2.0}) box({x - 0.25, 0, z - 0.25}, {x + 0.25, h, z + 0.25}, false);
+  return room;
+}
+
+// 9×7 textured spotlights like a measured luminaire's terms (5 mm apart, 128² textures with mips).
+std::vector<nearfield::TexturedSpotlight> make_spotlights() {
+  Image tex(128, 128, 3);
+  for (int y = 0; y < 128; ++y)
+    for (int x = 0; x < 128; ++x) {
+      double r = std::hypot(x - 63.5, y - 63.5) / 64;
+      tex.set_rgb(x, y, Vec3{1, 0.9, 0.7} * (2000.0 * std::exp(-8 * (r - 0.5) * (r - 0.5)) * (r < 1 ? 1 : 0)));
+    }
+  auto mips = std::make_shared<const std::vector<Image>>(nearfield::build_mips(tex));
+  std::vector<nearfield::TexturedSpotlight> out;
+  const Vec3 fwd = normalize(Vec3{0.3, -0.6, -1});
+  const Frame fr = Frame::from_normal(fwd);
+  for (int j = 0; j < 7; ++j)
+    for (int i = 0; i < 9; ++i) {
+      nearfield::TexturedSpotlight sp;
+      sp.position = Vec3{-1.0, 2.2, 2.5} + fr.t * (0.005 * (i - 4)) + fr.b * (0.005 * (j - 3));
+      sp.frame = fr;
+      sp.plane_distance = 0.5;
+      sp.tex_min = {-0.3, -0.3};
+      sp.tex_max = {0.3, 0.3};
+      sp.mips = mips;
+      sp.support_area = 0.005 * 0.005;
+      sp.support_width = 0.02;
+      out.push_back(sp);
+    }
+  return out;
 }
 
 }  // namespace
@@ -84,6 +138,23 @@ int main(int argc, char** argv) {
       run("lights16_all_shadowed");
       for (auto& l : d.lighting.lights) l.shadow = false;
       run("lights16_no_shadows");
+      // Granier et al.'s case: a 9×7 near-field dataset, every term a textured spotlight with its
+      // own shadow map (1024²), lighting a room with pillars and the object.
+      d.lighting.lights.clear();
+      d.lighting.spotlights = make_spotlights();
+      Mesh room = make_room(6, 4, 8);
+      Mesh small = blob;
+      small.transform(0.5, {0, 0.2, 0});
+      d.objects = {{&small, Material{{0.7, 0.7, 0.7}, {0.2, 0.2, 0.2}, 20}}, {&room, Material{{0.6, 0.6, 0.6}, {0, 0, 0}, 1}}};
+      d.camera.eye = {0.5, 1.6, 3.5};
+      d.camera.target = {0, 0.5, 0};
+      d.spot_shadow_map_size = 1024;
+      run("nearfield_9x7_shadowed_room");
+      d.lighting.spotlights.clear();
+      d.objects.resize(1);
+      d.objects[0] = {&blob, Material{{0.7, 0.7, 0.7}, {0, 0, 0}, 1}};
+      d.camera.eye = {0, 0.4, 1.6};
+      d.camera.target = {0, 0, 0};
     }
     std::printf("}\n");
   } catch (const std::exception& e) {
