@@ -148,7 +148,7 @@ int main(int argc, char** argv) {
       d.objects = {{&small, Material{{0.7, 0.7, 0.7}, {0.2, 0.2, 0.2}, 20}}, {&room, Material{{0.6, 0.6, 0.6}, {0, 0, 0}, 1}}};
       d.camera.eye = {0.5, 1.6, 3.5};
       d.camera.target = {0, 0.5, 0};
-      d.spot_shadow_map_size = 1024;
+      d.spot_shadow_map_size = 512;
       run("nearfield_9x7_shadowed_room");
       d.lighting.spotlights.clear();
       d.objects.resize(1);
