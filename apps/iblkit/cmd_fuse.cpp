@@ -202,7 +202,7 @@ void run_path(const FuseOpts& o, const std::string& probes, const std::string& p
   std::ofstream(dir / "path_summary.json") << j.dump(1) << "\n";
   std::string png = (dir / "path.png").string();
   ibl::io::write_image(png, ibl::io::contact_sheet(pics, 2, 512, 256,
-                                                   fmt::format("{} frames, {} tracked lights (τ = {})", path.size(), nlights, tau)));
+                                                   fmt::format("{} frames, {} tracked lights (filter time constant {})", path.size(), nlights, tau)));
   emit(j, [&] {
     fmt::print("fused {} frames along {} in {:.2f} s, {} lights each (tracked{})\n", path.size(), path_file, secs, nlights,
                no_filter ? "" : fmt::format(", low-pass τ = {}", tau));
