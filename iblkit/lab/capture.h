@@ -43,9 +43,10 @@ struct CaptureDesc {
 // is integrated analytically: each pixel then holds the exact pixel average of the lamp's radiance,
 // E_pixel = Σ_points I(−ω)/(K·d²) / Ω_pixel, with K ≥ 256 stratified points of the disc and at least
 // 16 per pixel it covers, instead of n×n point samples of a disc that covers a fraction of a pixel at
-// 10⁴× the scene's radiance (or a few pixels with an aliased rim: 2.6 % of its light at 22 pixels
-// with 4×4 samples). Larger apertures are resolved by the pixels.
-inline constexpr double kSmallApertureFactor = 256;
+// 10⁴× the scene's radiance (or a few hundred pixels with an aliased rim: 2.6 % of its light at 22
+// pixels with 4×4 samples; 9–13 % for a disc centred on a lat-long pole, whose rim runs along the
+// rows). Larger apertures are resolved by the pixels.
+inline constexpr double kSmallApertureFactor = 4096;
 
 struct Capture {
   Image radiance;                // RGB, W/(sr·m²); 0 where a pixel carries no direction

@@ -280,6 +280,32 @@ TEST(LabCapture, SmallApertureIsIntegratedPerPixel) {
   }
 }
 
+TEST(LabCapture, ApertureOnALatLongPoleIsExact) {
+  // A 2.5 cm disc straight above the probe at 1.2 m covers the top row and 60 % of the next of a
+  // 256-row map: its rim runs along a row, so point samples cannot average the rim's aliasing out
+  // (4×4 samples per pixel gave +13 %). Integrated per pixel it delivers I/d².
+  constexpr double kEnergyTol = 1e-3;  // relative: float32 pixels, 16+ points per covered pixel
+  constexpr double kAliasedAtLeast = 0.05;  // point-sampled: off by 13 % (shows the check can fail)
+  Scene s;
+  Emitter sp;
+  sp.type = EmitterType::Spot;
+  sp.position = {0, 2, 0};
+  sp.direction = {0, -1, 0};
+  sp.cone_deg = 60;
+  sp.falloff_deg = 50;
+  sp.intensity = {10, 10, 10};
+  sp.aperture_radius = 0.025;
+  s.emitters.push_back(sp);
+  s.build();
+  CaptureDesc cd;
+  cd.size = 256;
+  cd.samples = 4;
+  const double E = 10 / (1.2 * 1.2);
+  EXPECT_NEAR(total_radiance(capture_probe(s, {0, 0.8, 0}, cd)).x / E, 1.0, kEnergyTol);
+  cd.integrate_apertures = false;
+  EXPECT_GT(std::abs(total_radiance(capture_probe(s, {0, 0.8, 0}, cd)).x / E - 1.0), kAliasedAtLeast);
+}
+
 TEST(LabTruth, SmallApertureSHAgreeAtAnyResolution) {
   // The truth's SH must not depend on whether a map's pixels happen to hit the aperture: at 32, 64,
   // 128 and 512 rows the spot's c00 is (I/d²)·Y00 (plus nothing else in this scene).
