@@ -23,7 +23,7 @@ for g in 8 16 32 64; do
   lights+=(--light "$OUT/g$g.shgrid")
 done
 "$BIN" render blob "${lights[@]}" --at 0,0.85,0 --object-size 0.35 --floor-size 0.8 --eye 0,1.45,1.5 --target 0,0.8,0 \
-  --size 640x480 --truth "$SCENE" --truth-samples 4 --out "$OUT/fig9.png" --json > "$OUT/fig9.json"
+  --size 640x480 --truth "$SCENE" --truth-samples 6 --truth-bounces 1 --out "$OUT/fig9.png" --json > "$OUT/fig9.json"
 python3 - "$OUT/fig9.json" <<'PY'
 import json, sys
 j = json.load(open(sys.argv[1]))

@@ -44,7 +44,7 @@ void setup(CLI::App& app) {
     double gloss = 0, exponent = 20;
     std::string glossy = "map";
     std::string truth;
-    int truth_samples = 4, truth_bounces = 0;
+    int truth_samples = 4, truth_bounces = 1;
     double floor_size = 6;
     std::string luminaire = "0,1,0", luminaire_dir = "0,0,1";
     std::string texture, lobe = "phong";
@@ -91,7 +91,8 @@ void setup(CLI::App& app) {
                  "a lab scene (iblkit.scene/1, e.g. examples/low-scene2.json): also photograph the object and floor in it "
                  "with its real emitters (lab path tracing) and report the frame's error against that photograph");
   app.add_option("--truth-samples", o->truth_samples, "--truth: n×n rays per pixel")->check(CLI::Range(1, 64))->capture_default_str();
-  app.add_option("--truth-bounces", o->truth_bounces, "--truth: indirect bounces (match the capture's: lab capture --bounces)")
+  app.add_option("--truth-bounces", o->truth_bounces, "--truth: indirect bounces; one more than the capture's (lab capture --bounces, 0 by default): a probe "
+                 "sees the room's lit walls and floor, so their light must reach the photographed object too")
       ->check(CLI::Range(0, 16))
       ->capture_default_str();
   app.add_option("--luminaire", o->luminaire, "a near-field dataset's luminaire: centre of its sampling plane, x,y,z")
@@ -116,7 +117,8 @@ void setup(CLI::App& app) {
     Mesh object = iblcli::make_object(o->scene, o->object_size, o->triangles, at);
     Vec3 lo, hi;
     object.bounds(&lo, &hi);
-    Mesh floor = make_floor(o->floor_size, lo.y - 1e-3);  // just under the object's lowest point
+    Mesh floor = make_floor(o->floor_size, lo.y - 1e-3);  // just under the object's lowest point,
+    floor.transform(1.0, {at.x, 0, at.z});                 // centred under it
     Material mat{{0.75, 0.75, 0.75}, Vec3{1, 1, 1} * o->gloss, o->exponent, o->lobe == "blinn" ? Lobe::BlinnPhong : Lobe::Phong};
     if (!o->texture.empty()) {
       mat.albedo = {1, 1, 1};
@@ -324,7 +326,7 @@ void demo_step(iblcli::DemoContext& ctx) {
     small.bounds(&lo, &hi);
     Mesh table = make_floor(0.8, lo.y - 1e-3);
     f9.objects = {{&small, Material{{0.75, 0.75, 0.75}, {0, 0, 0}, 1}}, {&table, Material{{0.5, 0.5, 0.5}, {0, 0, 0}, 1}}};
-    iblcli::LabPhotograph photo = iblcli::photograph_frame("low-scene2", f9, 3, 0);
+    iblcli::LabPhotograph photo = iblcli::photograph_frame("low-scene2", f9, 3, 1);  // one bounce more than the capture
     io::ToneMapDesc t9;
     t9.auto_exposure = false;
     t9.exposure_stops = std::log2(photo.median > 0 ? 0.25 / photo.median : 1.0);

@@ -159,6 +159,7 @@ void run(const ViewOpts& o, const ibl::io::EnvReadDesc& rd) {
     Vec3 lo, hi;
     object.bounds(&lo, &hi);
     Mesh floor = make_floor(o.floor_size, lo.y - 1e-3);
+    floor.transform(1.0, {at.x + st.offset.x, 0, at.z + st.offset.z});
     Material mat{{0.75, 0.75, 0.75}, Vec3{1, 1, 1} * (st.glossy ? std::max(o.gloss, 0.15) : 0.0), o.exponent};
     d.objects = {{&object, mat}, {&floor, Material{{0.5, 0.5, 0.5}, {0, 0, 0}, 1}}};
     d.lighting = lightings[li];
