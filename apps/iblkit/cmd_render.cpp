@@ -171,6 +171,7 @@ void setup(CLI::App& app) {
       d.lighting = Lighting{};
       std::string kind;
       iblcli::load_lighting(light, lopt, &d.lighting, &kind);
+      if (std::string w = iblcli::grid_bounds_warning(d.lighting, object); !w.empty()) iblcli::info("warning: " + w);
       nlohmann::json j = {{"scene", o->scene}, {"light", light}, {"lighting", kind}, {"size", o->size}};
       RenderResult f;
 #ifdef IBLKIT_HAVE_GL

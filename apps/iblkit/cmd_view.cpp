@@ -69,6 +69,12 @@ void run(const ViewOpts& o, const ibl::io::EnvReadDesc& rd) {
     iblcli::load_lighting(o.lights[i], lopt, &lightings[i], &kinds[i]);
   const Vec3 at = iblcli::parse_vec3(o.at, "--at");
   const Mesh base = iblcli::make_object(o.scene, o.object_size, o.triangles, {0, 0, 0});
+  {
+    Mesh placed = base;
+    placed.transform(1.0, at);
+    for (const Lighting& L : lightings)
+      if (std::string w = iblcli::grid_bounds_warning(L, placed); !w.empty()) iblcli::info("warning: " + w);
+  }
 
   if (!glfwInit()) fail(ErrorKind::Unsupported, "no display: GLFW could not initialise (is DISPLAY set? try xvfb-run)");
   struct Terminate { ~Terminate() { glfwTerminate(); } } terminate;

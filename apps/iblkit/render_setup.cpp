@@ -100,6 +100,21 @@ void load_lighting(const std::string& path, const LightingOptions& o, Lighting* 
   }
 }
 
+std::string grid_bounds_warning(const Lighting& L, const Mesh& object) {
+  if (!L.grid) return {};
+  Vec3 lo, hi;
+  object.bounds(&lo, &hi);
+  const Vec3 gmin = L.grid->min, gmax = L.grid->max;
+  constexpr double kSlack = 1e-6;  // metres: an object exactly on the volume's faces is inside
+  for (int a = 0; a < 3; ++a)
+    if (lo[a] < gmin[a] - kSlack || hi[a] > gmax[a] + kSlack)
+      return fmt::format("the object spans ({:.3g}, {:.3g}, {:.3g})..({:.3g}, {:.3g}, {:.3g}), outside the SH grid's volume "
+                         "({:.3g}, {:.3g}, {:.3g})..({:.3g}, {:.3g}, {:.3g}): lookups there clamp to the grid's faces "
+                         "(move it with --at, shrink it with --object-size)",
+                         lo.x, lo.y, lo.z, hi.x, hi.y, hi.z, gmin.x, gmin.y, gmin.z, gmax.x, gmax.y, gmax.z);
+  return {};
+}
+
 Mesh make_object(const std::string& scene, double size, int triangles, Vec3 at) {
   Mesh object;
   if (!(size > 0) && (scene == "blob" || scene == "sphere")) fail(ErrorKind::Value, "--object-size must be > 0 for the {}", scene);

@@ -27,6 +27,10 @@ struct LightingOptions {
 // description.
 void load_lighting(const std::string& path, const LightingOptions& o, ibl::render::Lighting* L, std::string* kind);
 
+// A warning when the object reaches outside an SH grid's volume (lookups there clamp to the grid's
+// faces), or an empty string.
+std::string grid_bounds_warning(const ibl::render::Lighting& L, const ibl::render::Mesh& object);
+
 // "blob" (the procedural bunny stand-in, `triangles`), "sphere", or a mesh file centred and scaled
 // to `size` (its largest extent), then moved to `at`; size 0 keeps a mesh file where and as large
 // as it is (a room such as examples/crypt.obj).
