@@ -63,7 +63,7 @@ if [ -f "$PROBE" ]; then
   check render-missing-mesh fail "nothere.obj" -- "$BIN" render "$T/nothere.obj" --light "$PROBE" --backend cpu --out "$T/rm.png"
   check render-bad-size fail "--size" -- "$BIN" render blob --light "$PROBE" --size 64by48 --out "$T/r.png"
   printf '{"format":"iblkit.lights/1","lights":[{"direction":[0,1,0]}]}' > "$T/bad_lights.json"
-  check render-bad-lights fail "lacks" -- "$BIN" render blob --light "$T/bad_lights.json" --backend cpu --out "$T/r.png"
+  check render-bad-lights fail "irradiance" -- "$BIN" render blob --light "$T/bad_lights.json" --backend cpu --out "$T/r.png"
   [ -s "$T/demo/contact_sheet.png" ] && pass=$((pass+1)) || { echo "FAIL demo wrote no contact sheet"; fail=$((fail+1)); }
 else
   skip=$((skip+1))
