@@ -1,7 +1,10 @@
 #include "iblkit/lab/scene_io.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
+
+#include <fmt/ranges.h>
 
 #include <nlohmann/json.hpp>
 
@@ -234,7 +237,18 @@ std::string resolve_scene_path(const std::string& name) {
   if (fs::exists(name)) return name;
   fs::path builtin = fs::path(IBLKIT_SOURCE_DIR) / "examples" / (name + ".json");
   if (name.find('/') == std::string::npos && fs::exists(builtin)) return builtin.string();
-  fail(ErrorKind::Io, "{}: no such scene file (built-in scenes: low-scene1, low-scene2, t-corridor, crypt)", name);
+  // The built-in scenes are the iblkit.scene/1 files in examples/.
+  std::vector<std::string> names;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(fs::path(IBLKIT_SOURCE_DIR) / "examples", ec)) {
+    if (entry.path().extension() != ".json") continue;
+    std::ifstream in(entry.path());
+    std::string head(256, '\0');
+    in.read(head.data(), static_cast<std::streamsize>(head.size()));
+    if (head.find("iblkit.scene/1") != std::string::npos) names.push_back(entry.path().stem().string());
+  }
+  std::sort(names.begin(), names.end());
+  fail(ErrorKind::Io, "{}: no such scene file (built-in scenes: {})", name, fmt::join(names, ", "));
 }
 
 Scene load_scene(const std::string& name_or_path, bool build) {
