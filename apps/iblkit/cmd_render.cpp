@@ -345,7 +345,7 @@ void demo_step(iblcli::DemoContext& ctx) {
     }
     std::string pic = base + "/fig9.png";
     io::write_image(pic, io::contact_sheet(sheet, static_cast<int>(sheet.size()), 320, 240));
-    ctx.pictures.push_back({"render: Fig. 9 in low-scene2 (lab photo, 8³, 16³, 32³)", pic});
+    ctx.pictures.push_back({"render: Fig. 9 in low-scene2 (lab photo, 8^3, 16^3, 32^3 grids)", pic});
     j["fig9_object_rel_l1"] = errs;
   }
   ctx.summary["render"] = j;
