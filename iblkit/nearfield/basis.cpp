@@ -11,34 +11,47 @@ namespace {
 
 double hat(double x) { return std::max(0.0, 1.0 - std::abs(x)); }
 
-int dual_k(Basis b) { return b == Basis::Bilinear ? 2 : 3; }
+constexpr int kQ = 4;  // dual nodes per spacing
 
-// ∫ β1(2x − k) β(x − j) dx, exactly: both factors are polynomials on every half-integer interval
+// Number of unknowns a_0 … a_{n−1}: nodes k/kQ with |k| < kQ·(half width).
+int dual_unknowns(Basis b) { return static_cast<int>(kQ * dual_half_width(b)); }
+
+// ∫ β1(kQ·x − k) β(x − j) dx, exactly: both factors are polynomials on every quarter-integer interval
 // (degree ≤ 3 in total), so 3-point Gauss–Legendre on each is exact.
 double gram(Basis b, int k, int j) {
   static const double gx[3] = {-std::sqrt(0.6), 0.0, std::sqrt(0.6)}, gw[3] = {5.0 / 9, 8.0 / 9, 5.0 / 9};
-  double lo = std::max((k - 1) * 0.5, j - primal_half_width(b)), hi = std::min((k + 1) * 0.5, j + primal_half_width(b));
+  const double step = 1.0 / kQ;
+  double lo = std::max((k - 1) * step, j - primal_half_width(b)), hi = std::min((k + 1) * step, j + primal_half_width(b));
   double acc = 0;
-  for (double a = lo; a < hi - 1e-12; a += 0.5) {
-    double c = a + 0.25, r = 0.25;
+  for (double a = lo; a < hi - 1e-12; a += step) {
+    double c = a + 0.5 * step, r = 0.5 * step;
     for (int q = 0; q < 3; ++q) {
       double x = c + r * gx[q];
-      acc += r * gw[q] * hat(2 * x - k) * primal(b, x - j);
+      acc += r * gw[q] * hat(kQ * x - k) * primal(b, x - j);
     }
   }
   return acc;
 }
 
 std::vector<double> solve_dual(Basis b) {
-  const int K = dual_k(b);
-  // Unknowns a_0..a_K; condition j: Σ_k a_|k| G(k, j) = δ_j0.
-  Eigen::MatrixXd M = Eigen::MatrixXd::Zero(K + 1, K + 1);
-  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(K + 1);
+  const int n = dual_unknowns(b), K = n - 1;
+  const int nj = static_cast<int>(std::ceil(dual_half_width(b) + primal_half_width(b)));  // shifts that overlap
+  // Rows: biorthogonality Σ_k a_|k| G(k, j) = δ_j0 for j = 0..nj−1, then the partition of unity
+  // Σ_m φ'(x − m) = 1 at the node offsets r/kQ, r = 0..kQ−1 (which makes Σ_mn E_mn the irradiance
+  // behind an open aperture, so that the reconstruction keeps the power of any light field).
+  Eigen::MatrixXd M = Eigen::MatrixXd::Zero(nj + kQ, n);
+  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(nj + kQ);
   rhs(0) = 1;
-  for (int j = 0; j <= K; ++j)
+  for (int j = 0; j < nj; ++j)
     for (int k = -K; k <= K; ++k) M(j, std::abs(k)) += gram(b, k, j);
-  Eigen::VectorXd a = M.fullPivLu().solve(rhs);
-  if (!(M * a).isApprox(rhs, 1e-10)) fail(ErrorKind::Internal, "dual filter of the {} basis: singular system", basis_name(b));
+  for (int r = 0; r < kQ; ++r) {
+    for (int k = -K; k <= K; ++k)
+      if (((k - r) % kQ + kQ) % kQ == 0) M(nj + r, std::abs(k)) += 1;
+    rhs(nj + r) = 1;
+  }
+  // Underdetermined: the minimum-norm solution.
+  Eigen::VectorXd a = M.completeOrthogonalDecomposition().solve(rhs);
+  if ((M * a - rhs).norm() > 1e-10) fail(ErrorKind::Internal, "dual filter of the {} basis: inconsistent conditions", basis_name(b));
   return std::vector<double>(a.data(), a.data() + a.size());
 }
 
@@ -53,7 +66,7 @@ double primal(Basis b, double x) {
 }
 
 double primal_half_width(Basis b) { return b == Basis::Bilinear ? 1.0 : 1.5; }
-double dual_half_width(Basis b) { return 0.5 * (dual_k(b) + 1); }
+double dual_half_width(Basis b) { return b == Basis::Bilinear ? 1.5 : 2.0; }
 
 const std::vector<double>& dual_coefficients(Basis b) {
   static const std::vector<double> lin = solve_dual(Basis::Bilinear), quad = solve_dual(Basis::Biquadratic);
@@ -62,9 +75,9 @@ const std::vector<double>& dual_coefficients(Basis b) {
 
 double dual(Basis b, double x) {
   const auto& a = dual_coefficients(b);
-  const int K = dual_k(b);
+  const int K = dual_unknowns(b) - 1;
   // Only the two hats whose nodes bracket x are non-zero.
-  double y = 2 * x;
+  double y = kQ * x;
   int k0 = static_cast<int>(std::floor(y));
   double acc = 0;
   for (int k = k0; k <= k0 + 1; ++k)

@@ -75,15 +75,17 @@ Vec3 Luminaire::irradiance(Vec3 x, Vec3 n, const std::function<bool(int)>& visib
   Vec3 acc{0, 0, 0};
   for (size_t ei = 0; ei < emitters.size(); ++ei) {
     const auto& e = emitters[ei];
-    if (visible && !visible(static_cast<int>(ei))) continue;
+    Vec3 sum{0, 0, 0};
     for (const auto& [y, da] : quadrature(e)) {
       const Vec3 v = x - y;
       const double r2 = dot(v, v), r = std::sqrt(r2);
       const Vec3 w = v / r;
       const double ce = dot(w, e.normal), cx = -dot(w, n);
       if (ce <= 0 || cx <= 0) continue;
-      acc += emitted(e, w) * (ce * cx * da / r2);
+      sum += emitted(e, w) * (ce * cx * da / r2);
     }
+    // Shadow rays only for emitters that send light here.
+    if ((sum.x != 0 || sum.y != 0 || sum.z != 0) && (!visible || visible(static_cast<int>(ei)))) acc += sum;
   }
   return acc;
 }
