@@ -91,4 +91,25 @@ inline bool point_light_view_projection(Vec3 position, Vec3 centre, double radiu
   return true;
 }
 
+// The six faces of a cube shadow map around a point light (+X, −X, +Y, −Y, +Z, −Z, each a 95°
+// frustum: a margin at the face edges so that the 2×2 PCF taps stay inside), reaching `far` metres.
+// The shader picks the face of the largest component of p − position (its sign: + first).
+inline std::array<Mat4f, 6> cube_light_view_projections(Vec3 position, double far) {
+  static const Vec3 axes[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  static const Vec3 ups[6] = {{0, 1, 0}, {0, 1, 0}, {0, 0, 1}, {0, 0, -1}, {0, 1, 0}, {0, 1, 0}};
+  std::array<Mat4f, 6> out;
+  for (int f = 0; f < 6; ++f) {
+    Camera c;
+    c.eye = position;
+    c.target = position + axes[f];
+    c.up = ups[f];
+    c.fov_y_deg = 95;
+    c.width = c.height = 1;
+    c.zfar = far;
+    c.znear = std::max(1e-4, far * 1e-4);
+    out[f] = mul(c.projection(), c.view());
+  }
+  return out;
+}
+
 }  // namespace ibl::render

@@ -267,8 +267,8 @@ TEST_F(RenderGl, ShGridAgreesWithCpu) {
   }
 }
 
-// Point lights with perspective shadow maps against shadow rays; a light inside the objects'
-// bounds is drawn unshadowed on the GPU and counted.
+// Point lights with perspective shadow maps (cube maps inside the objects' bounds) against shadow
+// rays; a light that finds no free shadow layer is drawn unshadowed and counted.
 TEST_F(RenderGl, PointLightsWithShadowsAgreeWithCpu) {
   gl::Context ctx;
   Mesh blob = make_blob(6000, 0.5), floor = make_floor(1.6, -0.25);
@@ -293,7 +293,26 @@ TEST_F(RenderGl, PointLightsWithShadowsAgreeWithCpu) {
     EXPECT_LT(a.median, kLightsMedianTol) << "deferred " << deferred;
     EXPECT_LT(a.p99, kLightsP99Tol) << "deferred " << deferred;
   }
-  d.lighting.point_lights[0].position = {0, 0.1, 0};  // inside the bounding sphere of blob + floor
+  // A light inside the bounding sphere of blob + floor (beside the blob): a cube shadow map.
+  d.lighting.point_lights[0].position = {0.45, 0.35, 0.3};
+  cpu = render_cpu(d);
+  for (bool deferred : {false, true}) {
+    gl::Renderer r({deferred});
+    RenderResult g = r.render(d);
+    EXPECT_EQ(g.unshadowed_lights, 0);
+    Agreement a = compare(cpu, g);
+    if (const char* dir = std::getenv("IBLKIT_TEST_PICTURES")) {
+      io::write_image(std::string(dir) + "/cube_cpu.png", io::tonemap(cpu.color));
+      io::write_image(std::string(dir) + "/cube_gl.png", io::tonemap(g.color));
+    }
+    constexpr double kCubeMedianTol = 1e-3;
+    constexpr double kCubeP99Tol = 0.5;  // shadow edges, as above
+    EXPECT_LT(a.median, kCubeMedianTol) << "cube, deferred " << deferred;
+    EXPECT_LT(a.p99, kCubeP99Tol) << "cube, deferred " << deferred;
+  }
+  // Three cubes need 18 layers of the 16: the third light goes unshadowed, and is counted.
+  d.lighting.point_lights = {{{0.45, 0.35, 0.3}, {1, 1, 1}, true}, {{-0.45, 0.35, 0.3}, {1, 1, 1}, true},
+                             {{0, 0.35, -0.45}, {1, 1, 1}, true}};
   gl::Renderer r;
   EXPECT_EQ(r.render(d).unshadowed_lights, 1);
 }

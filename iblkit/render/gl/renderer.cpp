@@ -136,24 +136,32 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing)
                                          static_cast<float>(l.irradiance.x), static_cast<float>(l.irradiance.y),
                                          static_cast<float>(l.irradiance.z), 0.0f});
   }
-  // Point lights: a perspective shadow map each when they sit outside the objects' bounding sphere
-  // (a light inside it would need a cube map: it is drawn unshadowed, and `unshadowed` counts it).
+  // Point lights: a perspective shadow map when they sit outside the objects' bounding sphere, else a
+  // cube of six (layers of the same array). A light that finds no free layers is drawn unshadowed
+  // and counted in `unshadowed`.
   std::vector<float> point_data;
   for (const auto& l : L.point_lights) {
     float layer = -1;
     Mat4f m;
-    if (l.shadow && static_cast<int>(shadow_mats.size()) >= kMaxShadowMaps) ++unshadowed;
-    if (l.shadow && static_cast<int>(shadow_mats.size()) < kMaxShadowMaps) {
-      if (point_light_view_projection(l.position, centre, radius, &m)) {
+    float cube = 0;
+    if (l.shadow) {
+      const int free_layers = kMaxShadowMaps - static_cast<int>(shadow_mats.size());
+      if (point_light_view_projection(l.position, centre, radius, &m) && free_layers >= 1) {
         layer = static_cast<float>(shadow_mats.size());
         shadow_mats.push_back(m);
+      } else if (free_layers >= 6) {
+        // Inside (or next to) the objects' bounding sphere: a cube map of six faces.
+        layer = static_cast<float>(shadow_mats.size());
+        cube = 1;
+        for (const Mat4f& f : cube_light_view_projections(l.position, length(centre - l.position) + radius * 1.01))
+          shadow_mats.push_back(f);
       } else {
         ++unshadowed;
       }
     }
     point_data.insert(point_data.end(), {static_cast<float>(l.position.x), static_cast<float>(l.position.y),
                                          static_cast<float>(l.position.z), layer, static_cast<float>(l.intensity.x),
-                                         static_cast<float>(l.intensity.y), static_cast<float>(l.intensity.z), 0.0f});
+                                         static_cast<float>(l.intensity.y), static_cast<float>(l.intensity.z), cube});
   }
   GLuint point_ssbo;
   glCreateBuffers(1, &point_ssbo);

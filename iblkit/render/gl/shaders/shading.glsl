@@ -27,8 +27,8 @@ layout(std430, binding = 0) readonly buffer Lights { Light lights[]; };
 layout(std430, binding = 1) readonly buffer ShadowMatrices { mat4 shadow_matrices[]; };
 uniform int u_light_count;
 struct PointLightGpu {
-  vec4 position;   // xyz: world position; w: shadow layer or −1
-  vec4 intensity;  // rgb, W/sr
+  vec4 position;   // xyz: world position; w: shadow layer or −1 (the first of six for a cube)
+  vec4 intensity;  // rgb, W/sr; w: 1 for a cube shadow map (faces +X −X +Y −Y +Z −Z)
 };
 layout(std430, binding = 7) readonly buffer PointLights { PointLightGpu point_lights[]; };
 uniform int u_point_light_count;
@@ -161,6 +161,11 @@ vec3 shade(vec3 p, vec3 n_in, vec3 albedo, vec3 specular, float exponent, int lo
       l = to * inversesqrt(d2);
       irr = q.intensity.rgb / d2;
       layer = q.position.w;
+      if (layer >= 0.0 && q.intensity.w > 0.5) {  // cube: the face of the largest component of p − light
+        vec3 a = abs(-to);
+        int face = a.x >= a.y && a.x >= a.z ? (-to.x >= 0.0 ? 0 : 1) : (a.y >= a.z ? (-to.y >= 0.0 ? 2 : 3) : (-to.z >= 0.0 ? 4 : 5));
+        layer += float(face);
+      }
     }
     float ndl = dot(n, l);
     if (ndl <= 0.0) continue;
