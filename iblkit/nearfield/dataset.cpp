@@ -97,6 +97,7 @@ Dataset read_dataset(const std::string& path) {
     fail(ErrorKind::Format, "{}: not an iblkit.nearfield/1 manifest (\"format\" is missing or different)", path);
   Dataset ds;
   ds.name = j.value("name", fs::path(path).stem().string());
+  ds.luminaire = j.value("luminaire", "");
   ds.basis = basis_from_name(j.value("basis", ""), path + ": basis");
   ds.spacing = number(j, "spacing", path);
   ds.filter_width = number(j, "filter_width", path);
@@ -163,6 +164,7 @@ void write_dataset(const std::string& path, const Dataset& ds) {
     }
   json j = {{"format", "iblkit.nearfield/1"},
             {"name", ds.name},
+            {"luminaire", ds.luminaire},
             {"basis", basis_name(ds.basis)},
             {"spacing", ds.spacing},
             {"filter_width", ds.filter_width},

@@ -36,6 +36,7 @@ Basis basis_from_name(const std::string& name, const std::string& what);  // thr
 
 struct Dataset {
   std::string name;              // e.g. "flashlight-7x7"
+  std::string luminaire;         // the lab luminaire a simulated dataset came from ("" when measured)
   Basis basis = Basis::Biquadratic;  // Φ on S
   double spacing = 0.005;        // h: distance between neighbouring filter positions on S, metres
   double filter_width = 0.02;    // support width of the dual filter Φ' (must match basis and spacing)

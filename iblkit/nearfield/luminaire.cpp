@@ -159,6 +159,7 @@ Dataset simulate(const Luminaire& lum, const SimulateDesc& desc, const ProgressF
     fail(ErrorKind::Value, "simulate: spacing {} m, distance {} m, resolution {}, extent {}: need positive values",
          desc.spacing, desc.distance, desc.resolution, desc.extent);
   Dataset ds;
+  ds.luminaire = lum.name;
   ds.name = lum.name + "-" + std::to_string(desc.nx) + "x" + std::to_string(desc.ny);
   ds.basis = desc.basis;
   ds.spacing = desc.spacing;
