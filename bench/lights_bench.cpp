@@ -62,7 +62,6 @@ void BM_VarianceCut(benchmark::State& state) {
 }
 BENCHMARK(BM_VarianceCut)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
 
-#ifdef IBLKIT_HAVE_CERES
 // Optimisation only: the 20480 normals' ground truth and the initial cut are computed outside the loop.
 void BM_Optimize(benchmark::State& state) {
   auto* env = probe();
@@ -76,9 +75,10 @@ void BM_Optimize(benchmark::State& state) {
   ibl::lights::OptimizeReport rep;
   for (auto _ : state) benchmark::DoNotOptimize(ibl::lights::optimize_lights_from(*env, normals, gt, init.lights, od, &rep));
   state.counters["iterations"] = rep.iterations;
+  state.counters["final_iterations"] = rep.final_iterations;
+  state.counters["converged"] = rep.converged;
   state.counters["cost_ratio"] = rep.final_cost / rep.initial_cost;
 }
 BENCHMARK(BM_Optimize)->Arg(16)->Arg(64)->Unit(benchmark::kMillisecond)->Iterations(1)->UseRealTime();
-#endif
 
 }  // namespace
