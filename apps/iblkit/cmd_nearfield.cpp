@@ -110,7 +110,9 @@ void run_simulate(const SimOpts& o) {
   d.resolution = o.resolution;
   d.extent = o.extent;
   const auto half = lum.half_size();
-  const double pou = (0.5 * (std::min(d.nx, d.ny) - 1) - (nf::primal_half_width(d.basis) - 1) - 0.5 * (d.basis == nf::Basis::Biquadratic)) * d.spacing;
+  // Where the B-splines Φ_mn add up to 1 on S (the grid's full-reconstruction region), per axis.
+  const double trim = nf::primal_half_width(d.basis) - 1;
+  const double pou_x = (0.5 * (d.nx - 1) - trim) * d.spacing, pou_y = (0.5 * (d.ny - 1) - trim) * d.spacing;
   auto t0 = std::chrono::steady_clock::now();
   auto ds = nf::simulate(lum, d, iblcli::progress_bar());
   iblcli::progress_done();
@@ -120,14 +122,14 @@ void run_simulate(const SimOpts& o) {
   json j = {{"manifest", o.out}, {"name", ds.name}, {"luminaire", lum.name}, {"grid", {ds.nx, ds.ny}},
             {"basis", nf::basis_name(ds.basis)}, {"spacing", ds.spacing}, {"filter_width", ds.filter_width},
             {"distance", ds.distance}, {"extent", ds.m_max.x}, {"resolution", d.resolution}, {"seconds", secs},
-            {"luminaire_half_size", {half.x, half.y}}, {"full_reconstruction_half_width", pou}};
+            {"luminaire_half_size", {half.x, half.y}}, {"full_reconstruction_half_size", {pou_x, pou_y}}};
   iblcli::emit(j, [&] {
     fmt::print("simulated {} ({} filter positions, {} dual filter {:.1f} mm wide, h = {:.1f} mm, d = {:.2f} m) in {:.2f} s\n",
                ds.name, ds.count(), nf::basis_name(ds.basis), ds.filter_width * 1e3, ds.spacing * 1e3, ds.distance, secs);
     fmt::print("  images {}x{} over ±{:.3f} m on M\n  manifest: {}\n", d.resolution, d.resolution, ds.m_max.x, o.out);
-    if (std::max(half.x, half.y) > pou)
-      fmt::print("  note: the luminaire ({:.1f} x {:.1f} mm half size) reaches beyond the grid's full-reconstruction region (±{:.1f} mm)\n",
-                 half.x * 1e3, half.y * 1e3, pou * 1e3);
+    if (half.x > pou_x || half.y > pou_y)
+      fmt::print("  note: the luminaire ({:.1f} x {:.1f} mm half size) reaches beyond the grid's full-reconstruction region (±{:.1f} x ±{:.1f} mm)\n",
+                 half.x * 1e3, half.y * 1e3, pou_x * 1e3, pou_y * 1e3);
   });
 }
 
