@@ -199,7 +199,7 @@ struct RenderOpts {
   std::string dataset, scene = "crypt", out, eye = "0.9,1.5,0.9", target = "-1.1,0.3,-1.5", ies;
   int size = 400;
   double fov = 55, ies_scale = 1;
-  bool no_shadows = false;
+  bool no_shadows = false, srgbe = false;
   LightOpts light;
 };
 
@@ -234,6 +234,13 @@ void run_render(const RenderOpts& o) {
             {"shadows", !o.no_shadows}, {"setup_seconds", t_setup}, {"render_seconds", t_render}};
   std::vector<Image> imgs{img};
   std::vector<std::string> names{"near-field (Eq. 14)"};
+  if (o.srgbe) {
+    // The paper's 8-bit sRGBE frame buffer between passes of 3 spotlights, against the float sum.
+    Image q = nf::render_spotlights(sv, lights, view, !o.no_shadows, {}, 3);
+    auto st = nf::compare(q, img);
+    j["srgbe_passes"] = {{"passes", (lights.size() + 2) / 3}, {"error_vs_float", stats_json(st)},
+                         {"frame_buffer_bytes_float", 12 * o.size * o.size}, {"frame_buffer_bytes_srgbe", 4 * o.size * o.size}};
+  }
   auto lum = o.ies.empty() ? comparison(ds, o.light.exact) : std::nullopt;
   if (lum) {
     t0 = std::chrono::steady_clock::now();
@@ -281,6 +288,11 @@ void run_render(const RenderOpts& o) {
       fmt::print("  far field  vs exact: RMS {:.1f}%, mean |Δ| {:.1f}% of the mean, max {:.1f}% of the max, power ×{:.3f}\n",
                  100 * a["rel_rms"].get<double>(), 100 * a["rel_mean_abs"].get<double>(), 100 * a["rel_max"].get<double>(),
                  a["power_ratio"].get<double>());
+    }
+    if (j.contains("srgbe_passes")) {
+      auto& a = j["srgbe_passes"]["error_vs_float"];
+      fmt::print("  sRGBE frame buffer ({} passes of 3, 4 instead of 12 bytes a pixel): RMS {:.3f}%, max {:.3f}% of the max vs float\n",
+                 j["srgbe_passes"]["passes"].get<int>(), 100 * a["rel_rms"].get<double>(), 100 * a["rel_max"].get<double>());
     }
     if (j.contains("comparison")) fmt::print("  side by side: {}\n", j["comparison"].get<std::string>());
   });
@@ -380,6 +392,7 @@ void setup(CLI::App& app) {
   r->add_option("--exact", ro->light.exact, "also render the lab luminaire exactly (NAME or auto) and the far field, with errors");
   r->add_flag("--no-far", ro->light.no_far, "with --exact: skip the far-field picture");
   r->add_flag("--no-shadows", ro->no_shadows, "no visibility tests");
+  r->add_flag("--srgbe", ro->srgbe, "also sum through the paper's sRGBE frame buffer (passes of 3) and report its error");
   r->footer("Examples:\n  iblkit nearfield render bike/bike.json --scene crypt --out view.png\n"
             "  iblkit nearfield render bike/bike.json --scene crypt --exact auto --size 200 --out view.png");
   r->callback([ro] {

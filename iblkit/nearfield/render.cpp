@@ -5,6 +5,7 @@
 
 #include "iblkit/core/error.h"
 #include "iblkit/core/parallel.h"
+#include "iblkit/nearfield/rgbe.h"
 
 namespace ibl::nearfield {
 
@@ -137,16 +138,20 @@ Image render_rows(const SceneView& sv, const View& view, const ProgressFn& progr
 }  // namespace
 
 Image render_spotlights(const SceneView& sv, const std::vector<TexturedSpotlight>& lights, const View& view, bool shadows,
-                        const ProgressFn& progress) {
+                        const ProgressFn& progress, int srgbe_group) {
+  if (srgbe_group < 0) fail(ErrorKind::Value, "sRGBE pass size {} must be ≥ 0", srgbe_group);
   return render_rows(sv, view, progress, [&](Vec3 p, Vec3 n) {
-    Vec3 e{0, 0, 0};
-    for (const auto& L : lights) {
-      const Vec3 c = irradiance(L, p, n);
-      if (c.x == 0 && c.y == 0 && c.z == 0) continue;
-      if (shadows && L.shadow && sv.blocked(p, L.position)) continue;
-      e += c;
+    Vec3 e{0, 0, 0}, pass{0, 0, 0};
+    for (size_t k = 0; k < lights.size(); ++k) {
+      const auto& L = lights[k];
+      Vec3 c = irradiance(L, p, n);
+      if ((c.x != 0 || c.y != 0 || c.z != 0) && !(shadows && L.shadow && sv.blocked(p, L.position))) pass += c;
+      if (srgbe_group > 0 && ((k + 1) % static_cast<size_t>(srgbe_group) == 0 || k + 1 == lights.size())) {
+        e = decode_srgbe(encode_srgbe(e + pass));  // the frame buffer between passes
+        pass = {0, 0, 0};
+      }
     }
-    return e;
+    return e + pass;
   });
 }
 

@@ -63,8 +63,11 @@ class SceneView {
 };
 
 // Outgoing radiance images (RGB, W/(sr·m²)). `shadows` false drops every visibility test.
+// `srgbe_group` > 0 emulates the paper's 8-bit frame buffer (§4.1–4.2): the spotlights are summed in
+// passes of that many (the paper: 3), and after every pass the running irradiance sum is stored as
+// sRGBE (rgbe.h) and read back, as between the paper's rendering passes.
 Image render_spotlights(const SceneView& sv, const std::vector<TexturedSpotlight>& lights, const View& view,
-                        bool shadows, const ProgressFn& progress = {});
+                        bool shadows, const ProgressFn& progress = {}, int srgbe_group = 0);
 Image render_exact(const SceneView& sv, const Luminaire& lum, const Placement& placement, const View& view,
                    bool shadows, const ProgressFn& progress = {});
 
