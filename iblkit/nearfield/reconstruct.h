@@ -8,9 +8,10 @@
 // g_mn(s,t) = d²/R_mn⁴, R_mn² = d² + (s − c_u)² + (t − c_v)². Biorthogonality (∫Φ'_mn Φ_kl = δ) then
 // gives E_mn(s,t) ≈ h² · g_mn(s,t) · Σ_kl Φ_kl(s,t) L_mnkl (Eq. 9) and
 //
-//   ┌───────────────────────────────────────────────────────────────┐
-//   │ E'_mn = Σ_kl Φ_kl(s,t) L_mnkl,  L_mnkl · g_mn,kl = coefficients of E_mn/h² in the M basis │
-//   └───────────────────────────────────────────────────────────────┘
+//   ╔═════════════════════════════════════════════════════════════════════════════╗
+//   ║  E'_mn(s,t) = Σ_kl Φ_kl(s,t) L_mnkl,  where g_mn,kl · L_mnkl are the         ║
+//   ║  coefficients of E_mn / h² in the basis on M                                 ║
+//   ╚═════════════════════════════════════════════════════════════════════════════╝
 //
 // With the bilinear (interpolating) basis on M, the coefficients are the pixel values and the
 // deconvolution is a division per pixel: E'_mn(p) = E_mn(p) / (h² g_mn(p)). With the biquadratic
