@@ -48,7 +48,7 @@ void setup(CLI::App& app) {
     double floor_size = 6;
     std::string luminaire = "0,1,0", luminaire_dir = "0,0,1";
     std::string texture, lobe = "phong";
-    double exposure = 0;
+    double exposure = 0, fov = 40;
   };
   auto* o = new Opts();
   app.add_option("scene", o->scene,
@@ -99,6 +99,7 @@ void setup(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--luminaire-dir", o->luminaire_dir, "the direction the luminaire shines, x,y,z")->capture_default_str();
   app.add_option("--eye", o->eye, "camera position x,y,z")->capture_default_str();
+  app.add_option("--fov", o->fov, "vertical field of view, degrees")->check(CLI::Range(1.0, 170.0))->capture_default_str();
   app.add_option("--target", o->target, "camera target x,y,z")->capture_default_str();
   auto& rd = iblcli::add_probe_read_options(app);
   app.footer("Examples:\n  iblkit render blob --light probe.exr --out blob.png --backend cpu --size 400x300\n"
@@ -113,6 +114,7 @@ void setup(CLI::App& app) {
     d.camera.height = h;
     d.camera.eye = iblcli::parse_vec3(o->eye, "--eye");
     d.camera.target = iblcli::parse_vec3(o->target, "--target");
+    d.camera.fov_y_deg = o->fov;
     Vec3 at = iblcli::parse_vec3(o->at, "--at");
     Mesh object = iblcli::make_object(o->scene, o->object_size, o->triangles, at);
     Vec3 lo, hi;

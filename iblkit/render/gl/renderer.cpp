@@ -175,6 +175,7 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing)
   std::vector<Mat4f> spot_mats;
   GLuint spot_tex = 0;
   int spot_levels = 0;
+  std::vector<float> spot_scale;
   if (!L.spotlights.empty()) {
     const auto& first = L.spotlights[0];
     if (!first.mips || first.mips->empty()) fail(ErrorKind::Value, "textured spotlight 0 has no texture");
@@ -190,12 +191,19 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing)
       if (!sp.mips || sp.mips->size() != static_cast<size_t>(spot_levels) || (*sp.mips)[0].width() != tw ||
           (*sp.mips)[0].height() != th)
         fail(ErrorKind::Unsupported, "the GL renderer takes textured spotlights of one texture size per frame (spotlight {} differs from spotlight 0)", i);
+      // Half floats hold up to 65504 with 11-bit mantissas: each texture is stored divided by its
+      // largest |texel| (measured radiance of a small LED reaches 10⁶ and more), the shader
+      // multiplies it back.
+      float peak = 0;
+      for (size_t k = 0; k < (*sp.mips)[0].size(); ++k) peak = std::max(peak, std::abs((*sp.mips)[0].data()[k]));
+      const float scale = peak > 0 && std::isfinite(peak) ? peak : 1.0f;
+      spot_scale.push_back(scale);
       for (int lv = 0; lv < spot_levels; ++lv) {
         const Image& im = (*sp.mips)[lv];
         if (im.channels() != 3) fail(ErrorKind::Value, "spotlight {} mip {} is not RGB", i, lv);
         rgba.assign(im.pixel_count() * 4, 0.0f);
         for (size_t k = 0; k < im.pixel_count(); ++k)
-          for (int c = 0; c < 3; ++c) rgba[k * 4 + c] = im.data()[k * 3 + c];
+          for (int c = 0; c < 3; ++c) rgba[k * 4 + c] = im.data()[k * 3 + c] / scale;
         glTextureSubImage3D(spot_tex, lv, 0, 0, static_cast<GLint>(i), im.width(), im.height(), 1, GL_RGBA, GL_FLOAT, rgba.data());
       }
       float layer = -1;
@@ -225,7 +233,7 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing)
                              static_cast<float>(sp.frame.b.x), static_cast<float>(sp.frame.b.y), static_cast<float>(sp.frame.b.z), static_cast<float>(sp.tex_min.y),
                              static_cast<float>(sp.frame.n.x), static_cast<float>(sp.frame.n.y), static_cast<float>(sp.frame.n.z), static_cast<float>(sp.plane_distance),
                              static_cast<float>(sp.tex_max.x), static_cast<float>(sp.tex_max.y), static_cast<float>(sp.support_area), static_cast<float>(sp.support_width),
-                             static_cast<float>(texel), static_cast<float>(spot_levels), static_cast<float>(i), 0.0f};
+                             static_cast<float>(texel), static_cast<float>(spot_levels), static_cast<float>(i), spot_scale.back()};
       spot_data.insert(spot_data.end(), row, row + 24);
     }
     glTextureParameteri(spot_tex, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);

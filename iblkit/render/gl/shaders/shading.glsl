@@ -39,7 +39,8 @@ struct SpotGpu {
   vec4 up;        // xyz: t axis; w: tex_min.y
   vec4 forward;   // xyz: normal of S towards M; w: plane distance d
   vec4 extent;    // tex_max.x, tex_max.y, support area A, support width
-  vec4 tex;       // x: level-0 texel size (m), y: mip levels, z: layer in u_spot_textures
+  vec4 tex;       // x: level-0 texel size (m), y: mip levels, z: layer in u_spot_textures, w: the
+                  // scale the layer was divided by (its largest |texel|: half floats stop at 65504)
 };
 layout(std430, binding = 8) readonly buffer Spots { SpotGpu spots[]; };
 layout(std430, binding = 9) readonly buffer SpotShadowMatrices { mat4 spot_shadow_matrices[]; };
@@ -88,7 +89,7 @@ vec3 spot_irradiance(SpotGpu L, vec3 p, vec3 n) {
   vec2 uv = vec2((s - tmin.x) / (tmax.x - tmin.x), (tmax.y - t) / (tmax.y - tmin.y));
   float footprint = L.extent.w * abs(1.0 - d / z);
   float lambda = footprint > 0.0 ? clamp(log2(footprint / L.tex.x), 0.0, L.tex.y - 1.0) : 0.0;
-  vec3 e = textureLod(u_spot_textures, vec3(uv, L.tex.z), lambda).rgb;
+  vec3 e = textureLod(u_spot_textures, vec3(uv, L.tex.z), lambda).rgb * L.tex.w;
   return e * (L.extent.z * cos_l * cos_r / d2);
 }
 
