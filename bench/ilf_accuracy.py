@@ -7,7 +7,8 @@ Run through bench/ilf_accuracy.sh, which documents the settings. For each scene:
   2. the exact answers: `lab truth` SH (5 bands) at POINTS random grid points of each grid size
      (the same points for every density and repair), both of the whole sphere and without the
      dead-angle cone (`--blind-cone`: what any mirror-ball sequence can see), and the irradiance
-     for the normal +Y at the PLANE_N² pixel centres of `ilf slice --plane y=PLANE_Y --size PLANE_N`;
+     for the plane's normal at the PLANE_N² pixel centres of `ilf slice --plane P --size PLANE_N`
+     (low-scene1: z = 0 facing the projector, normal −Z; low-scene2: y = 1 facing up);
   3. the truth's own noise floor: the truth settings against finer ones with another seed;
   4. `ilf build` for every density × grid × repair (buckets shared per density), the grid's SH read
      at the points straight from the .shgrid file, and its slice at the plane;
@@ -25,7 +26,28 @@ GRIDS = [int(v) for v in env("GRIDS", "8 16 32 64").split()]
 REPAIRS = env("REPAIRS", "mip pullpush none").split()
 SIZE, SAMPLES = int(env("SIZE", "48")), int(env("SAMPLES", "2"))
 POINTS = int(env("POINTS", "20"))
-PLANE_Y, PLANE_N = float(env("PLANE_Y", "1.0")), int(env("PLANE_N", "20"))
+PLANE_N = int(env("PLANE_N", "20"))
+# Irradiance plane per scene: axis, value, normal sign (−: `ilf slice --down`). PLANE ("z=0-") overrides.
+PLANES = {"low-scene1": ("z", 0.0, -1), "low-scene2": ("y", 1.0, +1)}
+
+
+def plane_of(scene):
+    v = env("PLANE")
+    if v:
+        sign = -1 if v.endswith("-") else 1
+        a, val = v.rstrip("+-").split("=")
+        return (a, float(val), sign)
+    return PLANES.get(scene, ("y", 1.0, +1))
+
+
+def plane_tag(pl):
+    return "%s%g%s" % (pl[0], pl[1], "-" if pl[2] < 0 else "+")
+
+
+def plane_normal(pl):
+    n = [0, 0, 0]
+    n["xyz".index(pl[0])] = pl[2]
+    return ",".join(map(str, n))
 FLOOR_POINTS = int(env("FLOOR_POINTS", "6"))
 DEAD = 4.2
 LOOK = [float(v) for v in env("LOOK", "0,1,0").split(",")]       # the balls' +Z; the dead angle is around −LOOK
@@ -116,12 +138,18 @@ def srgb8(v):
 
 
 # ---------------------------------------------------------------------------------------------
-def plane_points(lo, hi):
+def plane_points(lo, hi, pl):
+    """The pixel centres of `ilf slice` (image x along a1, image y down along a2), row by row."""
+    axis = "xyz".index(pl[0])
+    a1, a2 = (2 if axis == 0 else 0), (2 if axis == 1 else 1)
     pts = []
     for y in range(PLANE_N):
         for x in range(PLANE_N):
-            pts.append([lo[0] + (hi[0] - lo[0]) * (x + 0.5) / PLANE_N, PLANE_Y,
-                        hi[2] - (hi[2] - lo[2]) * (y + 0.5) / PLANE_N])
+            p = [0.0, 0.0, 0.0]
+            p[axis] = pl[1]
+            p[a1] = lo[a1] + (hi[a1] - lo[a1]) * (x + 0.5) / PLANE_N
+            p[a2] = hi[a2] - (hi[a2] - lo[a2]) * (y + 0.5) / PLANE_N
+            pts.append(p)
     return pts
 
 
@@ -154,28 +182,32 @@ def scene_run(scene):
             s["probes"] = seq["probes"][:N]
             json.dump(s, open(p, "w"), indent=1)
 
-    # Exact SH at the grid points of each grid (whole sphere and without the dead-angle cone).
-    def sh_truth():
-        out = {}
-        for n in GRIDS:
-            rows = []
-            for ijk in grid_indices(n):
+    # Exact SH at the grid points of each grid (whole sphere and without the dead-angle cone). The
+    # points of a grid are a prefix-stable random sequence: raising POINTS only adds truth evaluations.
+    truth = {}
+    for n in GRIDS:
+        path = os.path.join(sdir, "truth_sh_%d.json" % n)
+        rows = json.load(open(path)) if os.path.exists(path) else []
+        want = grid_indices(n)
+        if len(rows) < POINTS:
+            for ijk in want[len(rows):]:
                 p = grid_pos(lo, hi, n, ijk)
                 t = run("lab", "truth", scene, "--at", fmt3(p), "--bands", 5, "--normal", "0,1,0", "--blind-cone", DEAD, "--blind-axis", BLIND_AXIS, *TRUTH_SH)
-                rows.append({"ijk": ijk, "p": p, "sh": t["sh"]["coefficients"], "sh_visible": t["sh_visible"]["coefficients"],
+                rows.append({"ijk": list(ijk), "p": p, "sh": t["sh"]["coefficients"], "sh_visible": t["sh_visible"]["coefficients"],
                              "E": t["irradiance"][0]["irradiance"]})
-            out[str(n)] = rows
-            log(scene, "SH truth", n)
-        return out
-    truth = cached(os.path.join(sdir, "truth_sh.json"), sh_truth)
+            json.dump(rows, open(path + ".tmp", "w"))
+            os.replace(path + ".tmp", path)
+            log(scene, "SH truth", n, len(rows), "points")
+        truth[str(n)] = rows[:POINTS]
 
     def plane_truth():
         rows = []
-        for p in plane_points(lo, hi):
-            rows.append(run("lab", "truth", scene, "--at", fmt3(p), "--bands", 0, "--normal", "0,1,0", *TRUTH_PLANE)["irradiance"][0]["irradiance"])
+        for p in plane_points(lo, hi, pl):
+            rows.append(run("lab", "truth", scene, "--at", fmt3(p), "--bands", 0, "--normal", plane_normal(pl), *TRUTH_PLANE)["irradiance"][0]["irradiance"])
         log(scene, "plane truth")
         return rows
-    ptruth = cached(os.path.join(sdir, "truth_plane.json"), plane_truth)
+    pl = plane_of(scene)
+    ptruth = cached(os.path.join(sdir, "truth_plane_%s.json" % plane_tag(pl)), plane_truth)
 
     # The truth's noise floor: the settings above against finer maps, more sub-samples, another seed.
     def floor():
@@ -184,14 +216,14 @@ def scene_run(scene):
             t = run("lab", "truth", scene, "--at", fmt3(r["p"]), "--bands", 5, "--normal", "0,1,0", "--blind-cone", DEAD, "--blind-axis", BLIND_AXIS, *TRUTH_FINE)
             sh_pairs += zip(flat(r["sh"]), flat(t["sh"]["coefficients"]))
             vis_pairs += zip(flat(r["sh_visible"]), flat(t["sh_visible"]["coefficients"]))
-        pts = plane_points(lo, hi)
+        pts = plane_points(lo, hi, pl)
         step = max(1, len(pts) // FLOOR_POINTS)
         for i in range(0, len(pts), step)[:FLOOR_POINTS]:
-            t = run("lab", "truth", scene, "--at", fmt3(pts[i]), "--bands", 0, "--normal", "0,1,0", *TRUTH_FINE)
+            t = run("lab", "truth", scene, "--at", fmt3(pts[i]), "--bands", 0, "--normal", plane_normal(pl), *TRUTH_FINE)
             e_pairs += zip(ptruth[i], t["irradiance"][0]["irradiance"])
         log(scene, "truth floor")
         return {"sh": rel_l2(sh_pairs), "sh_visible": rel_l2(vis_pairs), "plane_irradiance": rel_l2(e_pairs), "points": FLOOR_POINTS}
-    tfloor = cached(os.path.join(sdir, "truth_floor.json"), floor)
+    tfloor = cached(os.path.join(sdir, "truth_floor_%s.json" % plane_tag(pl)), floor)
 
     results = []
     for N in DENSITIES:
@@ -206,23 +238,26 @@ def scene_run(scene):
                     got = read_shgrid_points(g, [tuple(r["ijk"]) for r in rows])
                     per = sorted(rel_l2(zip(flat(c), flat(r["sh_visible"]))) for c, r in zip(got, rows))
                     pfm = os.path.join(sdir, key + "_slice.pfm")
-                    run("ilf", "slice", g, "--plane", "y=%g" % PLANE_Y, "--size", PLANE_N, "--out", pfm)
+                    run("ilf", "slice", g, "--plane", "%s=%g" % pl[:2], "--size", PLANE_N, "--out", pfm, *(["--down"] if pl[2] < 0 else []))
                     img = read_pfm(pfm)
                     plane = [list(img[y][x]) for y in range(PLANE_N) for x in range(PLANE_N)]
                     if os.environ.get("KEEP_GRIDS") != "1":
                         os.remove(g)
                     os.remove(pfm)
-                    return {"probes": N, "grid": n, "repair": rep,
+                    return {"probes": N, "grid": n, "repair": rep, "points": POINTS, "plane": plane_tag(pl),
                             "sh": rel_l2((a, b) for c, r in zip(got, rows) for a, b in zip(flat(c), flat(r["sh"]))),
                             "sh_visible": rel_l2((a, b) for c, r in zip(got, rows) for a, b in zip(flat(c), flat(r["sh_visible"]))),
                             "sh_visible_median": per[len(per) // 2], "sh_visible_max": per[-1],
                             "plane_irradiance": rel_l2((a, b) for e, t in zip(plane, ptruth) for a, b in zip(e, t)),
                             "uncovered": b["fraction_uncovered"], "build_s": b["seconds"]["total"], "plane": plane}
-                res = cached(os.path.join(sdir, key + ".json"), measure)
+                path = os.path.join(sdir, key + ".json")
+                if os.path.exists(path) and (json.load(open(path)).get("points"), json.load(open(path)).get("plane")) != (POINTS, plane_tag(pl)):
+                    os.remove(path)  # measured at another number of points
+                res = cached(path, measure)
                 log(scene, key, "SH %.3f vis %.3f E %.3f" % (res["sh"], res["sh_visible"], res["plane_irradiance"]))
                 results.append(res)
     pictures(scene, sdir, ptruth, results)
-    return {"scene": scene, "floor": tfloor, "results": results,
+    return {"scene": scene, "plane": plane_tag(pl), "floor": tfloor, "results": results,
             "capture_s": json.load(open(os.path.join(sdir, "capture_time.json")))["seconds"]
             if os.path.exists(os.path.join(sdir, "capture_time.json")) else None}
 
@@ -305,22 +340,32 @@ def pictures(scene, sdir, ptruth, results):
 
 
 def table(allres):
-    out = ["| scene | probes | grid | repair | rel. L2 SH (whole sphere) | rel. L2 SH (visible) | median / worst point (visible) "
-           "| rel. L2 irradiance, plane y=%g | uncovered | build s |" % PLANE_Y,
-           "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+    """One row per scene × density × grid; the repairs side by side (they coincide where nothing is uncovered)."""
+    reps = REPAIRS
+    out = ["| scene (plane) | probes | grid | uncovered | rel. L2 SH, visible sphere (%s) | median / worst point (%s) "
+           "| rel. L2 irradiance on the plane (%s) | build s (%s) |" % (" / ".join(reps), reps[0], " / ".join(reps), reps[0]),
+           "| --- | --- | --- | --- | --- | --- | --- | --- |"]
     for s in allres:
-        for r in s["results"]:
-            out.append("| %s | %d | %d³ | %s | %.3f | %.3f | %.3f / %.3f | %.3f | %.2f%% | %.1f |" % (
-                s["scene"], r["probes"], r["grid"], r["repair"], r["sh"], r["sh_visible"], r["sh_visible_median"],
-                r["sh_visible_max"], r["plane_irradiance"], 100 * r["uncovered"], r["build_s"]))
+        by = {(r["probes"], r["grid"], r["repair"]): r for r in s["results"]}
+        for N in DENSITIES:
+            for n in GRIDS:
+                rr = [by[(N, n, rep)] for rep in reps]
+                def cells(field):
+                    vals = [r[field] for r in rr]
+                    best = min(vals)
+                    return " / ".join(("**%.3f**" if v == best and len(set("%.3f" % x for x in vals)) > 1 else "%.3f") % v for v in vals)
+                out.append("| %s (%s) | %d | %d³ | %.2f%% | %s | %.3f / %.2f | %s | %.1f |" % (
+                    s["scene"], s["plane"], N, n, 100 * rr[0]["uncovered"], cells("sh_visible"), rr[0]["sh_visible_median"],
+                    rr[0]["sh_visible_max"], cells("plane_irradiance"), rr[0]["build_s"]))
     out.append("")
-    out.append("| scene | truth floor: SH whole / visible (%s vs %s) | plane irradiance (%s vs %s) | capture s |" % (
+    out.append("| scene | SH whole sphere = visible? (max difference over all rows) | truth floor: SH (%s vs %s) | plane irradiance (%s vs %s) | capture s |" % (
         " ".join(TRUTH_SH), " ".join(TRUTH_FINE), " ".join(TRUTH_PLANE), " ".join(TRUTH_FINE)))
-    out.append("| --- | --- | --- | --- |")
+    out.append("| --- | --- | --- | --- | --- |")
     for s in allres:
         f = s["floor"]
-        out.append("| %s | %.4f / %.4f (%d points) | %.4f | %s |" % (s["scene"], f["sh"], f["sh_visible"], f["points"], f["plane_irradiance"],
-                                                                    "%.0f" % s["capture_s"] if s["capture_s"] else "—"))
+        dmax = max(abs(r["sh"] - r["sh_visible"]) for r in s["results"])
+        out.append("| %s | %.4f | %.4f (%d points) | %.4f | %s |" % (s["scene"], dmax, f["sh_visible"], f["points"], f["plane_irradiance"],
+                                                               "%.0f" % s["capture_s"] if s["capture_s"] else "—"))
     return "\n".join(out) + "\n"
 
 
