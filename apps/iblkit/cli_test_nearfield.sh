@@ -54,10 +54,10 @@ j = json.load(open(sys.argv[1])); j["measurements"] = [m for m in j["measurement
 json.dump(j, open(sys.argv[2], "w"))
 PY
 check missing-position fail "\(4, 3\) of the 9x7 grid has no measurement" -- "$BIN" nearfield info "$T/bike/cut.json"
-"$BIN" convert "$T/bike/images/ij_0_0_pos.exr" "$T/bike/images/small.exr" --mapping latlong --size 8 >/dev/null 2>&1
+"$BIN" convert "$T/bike/bike_images/ij_0_0_pos.exr" "$T/bike/bike_images/small.exr" --mapping latlong --size 8 >/dev/null 2>&1
 python3 - "$T/bike/bike.json" "$T/bike/size.json" <<'PY'
 import json, sys
-j = json.load(open(sys.argv[1])); j["measurements"][5]["positive"] = "images/small.exr"
+j = json.load(open(sys.argv[1])); j["measurements"][5]["positive"] = "bike_images/small.exr"
 json.dump(j, open(sys.argv[2], "w"))
 PY
 check size-mismatch fail "is 16x8x3, the first is 48x48x3" -- "$BIN" nearfield info "$T/bike/size.json"

@@ -365,7 +365,7 @@ void setup(CLI::App& app) {
   s->add_option("--distance", so->distance, "distance d between S and M (metres)")->capture_default_str();
   s->add_option("--resolution", so->resolution, "image size on M (pixels per side)")->capture_default_str();
   s->add_option("--extent", so->extent, "half-extent of M (metres); 0 = what the luminaire's cut-off reaches")->capture_default_str();
-  s->add_option("-o,--out", so->out, "manifest path (images go to images/ beside it)")->required();
+  s->add_option("-o,--out", so->out, "manifest path STEM.json (images go to STEM_images/ beside it)")->required();
   s->footer("Examples:\n  iblkit nearfield simulate bikelight --grid 9x7 --out bike/bike.json\n"
             "  iblkit nearfield simulate flashlight --grid 5x5 --spacing 0.0075 --out mag5/mag5.json");
   s->callback([so] { run_simulate(*so); });

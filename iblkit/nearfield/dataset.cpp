@@ -150,14 +150,16 @@ Dataset read_dataset(const std::string& path) {
 void write_dataset(const std::string& path, const Dataset& ds) {
   ds.validate(path);
   const fs::path dir = fs::path(path).parent_path();
+  // Images go to STEM_images/ so that two manifests in one folder never share (and overwrite) images.
+  const std::string sub = fs::path(path).stem().string() + "_images";
   std::error_code ec;
-  fs::create_directories(dir / "images", ec);
-  if (ec) fail(ErrorKind::Io, "{}: cannot create {}: {}", path, (dir / "images").string(), ec.message());
+  fs::create_directories(dir / sub, ec);
+  if (ec) fail(ErrorKind::Io, "{}: cannot create {}: {}", path, (dir / sub).string(), ec.message());
   json ms = json::array();
   for (int j = 0; j < ds.ny; ++j)
     for (int i = 0; i < ds.nx; ++i) {
       const size_t k = static_cast<size_t>(j * ds.nx + i);
-      std::string pos = fmt::format("images/ij_{}_{}_pos.exr", i, j), neg = fmt::format("images/ij_{}_{}_neg.exr", i, j);
+      std::string pos = fmt::format("{}/ij_{}_{}_pos.exr", sub, i, j), neg = fmt::format("{}/ij_{}_{}_neg.exr", sub, i, j);
       io::write_image((dir / pos).string(), ds.positive[k]);
       io::write_image((dir / neg).string(), ds.negative[k]);
       ms.push_back({{"i", i}, {"j", j}, {"positive", pos}, {"negative", neg}});

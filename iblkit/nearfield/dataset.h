@@ -67,7 +67,8 @@ struct Dataset {
 
 // Reads an iblkit.nearfield/1 manifest and its images (paths relative to the manifest).
 Dataset read_dataset(const std::string& manifest_path);
-// Writes the manifest and the images (images/ij_{i}_{j}_pos.exr, …_neg.exr beside the manifest).
+// Writes the manifest and the images (STEM_images/ij_{i}_{j}_pos.exr, …_neg.exr beside the manifest
+// STEM.json, so that several datasets can share a folder).
 void write_dataset(const std::string& manifest_path, const Dataset& ds);
 
 }  // namespace ibl::nearfield
