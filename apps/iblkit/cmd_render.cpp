@@ -47,7 +47,7 @@ void setup(CLI::App& app) {
     int truth_samples = 4, truth_bounces = 1;
     double floor_size = 6;
     std::string luminaire = "0,1,0", luminaire_dir = "0,0,1";
-    std::string texture, lobe = "phong";
+    std::string texture, lobe = "phong", albedo = "0.75,0.75,0.75";
     double exposure = 0, fov = 40;
   };
   auto* o = new Opts();
@@ -77,6 +77,7 @@ void setup(CLI::App& app) {
   app.add_option("--lobe", o->lobe, "glossy lobe: phong, or blinn (Blinn-Phong for lights; SH and maps use Phong of exponent/4)")
       ->check(CLI::IsMember({"phong", "blinn"}))
       ->capture_default_str();
+  app.add_option("--albedo", o->albedo, "the object's diffuse reflectance r,g,b")->capture_default_str();
   app.add_option("--texture", o->texture, "albedo texture of the object (sRGB PNG/JPG or linear EXR), at the mesh's UVs");
   app.add_option("--exposure", o->exposure, "stops added to the auto exposure of PNG output")->capture_default_str();
   app.add_option("--glossy", o->glossy,
@@ -121,7 +122,7 @@ void setup(CLI::App& app) {
     object.bounds(&lo, &hi);
     Mesh floor = make_floor(o->floor_size, lo.y - 1e-3);  // just under the object's lowest point,
     floor.transform(1.0, {at.x, 0, at.z});                 // centred under it
-    Material mat{{0.75, 0.75, 0.75}, Vec3{1, 1, 1} * o->gloss, o->exponent, o->lobe == "blinn" ? Lobe::BlinnPhong : Lobe::Phong};
+    Material mat{iblcli::parse_vec3(o->albedo, "--albedo"), Vec3{1, 1, 1} * o->gloss, o->exponent, o->lobe == "blinn" ? Lobe::BlinnPhong : Lobe::Phong};
     if (!o->texture.empty()) {
       mat.albedo = {1, 1, 1};
       mat.texture = std::make_shared<Image>(io::read_image(o->texture).with_channels(3));

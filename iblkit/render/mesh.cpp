@@ -78,16 +78,45 @@ Mesh sphere_grid(int rings, int segments, R&& r) {
 }
 }  // namespace
 
-Mesh from_trimesh(const geometry::TriMesh& m) {
+Mesh from_trimesh(const geometry::TriMesh& m, double crease_deg) {
+  // Smooth normals within smooth regions, hard edges at creases: each triangle corner averages the
+  // (area-weighted) normals of the triangles around its vertex that lie within crease_deg of its
+  // own face, and corners of one vertex that end up with different normals become separate vertices.
+  const size_t T = m.triangles.size();
+  std::vector<Vec3> face(T);  // area-weighted (length = 2 × area)
+  std::vector<std::vector<uint32_t>> around(m.positions.size());
+  for (size_t t = 0; t < T; ++t) {
+    const auto& tri = m.triangles[t];
+    face[t] = cross(m.positions[tri[1]] - m.positions[tri[0]], m.positions[tri[2]] - m.positions[tri[0]]);
+    for (uint32_t v : tri) around[v].push_back(static_cast<uint32_t>(t));
+  }
+  const double cos_crease = std::cos(crease_deg * kPi / 180);
+  const bool has_uv = m.uvs.size() == m.positions.size();
   Mesh out;
-  out.positions.reserve(m.positions.size() * 3);
-  for (Vec3 p : m.positions)
-    out.positions.insert(out.positions.end(), {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z)});
-  out.indices.reserve(m.triangles.size() * 3);
-  for (const auto& t : m.triangles) out.indices.insert(out.indices.end(), t.begin(), t.end());
-  if (m.uvs.size() == m.positions.size())
-    for (Vec2 uv : m.uvs) out.uvs.insert(out.uvs.end(), {static_cast<float>(uv.x), static_cast<float>(uv.y)});
-  out.compute_normals();
+  out.indices.reserve(T * 3);
+  // Corners of vertex v with identical normals share one output vertex.
+  std::vector<std::vector<std::pair<Vec3, uint32_t>>> made(m.positions.size());
+  for (size_t t = 0; t < T; ++t) {
+    const Vec3 nt = normalize(face[t]);
+    for (uint32_t v : m.triangles[t]) {
+      Vec3 acc;
+      for (uint32_t u : around[v])
+        if (dot(normalize(face[u]), nt) >= cos_crease) acc += face[u];
+      Vec3 n = length(acc) > 0 ? normalize(acc) : nt;
+      uint32_t id = UINT32_MAX;
+      for (const auto& [nn, k] : made[v])
+        if (length(nn - n) < 1e-9) id = k;
+      if (id == UINT32_MAX) {
+        id = static_cast<uint32_t>(out.vertex_count());
+        Vec3 p = m.positions[v];
+        out.positions.insert(out.positions.end(), {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z)});
+        out.normals.insert(out.normals.end(), {static_cast<float>(n.x), static_cast<float>(n.y), static_cast<float>(n.z)});
+        if (has_uv) out.uvs.insert(out.uvs.end(), {static_cast<float>(m.uvs[v].x), static_cast<float>(m.uvs[v].y)});
+        made[v].push_back({n, id});
+      }
+      out.indices.push_back(id);
+    }
+  }
   return out;
 }
 

@@ -29,9 +29,10 @@ struct Mesh {
   void compute_normals();
 };
 
-// A geometry mesh (lab scenes, OBJ/PLY/glTF files) as a render mesh: float positions, area-weighted
-// smooth vertex normals, and its UVs when it has them.
-Mesh from_trimesh(const geometry::TriMesh& m);
+// A geometry mesh (lab scenes, OBJ/PLY/glTF files) as a render mesh: float positions, its UVs when
+// it has them, and area-weighted vertex normals that stay smooth across edges whose faces meet
+// within crease_deg and break at sharper ones (a room's corners, a pillar's edges stay hard).
+Mesh from_trimesh(const geometry::TriMesh& m, double crease_deg = 40);
 
 // A UV sphere of `rings` × `segments` quads; u runs once around (from +X), v from the south pole (0)
 // to the north pole (1). The blob has the same UVs.
