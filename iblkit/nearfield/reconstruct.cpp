@@ -98,7 +98,9 @@ std::vector<TexturedSpotlight> place_spotlights(const Dataset& ds, const std::ve
       L.tex_max = ds.m_max - c;
       L.mips = std::make_shared<const std::vector<Image>>(build_mips(eprime[static_cast<size_t>(j * ds.nx + i)]));
       L.support_area = ds.spacing * ds.spacing;  // ∫ β(u/h)β(v/h) du dv = h² for both B-splines
-      L.support_width = 2 * primal_half_width(ds.basis) * ds.spacing;
+      // The lookup footprint: the width of the box that carries Φ_mn's weight, half its support (the
+      // B-spline's weight sits in its middle: the full support over-blurs narrow beams far away).
+      L.support_width = primal_half_width(ds.basis) * ds.spacing;
       L.shadow = shadow;
       out.push_back(std::move(L));
     }

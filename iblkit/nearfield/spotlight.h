@@ -17,7 +17,7 @@
 //                                                      to the foot point position + d·forward)
 //   u      = (s − tex_min.x) / (tex_max.x − tex_min.x)
 //   v      = (tex_max.y − t) / (tex_max.y − tex_min.y)     (v = 0 is texture row 0 = the LARGEST t)
-//   footprint = support_width · |1 − d / z|   (Φ_mn's support on S projected from x through S onto M)
+//   footprint = support_width · |1 − d / z|   (Φ_mn's footprint on S projected from x through S onto M)
 //   texel  = max((tex_max.x − tex_min.x) / W0, (tex_max.y − tex_min.y) / H0)   (level 0 is W0×H0)
 //   λ      = clamp(log2(footprint / texel), 0, L − 1)     (λ = 0 when footprint = 0; L = mip levels)
 //   Ē'     = (1 − f)·bilinear(level a, u, v) + f·bilinear(level b, u, v),
@@ -50,7 +50,8 @@ struct TexturedSpotlight {
   Vec2 tex_min, tex_max;      // texture extent on M, (right, up) metres relative to position + d·forward
   std::shared_ptr<const std::vector<Image>> mips;  // E'_mn RGB radiance texture, level 0 full size, 2×2 box chain
   double support_area = 1;    // A = ∫ Φ_mn du dv (m²); h² for the B-spline bases
-  double support_width = 0;   // width of Φ_mn's support on S (metres); 0 = no filtering (a point light)
+  double support_width = 0;   // width of the box Ē' averages over on S (metres): half Φ_mn's support,
+                              // where its weight sits (docs/nearfield.md); 0 = no filtering (a point light)
   bool shadow = true;         // cast shadows (V_mn from a shadow ray / shadow map towards position)
 };
 
