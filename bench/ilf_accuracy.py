@@ -244,14 +244,14 @@ def scene_run(scene):
                     if os.environ.get("KEEP_GRIDS") != "1":
                         os.remove(g)
                     os.remove(pfm)
-                    return {"probes": N, "grid": n, "repair": rep, "points": POINTS, "plane": plane_tag(pl),
+                    return {"probes": N, "grid": n, "repair": rep, "points": POINTS, "plane_tag": plane_tag(pl),
                             "sh": rel_l2((a, b) for c, r in zip(got, rows) for a, b in zip(flat(c), flat(r["sh"]))),
                             "sh_visible": rel_l2((a, b) for c, r in zip(got, rows) for a, b in zip(flat(c), flat(r["sh_visible"]))),
                             "sh_visible_median": per[len(per) // 2], "sh_visible_max": per[-1],
                             "plane_irradiance": rel_l2((a, b) for e, t in zip(plane, ptruth) for a, b in zip(e, t)),
                             "uncovered": b["fraction_uncovered"], "build_s": b["seconds"]["total"], "plane": plane}
                 path = os.path.join(sdir, key + ".json")
-                if os.path.exists(path) and (json.load(open(path)).get("points"), json.load(open(path)).get("plane")) != (POINTS, plane_tag(pl)):
+                if os.path.exists(path) and (json.load(open(path)).get("points"), json.load(open(path)).get("plane_tag")) != (POINTS, plane_tag(pl)):
                     os.remove(path)  # measured at another number of points
                 res = cached(path, measure)
                 log(scene, key, "SH %.3f vis %.3f E %.3f" % (res["sh"], res["sh_visible"], res["plane_irradiance"]))
