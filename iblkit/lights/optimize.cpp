@@ -158,41 +158,51 @@ std::array<Eigen::MatrixXd, 3> gram_pass(const Problem& P, const Frames& F) {
     for (auto& g : part[q]) g = Eigen::MatrixXd::Zero(C, C);
     std::vector<int> U, col;
     Eigen::MatrixXd dots, geo, B, local;
+    Eigen::VectorXd wv;
     for (int64_t p = patches * q / kRanges; p < patches * (q + 1) / kRanges; ++p) {
       const int64_t lo = P.patch[p], hi = P.patch[p + 1];
       const int m = static_cast<int>(hi - lo);
       patch_lights(P, F, lo, hi, U, dots);
       const int u = static_cast<int>(U.size()), c3 = 3 * u + 1;
+      // Column by column (Eigen is column-major): the patch's geometry for each light in front.
       geo.setZero(m, c3);
-      for (int r = 0; r < m; ++r) {
-        const Vec3& n = P.n[lo + r];
-        for (int a = 0; a < u; ++a) {
-          int i = U[a];
-          double c = dots(r, i);
+      for (int a = 0; a < u; ++a) {
+        const int i = U[a];
+        const Vec3 t = F.t[i], sdir = F.s[i];
+        double* gc = geo.col(a).data();
+        double* gt_ = geo.col(u + a).data();
+        double* gs = geo.col(2 * u + a).data();
+        const double* dc = dots.col(i).data();
+        for (int r = 0; r < m; ++r) {
+          const double c = dc[r];
           if (c <= 0) continue;
-          geo(r, a) = c;
-          geo(r, u + a) = dot(n, F.t[i]);
-          geo(r, 2 * u + a) = dot(n, F.s[i]);
+          const Vec3& n = P.n[lo + r];
+          gc[r] = c;
+          gt_[r] = dot(n, t);
+          gs[r] = dot(n, sdir);
         }
       }
       col.resize(c3);
       for (int a = 0; a < u; ++a) { col[a] = U[a]; col[u + a] = N + U[a]; col[2 * u + a] = 2 * N + U[a]; }
       col[3 * u] = 3 * N;
       for (int ch = 0; ch < 3; ++ch) {
+        wv.resize(m);
         B.resize(m, c3);
         for (int r = 0; r < m; ++r) {
-          double w = P.w[lo + r][ch];
-          B.row(r).head(3 * u) = w * geo.row(r).head(3 * u);
-          B(r, 3 * u) = w * P.gt[lo + r][ch];
+          wv(r) = P.w[lo + r][ch];
+          B(r, 3 * u) = wv(r) * P.gt[lo + r][ch];
         }
+        B.leftCols(3 * u).noalias() = wv.asDiagonal() * geo.leftCols(3 * u);
         local.setZero(c3, c3);
         local.selfadjointView<Eigen::Lower>().rankUpdate(B.transpose());
+        // col[] ascends (U does, then the T, S and g blocks follow), so a ≥ b maps to the global lower
+        // triangle: scatter column by column through raw pointers.
         auto& G = part[q][ch];
-        for (int b = 0; b < c3; ++b)
-          for (int a = b; a < c3; ++a) {
-            int ga = col[a], gb = col[b];
-            if (ga >= gb) G(ga, gb) += local(a, b); else G(gb, ga) += local(a, b);
-          }
+        for (int b = 0; b < c3; ++b) {
+          double* gcol = G.data() + static_cast<size_t>(col[b]) * C;
+          const double* lcol = local.data() + static_cast<size_t>(b) * c3;
+          for (int a = b; a < c3; ++a) gcol[col[a]] += lcol[a];
+        }
       }
     }
   });
