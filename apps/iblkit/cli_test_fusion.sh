@@ -3,23 +3,7 @@
 # point, along a path, its depth traced and cached, and every bad-input class failing with a short
 # message (or warning) and a non-zero exit code, never a crash. A few seconds.
 set -u
-BIN="$1"
-T=$(mktemp -d)
-trap 'rm -rf "$T"' EXIT
-fail=0; pass=0
-
-# check NAME EXPECT(ok|fail) [PATTERN] -- CMD...
-check() {
-  local name="$1" want="$2" pat="$3"; shift 4
-  local out rc
-  out=$("$@" 2>&1); rc=$?
-  if [ $rc -ge 128 ]; then echo "FAIL $name: crashed (signal $((rc-128))): $out"; fail=$((fail+1)); return; fi
-  if [ "$want" = ok ] && [ $rc -ne 0 ]; then echo "FAIL $name: exit $rc: $out"; fail=$((fail+1)); return; fi
-  if [ "$want" = fail ] && [ $rc -eq 0 ]; then echo "FAIL $name: expected failure, got success: $out"; fail=$((fail+1)); return; fi
-  if [ -n "$pat" ] && ! grep -qE -- "$pat" <<<"$out"; then echo "FAIL $name: output lacks /$pat/: $out"; fail=$((fail+1)); return; fi
-  if [ "$want" = fail ] && [ "$(wc -l <<<"$out")" -gt 3 ]; then echo "FAIL $name: error message is not short: $out"; fail=$((fail+1)); return; fi
-  pass=$((pass+1))
-}
+source "$(dirname "$0")/cli_check.sh" "$1"
 exists() { if [ -s "$1" ]; then pass=$((pass+1)); else echo "FAIL missing $1"; fail=$((fail+1)); fi; }
 
 check help ok "--no-visibility" -- "$BIN" fuse --help

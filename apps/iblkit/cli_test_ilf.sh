@@ -4,23 +4,7 @@
 # `ilf build` accepts it; `lab truth --blind-cone/--blind-axis` gives sh_visible; bad values fail
 # with a one-line message.
 set -u
-BIN="$1"
-T=$(mktemp -d)
-trap 'rm -rf "$T"' EXIT
-fail=0; pass=0
-
-# check NAME EXPECT(ok|fail) [PATTERN] -- CMD...
-check() {
-  local name="$1" want="$2" pat="$3"; shift 4
-  local out rc
-  out=$("$@" 2>&1); rc=$?
-  if [ $rc -ge 128 ]; then echo "FAIL $name: crashed (signal $((rc-128))): $out"; fail=$((fail+1)); return; fi
-  if [ "$want" = ok ] && [ $rc -ne 0 ]; then echo "FAIL $name: exit $rc: $out"; fail=$((fail+1)); return; fi
-  if [ "$want" = fail ] && [ $rc -eq 0 ]; then echo "FAIL $name: expected failure, got success: $out"; fail=$((fail+1)); return; fi
-  if [ -n "$pat" ] && ! grep -qE -- "$pat" <<<"$out"; then echo "FAIL $name: output lacks /$pat/: $out"; fail=$((fail+1)); return; fi
-  if [ "$want" = fail ] && [ "$(wc -l <<<"$out")" -gt 3 ]; then echo "FAIL $name: error message is not short: $out"; fail=$((fail+1)); return; fi
-  pass=$((pass+1))
-}
+source "$(dirname "$0")/cli_check.sh" "$1"
 
 check look-up ok "" -- "$BIN" --quiet lab capture low-scene2 --random 12 --mapping mirrorball --size 16 --dead-angle 4.2 --look 0,1,0 --out "$T/cap"
 # the probe's +Z is world +Y: the rotation's third column is (0, 1, 0)

@@ -3,25 +3,8 @@
 # its stopping rule and says so, eval's table and CSV carry iterations and convergence, bad optimiser
 # options fail with a short message. Small normal sets keep it to a few seconds.
 set -u
-BIN="$1"
-T=$(mktemp -d)
-trap 'rm -rf "$T"' EXIT
-PROBE=/usr/share/blender/datafiles/studiolights/world/forest.exr
-fail=0; pass=0
+source "$(dirname "$0")/cli_check.sh" "$1"
 [ -f "$PROBE" ] || { echo "SKIP: blender-data probe missing"; exit 0; }
-
-# check NAME EXPECT(ok|fail) [PATTERN] -- CMD...
-check() {
-  local name="$1" want="$2" pat="$3"; shift 4
-  local out rc
-  out=$("$@" 2>&1); rc=$?
-  if [ $rc -ge 128 ]; then echo "FAIL $name: crashed (signal $((rc-128))): $out"; fail=$((fail+1)); return; fi
-  if [ "$want" = ok ] && [ $rc -ne 0 ]; then echo "FAIL $name: exit $rc: $out"; fail=$((fail+1)); return; fi
-  if [ "$want" = fail ] && [ $rc -eq 0 ]; then echo "FAIL $name: expected failure, got success: $out"; fail=$((fail+1)); return; fi
-  if [ -n "$pat" ] && ! grep -qE -- "$pat" <<<"$out"; then echo "FAIL $name: output lacks /$pat/: $out"; fail=$((fail+1)); return; fi
-  if [ "$want" = fail ] && [ "$(wc -l <<<"$out")" -gt 3 ]; then echo "FAIL $name: error message is not short: $out"; fail=$((fail+1)); return; fi
-  pass=$((pass+1))
-}
 
 check optimize-converges ok "optimiser: [0-9]+ iterations .*converged" -- \
   "$BIN" lights "$PROBE" --method optimize --count 8 --normals-level 3 --out "$T/o.json"

@@ -2,23 +2,7 @@
 # End-to-end checks of `iblkit nearfield` (CTest cli_nearfield): simulate, info, irradiance against
 # the exact luminaire, render with --exact, fig3, an IES file, and bad input failing with one line.
 set -u
-BIN="$1"
-T=$(mktemp -d)
-trap 'rm -rf "$T"' EXIT
-fail=0; pass=0
-
-# check NAME EXPECT(ok|fail) [PATTERN] -- CMD...
-check() {
-  local name="$1" want="$2" pat="$3"; shift 4
-  local out rc
-  out=$("$@" 2>&1); rc=$?
-  if [ $rc -ge 128 ]; then echo "FAIL $name: crashed (signal $((rc-128))): $out"; fail=$((fail+1)); return; fi
-  if [ "$want" = ok ] && [ $rc -ne 0 ]; then echo "FAIL $name: exit $rc: $out"; fail=$((fail+1)); return; fi
-  if [ "$want" = fail ] && [ $rc -eq 0 ]; then echo "FAIL $name: expected failure, got success: $out"; fail=$((fail+1)); return; fi
-  if [ -n "$pat" ] && ! grep -qE -- "$pat" <<<"$out"; then echo "FAIL $name: output lacks /$pat/: $out"; fail=$((fail+1)); return; fi
-  if [ "$want" = fail ] && [ "$(wc -l <<<"$out")" -gt 3 ]; then echo "FAIL $name: error message is not short: $out"; fail=$((fail+1)); return; fi
-  pass=$((pass+1))
-}
+source "$(dirname "$0")/cli_check.sh" "$1"
 
 check simulate ok "simulated bikelight-9x7 \(63 filter positions" -- "$BIN" nearfield simulate bikelight --grid 9x7 --resolution 48 --out "$T/bike/bike.json"
 check simulate-5x5 ok "25 filter positions" -- "$BIN" nearfield simulate flashlight --grid 5x5 --spacing 0.0075 --resolution 32 --out "$T/mag/mag.json"

@@ -3,11 +3,7 @@
 # Xvfb it opens a window, renders an orbit of frames through the GL renderer and the window's own
 # framebuffer, and writes a screenshot that shows the object.
 set -u
-BIN="$1"
-T=$(mktemp -d)
-trap 'rm -rf "$T"' EXIT
-PROBE=/usr/share/blender/datafiles/studiolights/world/forest.exr
-pass=0; fail=0; skip=0
+source "$(dirname "$0")/cli_check.sh" "$1"
 ok() { pass=$((pass+1)); }
 bad() { echo "FAIL $1"; fail=$((fail+1)); }
 
