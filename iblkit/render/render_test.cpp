@@ -170,6 +170,30 @@ Agreement compare(const RenderResult& a, const RenderResult& b) {
   return r;
 }
 
+// Renders d on GL (forward and deferred) and holds each frame to the CPU reference `cpu`: at least
+// `min_pixels` covered in both, coverage mismatch under kCoverageTol, median and 99th-percentile
+// relative differences under the test's named tolerances. With IBLKIT_TEST_PICTURES=DIR set, writes
+// both frames as DIR/<name>_cpu.png and DIR/<name>_gl.png for a person to look at.
+struct Tolerances {
+  double median, p99;
+  int min_pixels;
+};
+void expect_gl_agrees(const FrameDesc& d, const RenderResult& cpu, Tolerances tol, const std::string& name) {
+  for (bool deferred : {false, true}) {
+    gl::Renderer r({deferred});
+    RenderResult g = r.render(d);
+    if (const char* dir = std::getenv("IBLKIT_TEST_PICTURES"); dir && deferred) {
+      io::write_image(std::string(dir) + "/" + name + "_cpu.png", io::tonemap(cpu.color));
+      io::write_image(std::string(dir) + "/" + name + "_gl.png", io::tonemap(g.color));
+    }
+    Agreement a = compare(cpu, g);
+    EXPECT_GT(a.pixels, tol.min_pixels) << name << ", deferred " << deferred;
+    EXPECT_LT(a.coverage_mismatch, kCoverageTol) << name << ", deferred " << deferred;
+    EXPECT_LT(a.median, tol.median) << name << ", deferred " << deferred;
+    EXPECT_LT(a.p99, tol.p99) << name << ", deferred " << deferred;
+  }
+}
+
 // The GLSL basis (generated from the C++ constants) equals sh::eval_basis, 9 bands.
 TEST_F(RenderGl, GlslShBasisMatchesCpp) {
   constexpr double kBasisTol = 2e-5;  // float on the GPU vs double; |Y| ≤ ~2 up to 9 bands
@@ -202,16 +226,9 @@ TEST_F(RenderGl, ShEnvironmentAgreesWithCpu) {
   d.objects[0].material.specular = {0.2, 0.2, 0.2};
   d.objects[0].material.exponent = 12;
   RenderResult cpu = render_cpu(d);
-  for (bool deferred : {false, true}) {
-    gl::Renderer r({deferred});
-    Agreement a = compare(cpu, r.render(d));
-    constexpr double kShMedianTol = 1e-3;  // float shading on GL vs double on the CPU
-    constexpr double kShP99Tol = 2e-2;     // silhouette pixels where coverage differs in sub-pixel detail
-    EXPECT_GT(a.pixels, 1000) << "deferred " << deferred;
-    EXPECT_LT(a.coverage_mismatch, kCoverageTol) << "deferred " << deferred;
-    EXPECT_LT(a.median, kShMedianTol) << "deferred " << deferred;
-    EXPECT_LT(a.p99, kShP99Tol) << "deferred " << deferred;
-  }
+  constexpr double kShMedianTol = 1e-3;  // float shading on GL vs double on the CPU
+  constexpr double kShP99Tol = 2e-2;     // silhouette pixels where coverage differs in sub-pixel detail
+  expect_gl_agrees(d, cpu, {kShMedianTol, kShP99Tol, 1000}, "sh_environment");
 }
 
 TEST_F(RenderGl, DirectionalLightsWithShadowsAgreeWithCpu) {
@@ -227,48 +244,13 @@ TEST_F(RenderGl, DirectionalLightsWithShadowsAgreeWithCpu) {
                        {normalize(Vec3{0, 1, 0}), {0.2, 0.2, 0.3}, false}};
   d.shadow_map_size = 2048;
   RenderResult cpu = render_cpu(d);
-  for (bool deferred : {false, true}) {
-    gl::Renderer r({deferred});
-    Agreement a = compare(cpu, r.render(d));
-    // Shadow maps filter their edges (2×2 PCF) where shadow rays are binary, and their bias differs,
-    // so a few percent of pixels near shadow boundaries differ; the rest agree to float precision.
-    constexpr double kLightsMedianTol = 1e-3;
-    constexpr double kLightsP99Tol = 0.5;
-    EXPECT_GT(a.pixels, 4000) << "deferred " << deferred;
-    EXPECT_LT(a.coverage_mismatch, kCoverageTol) << "deferred " << deferred;  // the floor reaches behind the camera
-    EXPECT_LT(a.median, kLightsMedianTol) << "deferred " << deferred;
-    EXPECT_LT(a.p99, kLightsP99Tol) << "deferred " << deferred;
-  }
+  // Shadow maps filter their edges (2×2 PCF) where shadow rays are binary, and their bias differs,
+  // so a few percent of pixels near shadow boundaries differ; the rest agree to float precision.
+  constexpr double kLightsMedianTol = 1e-3;
+  constexpr double kLightsP99Tol = 0.5;
+  expect_gl_agrees(d, cpu, {kLightsMedianTol, kLightsP99Tol, 4000}, "directional");
 }
 
-TEST_F(RenderGl, ShGridAgreesWithCpu) {
-  gl::Context ctx;
-  Mesh m = make_blob(6000, 0.5);
-  FrameDesc d = sphere_scene(&m, 96, 72);
-  SHGridData g;
-  g.bands = 3;
-  g.nx = 4; g.ny = 5; g.nz = 3;
-  g.min = {-0.5, -0.5, -0.5};
-  g.max = {0.5, 0.5, 0.5};
-  g.data.resize(static_cast<size_t>(g.nx) * g.ny * g.nz * 9 * 3);
-  for (size_t i = 0; i < g.data.size(); ++i) g.data[i] = static_cast<float>((i % 27 == 0 ? 2.0 : 0.1) * (1 + 0.5 * std::sin(0.37 * i)));
-  d.lighting.grid = g;
-  d.objects[0].material.specular = {0.3, 0.3, 0.3};
-  RenderResult cpu = render_cpu(d);
-  for (bool deferred : {false, true}) {
-    gl::Renderer r({deferred});
-    Agreement a = compare(cpu, r.render(d));
-    constexpr double kGridMedianTol = 2e-3;  // RGBA16F texels (11-bit mantissa) and 8-bit filter weights
-    constexpr double kGridP99Tol = 3e-2;
-    EXPECT_GT(a.pixels, 800) << "deferred " << deferred;
-    EXPECT_LT(a.coverage_mismatch, kCoverageTol) << "deferred " << deferred;
-    EXPECT_LT(a.median, kGridMedianTol) << "deferred " << deferred;
-    EXPECT_LT(a.p99, kGridP99Tol) << "deferred " << deferred;
-  }
-}
-
-// Point lights with perspective shadow maps (cube maps inside the objects' bounds) against shadow
-// rays; a light that finds no free shadow layer is drawn unshadowed and counted.
 TEST_F(RenderGl, PointLightsWithShadowsAgreeWithCpu) {
   gl::Context ctx;
   Mesh blob = make_blob(6000, 0.5), floor = make_floor(1.6, -0.25);
@@ -280,36 +262,17 @@ TEST_F(RenderGl, PointLightsWithShadowsAgreeWithCpu) {
   d.objects = {{&blob, Material{{0.7, 0.6, 0.5}, {0.1, 0.1, 0.1}, 20}}, {&floor, Material{}}};
   d.lighting.point_lights = {{{1.2, 1.5, 0.6}, {4, 4, 4}, true}, {{-1.0, 0.8, -0.9}, {1.0, 0.8, 0.6}, true},
                              {{0, 2, 0}, {0.3, 0.3, 0.4}, false}};
+  // As for directional lights: shadow edges differ, the rest is float.
+  constexpr double kLightsMedianTol = 1e-3;
+  constexpr double kLightsP99Tol = 0.5;
   RenderResult cpu = render_cpu(d);
-  for (bool deferred : {false, true}) {
-    gl::Renderer r({deferred});
-    RenderResult g = r.render(d);
-    EXPECT_EQ(g.unshadowed_lights, 0);
-    Agreement a = compare(cpu, g);
-    constexpr double kLightsMedianTol = 1e-3;  // as for directional lights: shadow edges differ, the rest is float
-    constexpr double kLightsP99Tol = 0.5;
-    EXPECT_GT(a.pixels, 4000) << "deferred " << deferred;
-    EXPECT_LT(a.coverage_mismatch, kCoverageTol) << "deferred " << deferred;
-    EXPECT_LT(a.median, kLightsMedianTol) << "deferred " << deferred;
-    EXPECT_LT(a.p99, kLightsP99Tol) << "deferred " << deferred;
-  }
+  expect_gl_agrees(d, cpu, {kLightsMedianTol, kLightsP99Tol, 4000}, "point_lights");
+  gl::Renderer probe;
+  EXPECT_EQ(probe.render(d).unshadowed_lights, 0);
   // A light inside the bounding sphere of blob + floor (beside the blob): a cube shadow map.
   d.lighting.point_lights[0].position = {0.45, 0.35, 0.3};
-  cpu = render_cpu(d);
-  for (bool deferred : {false, true}) {
-    gl::Renderer r({deferred});
-    RenderResult g = r.render(d);
-    EXPECT_EQ(g.unshadowed_lights, 0);
-    Agreement a = compare(cpu, g);
-    if (const char* dir = std::getenv("IBLKIT_TEST_PICTURES")) {
-      io::write_image(std::string(dir) + "/cube_cpu.png", io::tonemap(cpu.color));
-      io::write_image(std::string(dir) + "/cube_gl.png", io::tonemap(g.color));
-    }
-    constexpr double kCubeMedianTol = 1e-3;
-    constexpr double kCubeP99Tol = 0.5;  // shadow edges, as above
-    EXPECT_LT(a.median, kCubeMedianTol) << "cube, deferred " << deferred;
-    EXPECT_LT(a.p99, kCubeP99Tol) << "cube, deferred " << deferred;
-  }
+  EXPECT_EQ(probe.render(d).unshadowed_lights, 0);
+  expect_gl_agrees(d, render_cpu(d), {kLightsMedianTol, kLightsP99Tol, 4000}, "point_light_cube");
   // Three cubes need 18 layers of the 16: the third light goes unshadowed, and is counted.
   d.lighting.point_lights = {{{0.45, 0.35, 0.3}, {1, 1, 1}, true}, {{-0.45, 0.35, 0.3}, {1, 1, 1}, true},
                              {{0, 0.35, -0.45}, {1, 1, 1}, true}};
@@ -354,21 +317,9 @@ TEST_F(RenderGl, TexturedSpotlightsWithShadowsAgreeWithCpu) {
   for (int y = 0; y < 96; ++y)
     for (int x = 0; x < 128; ++x) peak = std::max(peak, luminance(cpu.color.rgb(x, y)));
   EXPECT_GT(peak, 0.01);  // the spotlights light the scene
-  for (bool deferred : {false, true}) {
-    gl::Renderer r({deferred});
-    RenderResult g = r.render(d);
-    if (const char* dir = std::getenv("IBLKIT_TEST_PICTURES")) {  // for a person to look at
-      io::write_image(std::string(dir) + "/spotlights_cpu.png", io::tonemap(cpu.color));
-      io::write_image(std::string(dir) + "/spotlights_gl.png", io::tonemap(g.color));
-    }
-    Agreement a = compare(cpu, g);
-    constexpr double kSpotMedianTol = 2e-3;  // float math and GL's 8-bit filter weights (bilinear and between mips)
-    constexpr double kSpotP99Tol = 0.5;      // shadow-map edges against exact shadow rays
-    EXPECT_GT(a.pixels, 4000) << "deferred " << deferred;
-    EXPECT_LT(a.coverage_mismatch, kCoverageTol) << "deferred " << deferred;
-    EXPECT_LT(a.median, kSpotMedianTol) << "deferred " << deferred;
-    EXPECT_LT(a.p99, kSpotP99Tol) << "deferred " << deferred;
-  }
+  constexpr double kSpotMedianTol = 2e-3;  // float math and GL's 8-bit filter weights (bilinear and between mips)
+  constexpr double kSpotP99Tol = 0.5;      // shadow-map edges against exact shadow rays
+  expect_gl_agrees(d, cpu, {kSpotMedianTol, kSpotP99Tol, 4000}, "spotlights");
 }
 
 // Albedo textures at the meshes' UVs and the Blinn-Phong lobe (lights exact; SH and maps through the
@@ -403,21 +354,9 @@ TEST_F(RenderGl, TexturedBlinnPhongAgreesWithCpu) {
     hi = std::max(hi, v);
   }
   EXPECT_GT(hi, 2 * lo);
-  for (bool deferred : {false, true}) {
-    gl::Renderer r({deferred});
-    RenderResult g = r.render(d);
-    if (const char* dir = std::getenv("IBLKIT_TEST_PICTURES")) {
-      io::write_image(std::string(dir) + "/textured_cpu.png", io::tonemap(cpu.color));
-      io::write_image(std::string(dir) + "/textured_gl.png", io::tonemap(g.color));
-    }
-    Agreement a = compare(cpu, g);
-    constexpr double kTexMedianTol = 2e-3;  // float shading and GL's 8-bit bilinear weights
-    constexpr double kTexP99Tol = 0.1;      // texels at the checker's edges, where the weights' rounding shows
-    EXPECT_GT(a.pixels, 4000) << "deferred " << deferred;
-    EXPECT_LT(a.coverage_mismatch, kCoverageTol) << "deferred " << deferred;
-    EXPECT_LT(a.median, kTexMedianTol) << "deferred " << deferred;
-    EXPECT_LT(a.p99, kTexP99Tol) << "deferred " << deferred;
-  }
+  constexpr double kTexMedianTol = 2e-3;  // float shading and GL's 8-bit bilinear weights
+  constexpr double kTexP99Tol = 0.1;      // texels at the checker's edges, where the weights' rounding shows
+  expect_gl_agrees(d, cpu, {kTexMedianTol, kTexP99Tol, 4000}, "textured");
 }
 
 // A probe's glossy reflection through a prefiltered Phong map (render/prefilter.h): both renderers
@@ -435,16 +374,9 @@ TEST_F(RenderGl, GlossyMapAgreesWithCpu) {
   d.objects[0].material = Material{{0.3, 0.3, 0.3}, {0.6, 0.6, 0.6}, 30};
   d.lighting.glossy_maps.push_back(prefilter_phong(probe, 30));
   RenderResult cpu = render_cpu(d);
-  for (bool deferred : {false, true}) {
-    gl::Renderer r({deferred});
-    Agreement a = compare(cpu, r.render(d));
-    constexpr double kMapMedianTol = 2e-3;  // GL's 8-bit bilinear weights on an RGBA32F texture
-    constexpr double kMapP99Tol = 3e-2;     // silhouettes, and texels where the checker's edges sit
-    EXPECT_GT(a.pixels, 1000) << "deferred " << deferred;
-    EXPECT_LT(a.coverage_mismatch, kCoverageTol) << "deferred " << deferred;
-    EXPECT_LT(a.median, kMapMedianTol) << "deferred " << deferred;
-    EXPECT_LT(a.p99, kMapP99Tol) << "deferred " << deferred;
-  }
+  constexpr double kMapMedianTol = 2e-3;  // GL's 8-bit bilinear weights on an RGBA32F texture
+  constexpr double kMapP99Tol = 3e-2;     // silhouettes, and texels where the checker's edges sit
+  expect_gl_agrees(d, cpu, {kMapMedianTol, kMapP99Tol, 1000}, "glossy_map");
 }
 
 #endif

@@ -509,43 +509,28 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing)
   auto wall0 = std::chrono::steady_clock::now();
   for (int f = 0; f < nframes; ++f) {
     glBeginQuery(GL_TIME_ELAPSED, queries[f]);
-    // Shadow passes.
-    if (!shadow_mats.empty()) {
+    // Shadow passes: every layer of a depth array from its light matrix.
+    auto shadow_passes = [&](GLuint tex, const std::vector<Mat4f>& mats, int size) {
+      if (mats.empty()) return;
       glUseProgram(impl_->shadow_program);
       glBindFramebuffer(GL_FRAMEBUFFER, shadow_fbo);
-      glViewport(0, 0, S, S);
+      glViewport(0, 0, size, size);
       glEnable(GL_DEPTH_TEST);
       glEnable(GL_POLYGON_OFFSET_FILL);
       glPolygonOffset(1.5f, 2.0f);
-      for (size_t i = 0; i < shadow_mats.size(); ++i) {
-        glNamedFramebufferTextureLayer(shadow_fbo, GL_DEPTH_ATTACHMENT, shadow_tex, 0, static_cast<GLint>(i));
+      for (size_t i = 0; i < mats.size(); ++i) {
+        glNamedFramebufferTextureLayer(shadow_fbo, GL_DEPTH_ATTACHMENT, tex, 0, static_cast<GLint>(i));
         glClear(GL_DEPTH_BUFFER_BIT);
-        glUniformMatrix4fv(loc_light_vp, 1, GL_FALSE, shadow_mats[i].data());
+        glUniformMatrix4fv(loc_light_vp, 1, GL_FALSE, mats[i].data());
         for (auto& m : meshes) {
           glBindVertexArray(m.vao);
           glDrawElements(GL_TRIANGLES, m.count, GL_UNSIGNED_INT, nullptr);
         }
       }
       glDisable(GL_POLYGON_OFFSET_FILL);
-    }
-    if (!spot_mats.empty()) {
-      glUseProgram(impl_->shadow_program);
-      glBindFramebuffer(GL_FRAMEBUFFER, shadow_fbo);
-      glViewport(0, 0, SS, SS);
-      glEnable(GL_DEPTH_TEST);
-      glEnable(GL_POLYGON_OFFSET_FILL);
-      glPolygonOffset(1.5f, 2.0f);
-      for (size_t i = 0; i < spot_mats.size(); ++i) {
-        glNamedFramebufferTextureLayer(shadow_fbo, GL_DEPTH_ATTACHMENT, spot_shadow_tex, 0, static_cast<GLint>(i));
-        glClear(GL_DEPTH_BUFFER_BIT);
-        glUniformMatrix4fv(loc_light_vp, 1, GL_FALSE, spot_mats[i].data());
-        for (auto& m : meshes) {
-          glBindVertexArray(m.vao);
-          glDrawElements(GL_TRIANGLES, m.count, GL_UNSIGNED_INT, nullptr);
-        }
-      }
-      glDisable(GL_POLYGON_OFFSET_FILL);
-    }
+    };
+    shadow_passes(shadow_tex, shadow_mats, S);
+    shadow_passes(spot_shadow_tex, spot_mats, SS);
     // Shading pass (forward), or G-buffer pass then compute shading (deferred).
     glBindFramebuffer(GL_FRAMEBUFFER, fbo);
     glViewport(0, 0, W, H);
