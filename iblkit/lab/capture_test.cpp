@@ -15,6 +15,20 @@ namespace ibl::lab {
 namespace {
 
 // An empty scene inside a closed box facing inwards (for depth checks with known distances).
+// A spotlight at `position` shining along `direction` (full intensity inside falloff_deg, none
+// beyond cone_deg), with a visible aperture disc of `aperture` metres (0: none).
+Emitter spot(Vec3 position, Vec3 direction, double cone_deg, double falloff_deg, Vec3 intensity, double aperture) {
+  Emitter e;
+  e.type = EmitterType::Spot;
+  e.position = position;
+  e.direction = direction;
+  e.cone_deg = cone_deg;
+  e.falloff_deg = falloff_deg;
+  e.intensity = intensity;
+  e.aperture_radius = aperture;
+  return e;
+}
+
 Scene inside_box(Vec3 lo, Vec3 hi) {
   Scene s;
   Surface box;
@@ -138,14 +152,8 @@ Scene lit_room() {
   a.size = {1.5, 1.0};
   a.radiance = {5, 5, 4};
   s.emitters.push_back(a);
-  Emitter sp;
-  sp.type = EmitterType::Spot;
-  sp.position = {-1.5, 2, 1.5};
-  sp.direction = {1, -0.6, -1};
-  sp.cone_deg = 50;
-  sp.falloff_deg = 10;
-  sp.intensity = {4, 2, 1};
-  sp.aperture_radius = 0;  // no visible lamp: a tiny disc of huge radiance would only add sampling noise
+  // No visible lamp: a tiny disc of huge radiance would only add sampling noise.
+  Emitter sp = spot({-1.5, 2, 1.5}, {1, -0.6, -1}, 50, 10, {4, 2, 1}, 0);
   s.emitters.push_back(sp);
   s.build();
   return s;
@@ -205,14 +213,7 @@ TEST(LabCapture, SpotApertureDeliversTheLampsIntensity) {
   // Seen from a point in the beam, the lamp's disc must carry E = I/d² (its radiance is I/(A cos α)).
   constexpr double kApertureTol = 0.03;  // relative: the disc covers ~700 pixels of the 1024×512 map
   Scene s;
-  Emitter sp;
-  sp.type = EmitterType::Spot;
-  sp.position = {0, 2, 0};
-  sp.direction = {0.3, -1, 0};
-  sp.cone_deg = 60;
-  sp.falloff_deg = 60;
-  sp.intensity = {10, 10, 10};
-  sp.aperture_radius = 0.1;
+  Emitter sp = spot({0, 2, 0}, {0.3, -1, 0}, 60, 60, {10, 10, 10}, 0.1);
   s.emitters.push_back(sp);
   s.build();
   TruthDesc td;
@@ -231,14 +232,8 @@ TEST(LabCapture, SpotApertureDeliversTheLampsIntensity) {
 // from a probe on the axis).
 Scene small_spot(bool half_blocked) {
   Scene s;
-  Emitter sp;
-  sp.type = EmitterType::Spot;
-  sp.position = {0, 2, 0};
-  sp.direction = {0, -1, 0};
-  sp.cone_deg = 60;
-  sp.falloff_deg = 50;  // the probes below lie well inside the full-intensity cone
-  sp.intensity = {10, 10, 10};
-  sp.aperture_radius = 0.02;
+  // The probes below lie well inside the full-intensity cone.
+  Emitter sp = spot({0, 2, 0}, {0, -1, 0}, 60, 50, {10, 10, 10}, 0.02);
   s.emitters.push_back(sp);
   if (half_blocked) {
     Surface board;
@@ -287,14 +282,7 @@ TEST(LabCapture, ApertureOnALatLongPoleIsExact) {
   constexpr double kEnergyTol = 1e-3;  // relative: float32 pixels, 16+ points per covered pixel
   constexpr double kAliasedAtLeast = 0.05;  // point-sampled: off by 13 % (shows the check can fail)
   Scene s;
-  Emitter sp;
-  sp.type = EmitterType::Spot;
-  sp.position = {0, 2, 0};
-  sp.direction = {0, -1, 0};
-  sp.cone_deg = 60;
-  sp.falloff_deg = 50;
-  sp.intensity = {10, 10, 10};
-  sp.aperture_radius = 0.025;
+  Emitter sp = spot({0, 2, 0}, {0, -1, 0}, 60, 50, {10, 10, 10}, 0.025);
   s.emitters.push_back(sp);
   s.build();
   CaptureDesc cd;

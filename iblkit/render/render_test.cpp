@@ -30,6 +30,16 @@ FrameDesc sphere_scene(const Mesh* mesh, int w = 96, int h = 72) {
   return d;
 }
 
+// The 128×96 view of a blob on a floor that the light-kind tests share (objects added by each test).
+FrameDesc blob_scene() {
+  FrameDesc d;
+  d.camera.eye = {0.3, 0.9, 1.4};
+  d.camera.target = {0, 0, 0};
+  d.camera.width = 128;
+  d.camera.height = 96;
+  return d;
+}
+
 // White furnace: unit radiance from every direction, c00 = √(4π). A Lambertian surface of albedo ρ
 // then reflects exactly ρ everywhere (E = π); SH carries the constant exactly.
 TEST(RenderCpu, WhiteFurnaceGivesAlbedo) {
@@ -234,11 +244,7 @@ TEST_F(RenderGl, ShEnvironmentAgreesWithCpu) {
 TEST_F(RenderGl, DirectionalLightsWithShadowsAgreeWithCpu) {
   gl::Context ctx;
   Mesh blob = make_blob(6000, 0.5), floor = make_floor(3, -0.25);
-  FrameDesc d;
-  d.camera.eye = {0.3, 0.9, 1.4};
-  d.camera.target = {0, 0, 0};
-  d.camera.width = 128;
-  d.camera.height = 96;
+  FrameDesc d = blob_scene();
   d.objects = {{&blob, Material{{0.7, 0.6, 0.5}, {0.1, 0.1, 0.1}, 20}}, {&floor, Material{}}};
   d.lighting.lights = {{normalize(Vec3{0.5, 1, 0.3}), {2, 2, 2}, true}, {normalize(Vec3{-0.6, 0.7, -0.2}), {0.5, 0.4, 0.3}, true},
                        {normalize(Vec3{0, 1, 0}), {0.2, 0.2, 0.3}, false}};
@@ -254,11 +260,7 @@ TEST_F(RenderGl, DirectionalLightsWithShadowsAgreeWithCpu) {
 TEST_F(RenderGl, PointLightsWithShadowsAgreeWithCpu) {
   gl::Context ctx;
   Mesh blob = make_blob(6000, 0.5), floor = make_floor(1.6, -0.25);
-  FrameDesc d;
-  d.camera.eye = {0.3, 0.9, 1.4};
-  d.camera.target = {0, 0, 0};
-  d.camera.width = 128;
-  d.camera.height = 96;
+  FrameDesc d = blob_scene();
   d.objects = {{&blob, Material{{0.7, 0.6, 0.5}, {0.1, 0.1, 0.1}, 20}}, {&floor, Material{}}};
   d.lighting.point_lights = {{{1.2, 1.5, 0.6}, {4, 4, 4}, true}, {{-1.0, 0.8, -0.9}, {1.0, 0.8, 0.6}, true},
                              {{0, 2, 0}, {0.3, 0.3, 0.4}, false}};
@@ -285,11 +287,7 @@ TEST_F(RenderGl, PointLightsWithShadowsAgreeWithCpu) {
 TEST_F(RenderGl, TexturedSpotlightsWithShadowsAgreeWithCpu) {
   gl::Context ctx;
   Mesh blob = make_blob(6000, 0.5), floor = make_floor(3, -0.25);
-  FrameDesc d;
-  d.camera.eye = {0.3, 0.9, 1.4};
-  d.camera.target = {0, 0, 0};
-  d.camera.width = 128;
-  d.camera.height = 96;
+  FrameDesc d = blob_scene();
   d.spot_shadow_map_size = 512;
   d.objects = {{&blob, Material{{0.7, 0.6, 0.5}, {0.1, 0.1, 0.1}, 20}}, {&floor, Material{}}};
   Image tex(32, 24, 3);
@@ -332,11 +330,7 @@ TEST_F(RenderGl, TexturedBlinnPhongAgreesWithCpu) {
   auto tex = std::make_shared<Image>(64, 32, 3);
   for (int y = 0; y < 32; ++y)
     for (int x = 0; x < 64; ++x) tex->set_rgb(x, y, ((x / 8 + y / 8) % 2) ? Vec3{0.9, 0.8, 0.2} : Vec3{0.1, 0.3, 0.8});
-  FrameDesc d;
-  d.camera.eye = {0.3, 0.9, 1.4};
-  d.camera.target = {0, 0, 0};
-  d.camera.width = 128;
-  d.camera.height = 96;
+  FrameDesc d = blob_scene();
   Material shiny{{1, 1, 1}, {0.3, 0.3, 0.3}, 80, Lobe::BlinnPhong, tex};
   Material matte{{0.6, 0.6, 0.6}, {0, 0, 0}, 1, Lobe::Phong, tex};
   d.objects = {{&blob, shiny}, {&floor, matte}};
