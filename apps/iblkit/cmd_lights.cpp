@@ -139,6 +139,16 @@ void run_lights(const LightsOpts& o, const ibl::io::EnvReadDesc& rd) {
   });
 }
 
+// --iterations and --tolerance, which `lights` and `eval` share.
+void add_optimiser_options(CLI::App& app, int* iterations, double* tolerance) {
+  app.add_option("--iterations", *iterations,
+                 "optimize: safety cap on Levenberg–Marquardt steps per stage (the stopping rule is --tolerance)")
+      ->check(CLI::Range(1, 100000))->capture_default_str();
+  app.add_option("--tolerance", *tolerance,
+                 "optimize: converged when the last step and a full Gauss–Newton step each lower the cost by less "
+                 "than this fraction")->check(CLI::Range(1e-15, 0.1))->capture_default_str();
+}
+
 void setup_lights(CLI::App& app) {
   auto* o = new LightsOpts();
   app.add_option("probe", o->probe, "HDR probe image")->required();
@@ -151,12 +161,7 @@ void setup_lights(CLI::App& app) {
   app.add_option("--overlay", o->overlay, "write a PNG of the probe with every light and its region marked");
   app.add_option("--shadows", o->shadows, "how many lights (in priority order) deserve shadow maps")->capture_default_str();
   app.add_option("--normals-level", o->level, "optimize: icosphere level of the fitted normals (5: 20480)")->capture_default_str();
-  app.add_option("--iterations", o->iterations,
-                 "optimize: safety cap on Levenberg–Marquardt steps per stage (the stopping rule is --tolerance)")
-      ->check(CLI::Range(1, 100000))->capture_default_str();
-  app.add_option("--tolerance", o->tolerance,
-                 "optimize: converged when the last step and a full Gauss–Newton step each lower the cost by less "
-                 "than this fraction")->check(CLI::Range(1e-15, 0.1))->capture_default_str();
+  add_optimiser_options(app, &o->iterations, &o->tolerance);
   auto& rd = iblcli::add_probe_read_options(app);
   app.footer("Example:\n  iblkit lights forest.exr --method median-cut --count 16 --out lights.json --gltf lights.gltf --overlay lights.png");
   app.callback([o, &rd] { run_lights(*o, rd); });
@@ -348,12 +353,7 @@ void setup_eval(CLI::App& app) {
   app.add_option("--counts", o->counts, "comma-separated light counts N")->capture_default_str();
   app.add_option("--lights", o->lights, "also evaluate this iblkit.lights/1 file");
   app.add_option("--normals-level", o->level, "icosphere level of the normals (5: 20480, as the paper)")->capture_default_str();
-  app.add_option("--iterations", o->iterations,
-                 "optimize: safety cap on Levenberg–Marquardt steps per stage (the stopping rule is --tolerance)")
-      ->check(CLI::Range(1, 100000))->capture_default_str();
-  app.add_option("--tolerance", o->tolerance,
-                 "optimize: converged when the last step and a full Gauss–Newton step each lower the cost by less "
-                 "than this fraction")->check(CLI::Range(1e-15, 0.1))->capture_default_str();
+  add_optimiser_options(app, &o->iterations, &o->tolerance);
   app.add_option("--sh-bands", o->sh_bands, "SH reference line bands (0: none)")->capture_default_str();
   app.add_option("--min-separation", o->sep, "minimum angular separation of lights in degrees (0: off)");
   app.add_option("--picture-count", o->picture_count, "N of the sets drawn in the irradiance comparison")->capture_default_str();

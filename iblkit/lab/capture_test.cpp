@@ -29,6 +29,17 @@ Emitter spot(Vec3 position, Vec3 direction, double cone_deg, double falloff_deg,
   return e;
 }
 
+// Nothing but a constant distant environment of radiance L.
+Scene uniform_sky(Vec3 L) {
+  Scene s;
+  Emitter env;
+  env.type = EmitterType::Environment;
+  env.radiance = L;
+  s.emitters.push_back(env);
+  s.build();
+  return s;
+}
+
 Scene inside_box(Vec3 lo, Vec3 hi) {
   Scene s;
   Surface box;
@@ -314,12 +325,7 @@ TEST(LabTruth, SmallApertureSHAgreeAtAnyResolution) {
 TEST(LabTruth, BlindConeLeavesOutItsSolidAngle) {
   // Under a uniform sky L, the SH without a 30° cone around −Z has c00 = L·(4π − 2π(1 − cos 30°))·Y00.
   constexpr double kConeTol = 1e-3;  // relative: 4×4 sub-samples per pixel decide in or out (64 rows)
-  Scene s;
-  Emitter env;
-  env.type = EmitterType::Environment;
-  env.radiance = {1, 1, 1};
-  s.emitters.push_back(env);
-  s.build();
+  Scene s = uniform_sky({1, 1, 1});
   TruthDesc td;
   td.size = 64;
   td.samples = 4;
@@ -333,12 +339,7 @@ TEST(LabTruth, BlindConeLeavesOutItsSolidAngle) {
 
 TEST(LabTruth, UniformEnvironmentGivesPiLIrradiance) {
   constexpr double kQuadTol = 3e-3;  // relative: pixel-centre cosines over a 64×32 map (horizon pixels)
-  Scene s;
-  Emitter env;
-  env.type = EmitterType::Environment;
-  env.radiance = {1.5, 1.5, 1.5};
-  s.emitters.push_back(env);
-  s.build();
+  Scene s = uniform_sky({1.5, 1.5, 1.5});
   TruthDesc td;
   td.size = 32;
   td.samples = 1;

@@ -30,9 +30,11 @@ FrameDesc sphere_scene(const Mesh* mesh, int w = 96, int h = 72) {
   return d;
 }
 
-// The 128×96 view of a blob on a floor that the light-kind tests share (objects added by each test).
-FrameDesc blob_scene() {
+// The 128×96 view of a blob (slightly glossy) on a floor that the light-kind tests share; a test that
+// wants other objects replaces d.objects.
+FrameDesc blob_scene(const Mesh* blob, const Mesh* floor) {
   FrameDesc d;
+  d.objects = {{blob, Material{{0.7, 0.6, 0.5}, {0.1, 0.1, 0.1}, 20}}, {floor, Material{}}};
   d.camera.eye = {0.3, 0.9, 1.4};
   d.camera.target = {0, 0, 0};
   d.camera.width = 128;
@@ -244,8 +246,7 @@ TEST_F(RenderGl, ShEnvironmentAgreesWithCpu) {
 TEST_F(RenderGl, DirectionalLightsWithShadowsAgreeWithCpu) {
   gl::Context ctx;
   Mesh blob = make_blob(6000, 0.5), floor = make_floor(3, -0.25);
-  FrameDesc d = blob_scene();
-  d.objects = {{&blob, Material{{0.7, 0.6, 0.5}, {0.1, 0.1, 0.1}, 20}}, {&floor, Material{}}};
+  FrameDesc d = blob_scene(&blob, &floor);
   d.lighting.lights = {{normalize(Vec3{0.5, 1, 0.3}), {2, 2, 2}, true}, {normalize(Vec3{-0.6, 0.7, -0.2}), {0.5, 0.4, 0.3}, true},
                        {normalize(Vec3{0, 1, 0}), {0.2, 0.2, 0.3}, false}};
   d.shadow_map_size = 2048;
@@ -260,8 +261,7 @@ TEST_F(RenderGl, DirectionalLightsWithShadowsAgreeWithCpu) {
 TEST_F(RenderGl, PointLightsWithShadowsAgreeWithCpu) {
   gl::Context ctx;
   Mesh blob = make_blob(6000, 0.5), floor = make_floor(1.6, -0.25);
-  FrameDesc d = blob_scene();
-  d.objects = {{&blob, Material{{0.7, 0.6, 0.5}, {0.1, 0.1, 0.1}, 20}}, {&floor, Material{}}};
+  FrameDesc d = blob_scene(&blob, &floor);
   d.lighting.point_lights = {{{1.2, 1.5, 0.6}, {4, 4, 4}, true}, {{-1.0, 0.8, -0.9}, {1.0, 0.8, 0.6}, true},
                              {{0, 2, 0}, {0.3, 0.3, 0.4}, false}};
   // As for directional lights: shadow edges differ, the rest is float.
@@ -287,9 +287,8 @@ TEST_F(RenderGl, PointLightsWithShadowsAgreeWithCpu) {
 TEST_F(RenderGl, TexturedSpotlightsWithShadowsAgreeWithCpu) {
   gl::Context ctx;
   Mesh blob = make_blob(6000, 0.5), floor = make_floor(3, -0.25);
-  FrameDesc d = blob_scene();
+  FrameDesc d = blob_scene(&blob, &floor);
   d.spot_shadow_map_size = 512;
-  d.objects = {{&blob, Material{{0.7, 0.6, 0.5}, {0.1, 0.1, 0.1}, 20}}, {&floor, Material{}}};
   Image tex(32, 24, 3);
   for (int y = 0; y < 24; ++y)
     for (int x = 0; x < 32; ++x)
@@ -330,7 +329,7 @@ TEST_F(RenderGl, TexturedBlinnPhongAgreesWithCpu) {
   auto tex = std::make_shared<Image>(64, 32, 3);
   for (int y = 0; y < 32; ++y)
     for (int x = 0; x < 64; ++x) tex->set_rgb(x, y, ((x / 8 + y / 8) % 2) ? Vec3{0.9, 0.8, 0.2} : Vec3{0.1, 0.3, 0.8});
-  FrameDesc d = blob_scene();
+  FrameDesc d = blob_scene(&blob, &floor);
   Material shiny{{1, 1, 1}, {0.3, 0.3, 0.3}, 80, Lobe::BlinnPhong, tex};
   Material matte{{0.6, 0.6, 0.6}, {0, 0, 0}, 1, Lobe::Phong, tex};
   d.objects = {{&blob, shiny}, {&floor, matte}};
