@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <functional>
 
 #include "iblkit/io/image_io.h"
 #include "iblkit/io/tonemap.h"
@@ -42,6 +43,23 @@ FrameDesc blob_scene(const Mesh* blob, const Mesh* floor) {
   return d;
 }
 
+// Holds the red channel of every pixel that sees the 0.4 m sphere at the origin (away from its
+// silhouette, where facets and the true sphere disagree) to want(p, n) at the exact hit point p with
+// normal n, and checks that over 1000 pixels were compared.
+void expect_sphere_shading(const FrameDesc& d, const RenderResult& f, double tol, const std::function<double(Vec3, Vec3)>& want) {
+  int checked = 0;
+  for (int y = 0; y < f.color.height(); ++y)
+    for (int x = 0; x < f.color.width(); ++x) {
+      Vec3 dir = d.camera.ray_direction(x + 0.5, y + 0.5), o = d.camera.eye;
+      double b = dot(o, dir), c = dot(o, o) - 0.16, disc = b * b - c;
+      if (disc < 1e-3) continue;
+      Vec3 p = o + dir * (-b - std::sqrt(disc));
+      ASSERT_NEAR(f.color.at(x, y, 0), want(p, normalize(p)), tol) << x << "," << y;
+      ++checked;
+    }
+  EXPECT_GT(checked, 1000);
+}
+
 // White furnace: unit radiance from every direction, c00 = √(4π). A Lambertian surface of albedo ρ
 // then reflects exactly ρ everywhere (E = π); SH carries the constant exactly.
 TEST(RenderCpu, WhiteFurnaceGivesAlbedo) {
@@ -77,19 +95,7 @@ TEST(RenderCpu, DirectionalLightOnSphereMatchesClosedForm) {
   d.objects[0].material.albedo = {0.5, 0.5, 0.5};
   Vec3 l = normalize(Vec3{0.4, 0.8, 0.5});
   d.lighting.lights.push_back({l, {3, 3, 3}, false});
-  RenderResult f = render_cpu(d);
-  int checked = 0;
-  for (int y = 0; y < f.color.height(); ++y)
-    for (int x = 0; x < f.color.width(); ++x) {
-      Vec3 dir = d.camera.ray_direction(x + 0.5, y + 0.5), o = d.camera.eye;
-      double b = dot(o, dir), c = dot(o, o) - 0.16, disc = b * b - c;
-      if (disc < 1e-3) continue;  // skip the silhouette, where facets and the sphere disagree
-      Vec3 n = normalize(o + dir * (-b - std::sqrt(disc)));
-      double want = 0.5 / kPi * 3 * std::max(0.0, dot(n, l));
-      ASSERT_NEAR(f.color.at(x, y, 0), want, kFacetTol) << x << "," << y;
-      ++checked;
-    }
-  EXPECT_GT(checked, 1000);
+  expect_sphere_shading(d, render_cpu(d), kFacetTol, [&](Vec3, Vec3 n) { return 0.5 / kPi * 3 * std::max(0.0, dot(n, l)); });
 }
 
 // A point light near a sphere: L_o = ρ/π · I · max(0, n·l)/d² with l and d from the exact hit point.
@@ -100,20 +106,10 @@ TEST(RenderCpu, PointLightOnSphereMatchesClosedForm) {
   d.objects[0].material.albedo = {0.5, 0.5, 0.5};
   const Vec3 q{0.5, 0.9, 0.7};
   d.lighting.point_lights.push_back({q, {2, 2, 2}, true});  // shadow rays: a convex object never shadows itself
-  RenderResult f = render_cpu(d);
-  int checked = 0;
-  for (int y = 0; y < f.color.height(); ++y)
-    for (int x = 0; x < f.color.width(); ++x) {
-      Vec3 dir = d.camera.ray_direction(x + 0.5, y + 0.5), o = d.camera.eye;
-      double b = dot(o, dir), c = dot(o, o) - 0.16, disc = b * b - c;
-      if (disc < 1e-3) continue;
-      Vec3 p = o + dir * (-b - std::sqrt(disc)), n = normalize(p);
-      Vec3 to = q - p;
-      double want = 0.5 / kPi * 2 * std::max(0.0, dot(n, normalize(to))) / dot(to, to);
-      ASSERT_NEAR(f.color.at(x, y, 0), want, kFacetTol * 2) << x << "," << y;
-      ++checked;
-    }
-  EXPECT_GT(checked, 1000);
+  expect_sphere_shading(d, render_cpu(d), 2 * kFacetTol, [&](Vec3 p, Vec3 n) {
+    Vec3 to = q - p;
+    return 0.5 / kPi * 2 * std::max(0.0, dot(n, normalize(to))) / dot(to, to);
+  });
 }
 
 // A floor under a blob and a light from above: the floor below the blob is in shadow.
