@@ -13,6 +13,8 @@
 #include "iblkit/render/mesh.h"
 #include "iblkit/sh/basis.h"
 #ifdef IBLKIT_HAVE_GL
+#include <epoxy/gl.h>
+
 #include "iblkit/render/gl/context.h"
 #include "iblkit/render/gl/renderer.h"
 #include "iblkit/render/gl/sh_glsl.h"
@@ -313,6 +315,50 @@ TEST_F(RenderGl, TexturedSpotlightsWithShadowsAgreeWithCpu) {
   constexpr double kSpotMedianTol = 2e-3;  // float math and GL's 8-bit filter weights (bilinear and between mips)
   constexpr double kSpotP99Tol = 0.5;      // shadow-map edges against exact shadow rays
   expect_gl_agrees(d, cpu, {kSpotMedianTol, kSpotP99Tol, 4000}, "spotlights");
+}
+
+// One instanced draw into all layers of a shadow-map array gives the maps that one pass per light
+// gives: directional maps, a point light's cube and spotlight maps, in the same frame. (Comparing two
+// renderers in one context also catches GL state leaking from one frame into the next.)
+TEST_F(RenderGl, LayeredShadowPassEqualsPassPerLight) {
+  gl::Context ctx;
+  if (!epoxy_has_gl_extension("GL_ARB_shader_viewport_layer_array"))
+    GTEST_SKIP() << "this GL has no GL_ARB_shader_viewport_layer_array: the renderer uses one pass per light";
+  Mesh blob = make_blob(6000, 0.5), floor = make_floor(1.6, -0.25);
+  FrameDesc d = blob_scene(&blob, &floor);
+  d.lighting.lights = {{normalize(Vec3{0.5, 1, 0.3}), {1, 1, 1}, true}, {normalize(Vec3{-0.6, 0.7, -0.2}), {0.5, 0.4, 0.3}, true}};
+  d.lighting.point_lights = {{{0.45, 0.35, 0.3}, {1, 1, 1}, true}};  // inside the bounds: a cube of six layers
+  Image tex(8, 8, 3);
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 8; ++x) tex.set_rgb(x, y, {50.0 + x, 40.0 + y, 30.0});
+  auto mips = std::make_shared<const std::vector<Image>>(nearfield::build_mips(tex));
+  for (int i = 0; i < 4; ++i) {
+    nearfield::TexturedSpotlight sp;
+    sp.position = {-0.4 + 0.25 * i, 1.2, 0.3};
+    sp.frame = Frame::from_normal(normalize(Vec3{0.1, -1, -0.2}));
+    sp.plane_distance = 0.5;
+    sp.tex_min = {-0.4, -0.4};
+    sp.tex_max = {0.4, 0.4};
+    sp.mips = mips;
+    sp.support_area = 0.01;
+    sp.support_width = 0.1;
+    d.lighting.spotlights.push_back(sp);
+  }
+  d.shadow_map_size = 512;
+  d.spot_shadow_map_size = 256;
+  for (bool deferred : {false, true}) {
+    RenderResult layered = gl::Renderer({deferred, true}).render(d);
+    RenderResult per_light = gl::Renderer({deferred, false}).render(d);
+    EXPECT_EQ(layered.unshadowed_lights, 0);
+    double worst = 0, lit = 0;
+    for (int y = 0; y < layered.color.height(); ++y)
+      for (int x = 0; x < layered.color.width(); ++x) {
+        worst = std::max(worst, length(layered.color.rgb(x, y) - per_light.color.rgb(x, y)));
+        lit = std::max(lit, luminance(per_light.color.rgb(x, y)));
+      }
+    EXPECT_GT(lit, 0.05) << "deferred " << deferred;
+    EXPECT_LE(worst, 1e-6 * lit) << "deferred " << deferred;  // same depths, same comparisons
+  }
 }
 
 // Albedo textures at the meshes' UVs and the Blinn-Phong lobe (lights exact; SH and maps through the

@@ -67,6 +67,7 @@ struct Renderer::Impl {
   enum Kind { Forward, GBuffer, Compute };
   std::map<std::tuple<int, bool, int>, GLuint> programs;
   GLuint shadow_program = 0;
+  GLuint layered_shadow_program = 0;  // 0 where the driver lacks GL_ARB_shader_viewport_layer_array
 
   GLuint program(int bands, bool glossy, Kind kind) {
     auto key = std::make_tuple(std::max(1, bands), glossy, static_cast<int>(kind));
@@ -86,12 +87,16 @@ struct Renderer::Impl {
   ~Impl() {
     for (auto& [k, p] : programs) glDeleteProgram(p);
     if (shadow_program) glDeleteProgram(shadow_program);
+    if (layered_shadow_program) glDeleteProgram(layered_shadow_program);
   }
 };
 
 Renderer::Renderer(const RendererDesc& desc) : impl_(std::make_unique<Impl>()) {
   impl_->desc = desc;
   impl_->shadow_program = build_program({{GL_VERTEX_SHADER, "shadow.vert", ""}, {GL_FRAGMENT_SHADER, "shadow.frag", ""}});
+  if (desc.layered_shadows && epoxy_has_gl_extension("GL_ARB_shader_viewport_layer_array"))
+    impl_->layered_shadow_program =
+        build_program({{GL_VERTEX_SHADER, "shadow_layered.vert", ""}, {GL_FRAGMENT_SHADER, "shadow.frag", ""}});
 }
 Renderer::~Renderer() = default;
 
@@ -509,28 +514,41 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing)
   auto wall0 = std::chrono::steady_clock::now();
   for (int f = 0; f < nframes; ++f) {
     glBeginQuery(GL_TIME_ELAPSED, queries[f]);
-    // Shadow passes: every layer of a depth array from its light matrix.
-    auto shadow_passes = [&](GLuint tex, const std::vector<Mat4f>& mats, int size) {
+    // Shadow passes: every layer of a depth array from its light matrix, in one instanced draw per
+    // mesh (layered) or one pass per layer.
+    auto shadow_passes = [&](GLuint tex, GLuint mats_ssbo, const std::vector<Mat4f>& mats, int size) {
       if (mats.empty()) return;
-      glUseProgram(impl_->shadow_program);
       glBindFramebuffer(GL_FRAMEBUFFER, shadow_fbo);
       glViewport(0, 0, size, size);
       glEnable(GL_DEPTH_TEST);
+      glDisable(GL_CULL_FACE);  // both faces cast: open meshes (a floor, a room seen from outside)
       glEnable(GL_POLYGON_OFFSET_FILL);
       glPolygonOffset(1.5f, 2.0f);
-      for (size_t i = 0; i < mats.size(); ++i) {
-        glNamedFramebufferTextureLayer(shadow_fbo, GL_DEPTH_ATTACHMENT, tex, 0, static_cast<GLint>(i));
+      if (impl_->layered_shadow_program) {
+        glUseProgram(impl_->layered_shadow_program);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 11, mats_ssbo);
+        glNamedFramebufferTexture(shadow_fbo, GL_DEPTH_ATTACHMENT, tex, 0);  // layered: all layers
         glClear(GL_DEPTH_BUFFER_BIT);
-        glUniformMatrix4fv(loc_light_vp, 1, GL_FALSE, mats[i].data());
         for (auto& m : meshes) {
           glBindVertexArray(m.vao);
-          glDrawElements(GL_TRIANGLES, m.count, GL_UNSIGNED_INT, nullptr);
+          glDrawElementsInstanced(GL_TRIANGLES, m.count, GL_UNSIGNED_INT, nullptr, static_cast<GLsizei>(mats.size()));
+        }
+      } else {
+        glUseProgram(impl_->shadow_program);
+        for (size_t i = 0; i < mats.size(); ++i) {
+          glNamedFramebufferTextureLayer(shadow_fbo, GL_DEPTH_ATTACHMENT, tex, 0, static_cast<GLint>(i));
+          glClear(GL_DEPTH_BUFFER_BIT);
+          glUniformMatrix4fv(loc_light_vp, 1, GL_FALSE, mats[i].data());
+          for (auto& m : meshes) {
+            glBindVertexArray(m.vao);
+            glDrawElements(GL_TRIANGLES, m.count, GL_UNSIGNED_INT, nullptr);
+          }
         }
       }
       glDisable(GL_POLYGON_OFFSET_FILL);
     };
-    shadow_passes(shadow_tex, shadow_mats, S);
-    shadow_passes(spot_shadow_tex, spot_mats, SS);
+    shadow_passes(shadow_tex, ssbo[1], shadow_mats, S);
+    shadow_passes(spot_shadow_tex, spot_ssbo[1], spot_mats, SS);
     // Shading pass (forward), or G-buffer pass then compute shading (deferred).
     glBindFramebuffer(GL_FRAMEBUFFER, fbo);
     glViewport(0, 0, W, H);

@@ -22,6 +22,10 @@ struct RendererDesc {
   // Shade in a compute pass over a G-buffer instead of in the fragment shader. Faster on GPUs whose
   // fragment stage runs on few units (the H100: see bench/RESULTS.md); both give the same image.
   bool deferred = true;
+  // Draw all layers of a shadow-map array in one instanced pass (the vertex shader picks the layer,
+  // GL_ARB_shader_viewport_layer_array) instead of one pass per light. Falls back to passes per
+  // light where the extension is missing; both give the same maps.
+  bool layered_shadows = true;
 };
 
 class Renderer {
