@@ -123,6 +123,12 @@ std::vector<nearfield::TexturedSpotlight> make_spotlights(Vec3 at, Vec3 forward,
   return out;
 }
 
+// One entry of the JSON object: the median GPU time and the wall time per frame.
+void report(const char* path, const std::string& name, const gl::GpuTiming& t) {
+  std::printf(",\n \"%s_%s_ms\": %.4f, \"%s_%s_wall_ms\": %.2f", path, name.c_str(), median(t.frame_ms), path, name.c_str(),
+              t.wall_ms_per_frame);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -149,8 +155,7 @@ int main(int argc, char** argv) {
       auto run = [&](const char* name) {
         gl::GpuTiming t;
         r.render(d, frames, &t);
-        std::printf(",\n \"%s_%s_ms\": %.4f, \"%s_%s_wall_ms\": %.2f", path, name, median(t.frame_ms), path, name,
-                    t.wall_ms_per_frame);
+        report(path, name, t);
       };
       for (int n : {8, 16, 32}) {
         d.lighting.grid = make_grid(n, 5);
@@ -159,6 +164,18 @@ int main(int argc, char** argv) {
       }
       d.objects[0].material = Material{{0.6, 0.6, 0.6}, {0.3, 0.3, 0.3}, 30};
       run("shgrid32_b5_glossy_s30");
+      {
+        // Löw et al.'s suggested variant: the SH basis from a precomputed table (64² cube faces)
+        // instead of per-fragment polynomials.
+        gl::Renderer table({deferred, true, 64});
+        for (bool glossy : {false, true}) {
+          d.objects[0].material = glossy ? Material{{0.6, 0.6, 0.6}, {0.3, 0.3, 0.3}, 30} : Material{{0.7, 0.7, 0.7}, {0, 0, 0}, 1};
+          gl::GpuTiming t;
+          table.render(d, frames, &t);
+          const char* name = glossy ? "shgrid32_b5_glossy_s30_table64" : "shgrid32_b5_diffuse_table64";
+          report(path, name, t);
+        }
+      }
       d.lighting.grid.reset();
       for (int i = 0; i < 256; ++i) {
         double th = std::acos(1 - (i + 0.5) / 256.0), ph = 2.39996 * i;
@@ -186,8 +203,7 @@ int main(int argc, char** argv) {
           gl::Renderer per_pass({deferred, false});
           gl::GpuTiming t;
           per_pass.render(d, frames, &t);
-          std::printf(",\n \"%s_%s_ms\": %.4f, \"%s_%s_wall_ms\": %.2f", path, "nearfield_9x7_crypt_shadow_pass_per_light",
-                      median(t.frame_ms), path, "nearfield_9x7_crypt_shadow_pass_per_light", t.wall_ms_per_frame);
+          report(path, "nearfield_9x7_crypt_shadow_pass_per_light", t);
         }
       }
       d.lighting.spotlights = make_spotlights({-1.0, 2.2, 2.5}, {0.3, -0.6, -1}, 128);

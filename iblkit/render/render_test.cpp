@@ -188,9 +188,11 @@ struct Tolerances {
   double median, p99;
   int min_pixels;
 };
-void expect_gl_agrees(const FrameDesc& d, const RenderResult& cpu, Tolerances tol, const std::string& name) {
+void expect_gl_agrees(const FrameDesc& d, const RenderResult& cpu, Tolerances tol, const std::string& name,
+                      gl::RendererDesc desc = {}) {
   for (bool deferred : {false, true}) {
-    gl::Renderer r({deferred});
+    desc.deferred = deferred;
+    gl::Renderer r(desc);
     RenderResult g = r.render(d);
     if (const char* dir = std::getenv("IBLKIT_TEST_PICTURES"); dir && deferred) {
       io::write_image(std::string(dir) + "/" + name + "_cpu.png", io::tonemap(cpu.color));
@@ -224,6 +226,36 @@ TEST_F(RenderGl, GlslShBasisMatchesCpp) {
   }
 }
 
+// The table variant of sh_eval (a cube-map array of the C++ basis, bilinear) stays within its
+// interpolation error of sh::eval_basis, which falls as the square of the face size everywhere,
+// face edges and corners included (the lookups never filter across an edge).
+TEST_F(RenderGl, GlslShTableMatchesCpp) {
+  gl::Context ctx;
+  const int bands = 5, K = 25;
+  std::vector<Vec3> dirs;
+  for (int i = 0; i < 4000; ++i) {
+    double z = 1 - 2 * (i + 0.5) / 4000, r = std::sqrt(1 - z * z), ph = 2.39996 * i;
+    dirs.push_back({r * std::cos(ph), r * std::sin(ph), z});
+  }
+  for (Vec3 c : {Vec3{1, 1, 1}, Vec3{-1, 1, -1}, Vec3{1, 0, 1}, Vec3{0, -1, 1}, Vec3{1, 0, 0}, Vec3{0, 0, -1}}) dirs.push_back(normalize(c));
+  for (int i = 0; i < 200; ++i) dirs.push_back(normalize(Vec3{1, -1 + 0.01 * i, 0.999}));  // along an edge
+  std::vector<double> cpu(dirs.size() * K);
+  for (size_t i = 0; i < dirs.size(); ++i) sh::eval_basis(bands, dirs[i], cpu.data() + i * K);
+  // Measured on llvmpipe: 0.037, 0.0088, 0.0021, 0.00053 for 16², 32², 64², 128² (the worst at the
+  // faces' centres, Y_40's peak).
+  constexpr double kQuadratic = 0.3;    // error ratio per doubling of the face size (¼ ideally)
+  constexpr double kTable64Tol = 3e-3;  // the renderer's default table
+  double previous = 0;
+  for (int size : {16, 32, 64, 128}) {
+    auto gpu = gl::sh_eval_on_gl(bands, dirs, size);
+    double worst = 0;
+    for (size_t i = 0; i < cpu.size(); ++i) worst = std::max(worst, std::abs(gpu[i] - cpu[i]));
+    if (previous > 0) EXPECT_LT(worst, previous * kQuadratic) << size;
+    if (size == 64) EXPECT_LT(worst, kTable64Tol);
+    previous = worst;
+  }
+}
+
 TEST_F(RenderGl, ShEnvironmentAgreesWithCpu) {
   gl::Context ctx;
   Mesh m = make_sphere(0.4, 48, 96);
@@ -239,6 +271,33 @@ TEST_F(RenderGl, ShEnvironmentAgreesWithCpu) {
   constexpr double kShMedianTol = 1e-3;  // float shading on GL vs double on the CPU
   constexpr double kShP99Tol = 2e-2;     // silhouette pixels where coverage differs in sub-pixel detail
   expect_gl_agrees(d, cpu, {kShMedianTol, kShP99Tol, 1000}, "sh_environment");
+}
+
+// An SH grid of 25 coefficients (RGBA16F 3D texture, hardware trilinear) on a diffuse + Phong s = 30
+// blob that spans many cells: the basis by its polynomials per fragment, and by the precomputed
+// table (64² faces).
+TEST_F(RenderGl, ShGridAgreesWithCpu) {
+  gl::Context ctx;
+  Mesh m = make_blob(6000, 0.5);
+  FrameDesc d = sphere_scene(&m, 96, 72);
+  SHGridData g;
+  g.bands = 5;
+  g.nx = 4; g.ny = 5; g.nz = 3;
+  g.min = {-0.5, -0.5, -0.5};
+  g.max = {0.5, 0.5, 0.5};
+  g.data.resize(static_cast<size_t>(g.nx) * g.ny * g.nz * 25 * 3);
+  for (size_t i = 0; i < g.data.size(); ++i) g.data[i] = static_cast<float>((i % 75 < 3 ? 2.0 : 0.1) * (1 + 0.5 * std::sin(0.37 * i)));
+  d.lighting.grid = g;
+  d.objects[0].material.specular = {0.3, 0.3, 0.3};
+  d.objects[0].material.exponent = 30;
+  RenderResult cpu = render_cpu(d);
+  // Measured on llvmpipe: median 3.6e-4, p99 5.0e-4 (table: 5.8e-4).
+  constexpr double kGridMedianTol = 2e-3;  // RGBA16F texels (11-bit mantissas) and 8-bit filter weights
+  constexpr double kGridP99Tol = 5e-3;
+  expect_gl_agrees(d, cpu, {kGridMedianTol, kGridP99Tol, 800}, "sh_grid");
+  constexpr double kTableMedianTol = 3e-3;  // and the table's interpolation (max |ΔY| 2e-3 at 64²)
+  constexpr double kTableP99Tol = 5e-3;
+  expect_gl_agrees(d, cpu, {kTableMedianTol, kTableP99Tol, 800}, "sh_grid_table", {.sh_table_size = 64});
 }
 
 TEST_F(RenderGl, DirectionalLightsWithShadowsAgreeWithCpu) {

@@ -66,6 +66,13 @@ struct Renderer::Impl {
   // Programs by (SH bands (0 → 1), glossy, stage kind).
   enum Kind { Forward, GBuffer, Compute };
   std::map<std::tuple<int, bool, int>, GLuint> programs;
+  std::map<int, GLuint> sh_tables;  // by bands, when desc.sh_table_size > 0
+
+  GLuint sh_table(int bands) {
+    auto& t = sh_tables[bands];
+    if (!t) t = make_sh_table_texture(bands, desc.sh_table_size);
+    return t;
+  }
   GLuint shadow_program = 0;
   GLuint layered_shadow_program = 0;  // 0 where the driver lacks GL_ARB_shader_viewport_layer_array
 
@@ -73,7 +80,8 @@ struct Renderer::Impl {
     auto key = std::make_tuple(std::max(1, bands), glossy, static_cast<int>(kind));
     auto it = programs.find(key);
     if (it != programs.end()) return it->second;
-    std::string lib = sh_glsl_source(std::get<0>(key)) + (glossy ? "#define GLOSSY 1\n" : "#define GLOSSY 0\n") +
+    const int b = std::get<0>(key);
+    std::string lib = (desc.sh_table_size > 0 ? sh_table_glsl_source(b) : sh_glsl_source(b)) + (glossy ? "#define GLOSSY 1\n" : "#define GLOSSY 0\n") +
                       "#line 1\n" + shader_source("shading.glsl");
     GLuint p = 0;
     switch (kind) {
@@ -88,11 +96,14 @@ struct Renderer::Impl {
     for (auto& [k, p] : programs) glDeleteProgram(p);
     if (shadow_program) glDeleteProgram(shadow_program);
     if (layered_shadow_program) glDeleteProgram(layered_shadow_program);
+    for (auto& [b, t] : sh_tables) glDeleteTextures(1, &t);
   }
 };
 
 Renderer::Renderer(const RendererDesc& desc) : impl_(std::make_unique<Impl>()) {
   impl_->desc = desc;
+  if (desc.sh_table_size < 0 || desc.sh_table_size == 1 || desc.sh_table_size > 4096)
+    fail(ErrorKind::Value, "SH table size {} is out of range (0 for none, 2..4096)", desc.sh_table_size);
   impl_->shadow_program = build_program({{GL_VERTEX_SHADER, "shadow.vert", ""}, {GL_FRAGMENT_SHADER, "shadow.frag", ""}});
   if (desc.layered_shadows && epoxy_has_gl_extension("GL_ARB_shader_viewport_layer_array"))
     impl_->layered_shadow_program =
@@ -497,6 +508,12 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing)
   glProgramUniform1i(prog, glGetUniformLocation(prog, "u_grid"), 1);
   glProgramUniform1i(prog, glGetUniformLocation(prog, "u_glossy_maps"), 3);
   glProgramUniform1i(prog, glGetUniformLocation(prog, "u_albedo_textures"), 6);
+  GLuint sh_table_tex = 0;
+  if (impl_->desc.sh_table_size > 0) {
+    sh_table_tex = impl_->sh_table(std::max(1, bands));
+    glProgramUniform1i(prog, glGetUniformLocation(prog, "u_sh_table"), 7);
+    glProgramUniform1f(prog, glGetUniformLocation(prog, "u_sh_table_warp"), sh_table_warp(impl_->desc.sh_table_size));
+  }
   GLint loc_albedo = glGetUniformLocation(prog, "u_albedo"), loc_specular = glGetUniformLocation(prog, "u_specular"),
         loc_exponent = glGetUniformLocation(prog, "u_exponent"), loc_glossy = glGetUniformLocation(prog, "u_glossy_zh"),
         loc_glossy_layer = glGetUniformLocation(prog, "u_glossy_layer"),
@@ -570,6 +587,7 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing)
     if (spot_tex) glBindTextureUnit(4, spot_tex);
     if (albedo_tex) glBindTextureUnit(6, albedo_tex);
     if (spot_shadow_tex) glBindTextureUnit(5, spot_shadow_tex);
+    if (sh_table_tex) glBindTextureUnit(7, sh_table_tex);
     for (size_t i = 0; i < meshes.size(); ++i) {
       if (deferred) {
         glUniform1ui(loc_material, static_cast<GLuint>(i));

@@ -26,6 +26,11 @@ struct RendererDesc {
   // GL_ARB_shader_viewport_layer_array) instead of one pass per light. Falls back to passes per
   // light where the extension is missing; both give the same maps.
   bool layered_shadows = true;
+  // How shaders evaluate the SH basis at the normal and the reflection vector: 0 (default) by its
+  // polynomials per fragment, as Löw et al. did; N > 0 by a lookup in a precomputed table of the
+  // basis (a cube-map array with N² faces, bilinear), the variant they suggested. Max |ΔY| of the
+  // table: 2e-3 at N = 64, 5e-4 at N = 128 (test RenderGl.GlslShTableMatchesCpp).
+  int sh_table_size = 0;
 };
 
 class Renderer {

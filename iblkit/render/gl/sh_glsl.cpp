@@ -42,8 +42,86 @@ std::string sh_glsl_source(int bands) {
   return s;
 }
 
-std::vector<float> sh_eval_on_gl(int bands, const std::vector<Vec3>& directions) {
-  GLuint prog = build_program({{GL_COMPUTE_SHADER, "sh_eval.comp", sh_glsl_source(bands)}});
+std::string sh_table_glsl_source(int bands) {
+  if (bands < 1 || bands > 10) fail(ErrorKind::Value, "GLSL SH supports 1..10 bands (got {})", bands);
+  // The faces' outer texel centres lie on the cube's edges (sh_table_texels), and the lookup
+  // shrinks the two minor components by u_sh_table_warp = (size − 1)/size so that they land there:
+  // bilinear filtering then never crosses a face edge, where interpolating between two faces at
+  // 90° would cost first-order error.
+  return fmt::format(
+      "#define SH_BANDS {0}\n#define SH_K {1}\n"
+      "uniform samplerCubeArray u_sh_table;\n"
+      "uniform float u_sh_table_warp;\n"
+      "void sh_eval(vec3 d, out float Y[SH_K]) {{\n"
+      "  vec3 a = abs(d);\n"
+      "  vec3 w = a.x >= a.y && a.x >= a.z ? vec3(1.0, u_sh_table_warp, u_sh_table_warp)\n"
+      "         : (a.y >= a.z ? vec3(u_sh_table_warp, 1.0, u_sh_table_warp) : vec3(u_sh_table_warp, u_sh_table_warp, 1.0));\n"
+      "  vec3 q = d * w;\n"
+      "  for (int j = 0; j < {2}; ++j) {{\n"
+      "    vec4 v = texture(u_sh_table, vec4(q, float(j)));\n"
+      "    for (int c = 0; c < 4; ++c) if (4 * j + c < SH_K) Y[4 * j + c] = v[c];\n"
+      "  }}\n}}\n",
+      bands, bands * bands, (bands * bands + 3) / 4);
+}
+
+float sh_table_warp(int size) { return static_cast<float>(size - 1) / static_cast<float>(size); }
+
+namespace {
+// Direction through face coordinates (sc, tc) ∈ [−1, 1]² of cube face f (GL's table 8.19 inverted).
+Vec3 cube_direction(int face, double sc, double tc) {
+  switch (face) {
+    case 0: return {1, -tc, -sc};
+    case 1: return {-1, -tc, sc};
+    case 2: return {sc, 1, tc};
+    case 3: return {sc, -1, -tc};
+    case 4: return {sc, -tc, 1};
+    default: return {-sc, -tc, -1};
+  }
+}
+}  // namespace
+
+std::vector<float> sh_table_texels(int bands, int size) {
+  if (bands < 1 || bands > 10) fail(ErrorKind::Value, "SH table supports 1..10 bands (got {})", bands);
+  if (size < 2 || size > 4096) fail(ErrorKind::Value, "SH table face size {} is out of range 2..4096", size);
+  const int K = bands * bands, layers = (K + 3) / 4;
+  std::vector<float> out(static_cast<size_t>(layers) * 6 * size * size * 4, 0.0f);
+  std::vector<double> Y(K);
+  for (int f = 0; f < 6; ++f)
+    for (int t = 0; t < size; ++t)
+      for (int s = 0; s < size; ++s) {
+        // Texel centres from edge to edge: face coordinate (2i + 1 − size)/(size − 1) ∈ [−1, 1].
+        const double sc = (2.0 * s + 1 - size) / (size - 1), tc = (2.0 * t + 1 - size) / (size - 1);
+        sh::eval_basis(bands, normalize(cube_direction(f, sc, tc)), Y.data());
+        for (int k = 0; k < K; ++k) {
+          const size_t layer_face = static_cast<size_t>(k / 4) * 6 + f;
+          out[((layer_face * size + t) * size + s) * 4 + k % 4] = static_cast<float>(Y[k]);
+        }
+      }
+  return out;
+}
+
+unsigned make_sh_table_texture(int bands, int size) {
+  const std::vector<float> texels = sh_table_texels(bands, size);
+  const int layers = (bands * bands + 3) / 4;
+  GLuint tex = 0;
+  glCreateTextures(GL_TEXTURE_CUBE_MAP_ARRAY, 1, &tex);
+  glTextureStorage3D(tex, 1, GL_RGBA32F, size, size, 6 * layers);
+  glTextureSubImage3D(tex, 0, 0, 0, 0, size, size, 6 * layers, GL_RGBA, GL_FLOAT, texels.data());
+  glTextureParameteri(tex, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTextureParameteri(tex, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTextureParameteri(tex, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTextureParameteri(tex, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  return tex;
+}
+
+std::vector<float> sh_eval_on_gl(int bands, const std::vector<Vec3>& directions, int table_size) {
+  GLuint table = table_size > 0 ? make_sh_table_texture(bands, table_size) : 0;
+  GLuint prog = build_program({{GL_COMPUTE_SHADER, "sh_eval.comp", table ? sh_table_glsl_source(bands) : sh_glsl_source(bands)}});
+  if (table) {
+    glBindTextureUnit(7, table);
+    glProgramUniform1i(prog, glGetUniformLocation(prog, "u_sh_table"), 7);
+    glProgramUniform1f(prog, glGetUniformLocation(prog, "u_sh_table_warp"), sh_table_warp(table_size));
+  }
   const int K = bands * bands, n = static_cast<int>(directions.size());
   std::vector<float> dirs(static_cast<size_t>(n) * 4, 0.0f);
   for (int i = 0; i < n; ++i)
@@ -62,6 +140,7 @@ std::vector<float> sh_eval_on_gl(int bands, const std::vector<Vec3>& directions)
   glGetNamedBufferSubData(buf[1], 0, static_cast<GLsizeiptr>(out.size() * sizeof(float)), out.data());
   glDeleteBuffers(2, buf);
   glDeleteProgram(prog);
+  if (table) glDeleteTextures(1, &table);
   return out;
 }
 
