@@ -17,6 +17,16 @@ if grep -q "outside the SH grid" <<<"$out"; then echo "FAIL grid-inside warns: $
 check grid-outside-warns ok "outside the SH grid's volume" -- "$BIN" render blob --light "$T/g4.shgrid" --at 0,0,0 --size 48x36 \
   --backend cpu --out "$T/out.png"
 
+# The GL path's SH-basis table variant (where this machine has GL), and a table size it refuses.
+if "$BIN" render sphere --light "$T/g4.shgrid" --size 8x8 --backend gl --out "$T/gl_probe.png" >/dev/null 2>&1; then
+  check grid-sh-table ok "gl backend" -- "$BIN" render blob --light "$T/g4.shgrid" --at 0,1,0 --object-size 0.3 --gloss 0.3 \
+    --size 48x36 --backend gl --sh-table 64 --out "$T/table.png"
+  check grid-sh-table-bad fail "SH table size 1 is out of range" -- "$BIN" render blob --light "$T/g4.shgrid" --at 0,1,0 \
+    --size 48x36 --backend gl --sh-table 1 --out "$T/table.png"
+else
+  echo "no GL here: the --sh-table checks are skipped"; skip=$((skip+1))
+fi
+
 # Two lightings, one photograph: one frame each and the comparison sheet.
 check truth-two-lights ok "object relative L1" -- "$BIN" render blob --light "$T/g4.shgrid" --light "$PROBE" --at 0,0.85,0 \
   --object-size 0.35 --floor-size 0.8 --eye 0,1.45,1.5 --target 0,0.8,0 --size 64x48 --backend cpu --truth low-scene2 \
