@@ -9,6 +9,7 @@
 #include <fstream>
 #include <memory>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 
 #include "iblkit/render/gl/context.h"
@@ -86,7 +87,12 @@ Mesh read_obj(const std::string& path) {
     } else if (tag == "f") {
       std::vector<uint32_t> f;
       std::string v;
-      while (ls >> v) f.push_back(static_cast<uint32_t>(std::stoul(v.substr(0, v.find('/'))) - 1));
+      while (ls >> v) {
+        const long i = std::stol(v.substr(0, v.find('/')));
+        if (i < 1 || static_cast<size_t>(i) > m.positions.size() / 3)
+          throw std::runtime_error(path + ": vertex index " + std::to_string(i) + " is out of range (this reader takes positive indices of vertices listed before the face)");
+        f.push_back(static_cast<uint32_t>(i - 1));
+      }
       for (size_t k = 2; k < f.size(); ++k) m.indices.insert(m.indices.end(), {f[0], f[k - 1], f[k]});
     }
   }
@@ -167,7 +173,7 @@ int main(int argc, char** argv) {
       {
         // Löw et al.'s suggested variant: the SH basis from a precomputed table (64² cube faces)
         // instead of per-fragment polynomials.
-        gl::Renderer table({deferred, true, 64});
+        gl::Renderer table({.deferred = deferred, .sh_table_size = 64});
         for (bool glossy : {false, true}) {
           d.objects[0].material = glossy ? Material{{0.6, 0.6, 0.6}, {0.3, 0.3, 0.3}, 30} : Material{{0.7, 0.7, 0.7}, {0, 0, 0}, 1};
           gl::GpuTiming t;
@@ -200,7 +206,7 @@ int main(int argc, char** argv) {
         d.camera.target = {-0.8, 0.6, -1.2};
         run("nearfield_9x7_crypt");
         if (deferred) {
-          gl::Renderer per_pass({deferred, false});
+          gl::Renderer per_pass({.deferred = deferred, .layered_shadows = false});
           gl::GpuTiming t;
           per_pass.render(d, frames, &t);
           report(path, "nearfield_9x7_crypt_shadow_pass_per_light", t);

@@ -86,9 +86,9 @@ void setup(CLI::App& app) {
       ->check(CLI::IsMember({"map", "sh"}))
       ->capture_default_str();
   app.add_option("--sh-table", o->sh_table,
-                 "GL: evaluate the SH basis from a precomputed table with faces of N² texels (Löw et al.'s suggested "
-                 "variant; 64 keeps |ΔY| under 2e-3) instead of its polynomials per fragment (0)")
-      ->check(CLI::Range(0, 4096))
+                 "GL backend only: evaluate the SH basis from a precomputed table with faces of N×N texels (Löw et al.'s "
+                 "suggested variant; 64: |ΔY| about 2e-3) instead of its polynomials per fragment (0)")
+      ->check(CLI::Range(0, 1024))
       ->capture_default_str();
   app.add_option("--floor-size", o->floor_size, "side of the square floor under the object, metres (a table top when small; 0: no floor)")
       ->check(CLI::Range(0.0, 1000.0))
@@ -184,9 +184,9 @@ void setup(CLI::App& app) {
       RenderResult f;
 #ifdef IBLKIT_HAVE_GL
       if (backend == "gl") {
-        gl::RendererDesc rd;
-        rd.sh_table_size = o->sh_table;
-        gl::Renderer r(rd);
+        gl::RendererDesc gl_desc;
+        gl_desc.sh_table_size = o->sh_table;
+        gl::Renderer r(gl_desc);
         gl::GpuTiming t;
         f = r.render(d, o->frames, &t);
         std::vector<double> ms = t.frame_ms;

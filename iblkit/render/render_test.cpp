@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <functional>
 
+#include "iblkit/core/error.h"
 #include "iblkit/io/image_io.h"
 #include "iblkit/io/tonemap.h"
 #include "iblkit/render/cpu_renderer.h"
@@ -16,6 +17,7 @@
 #include <epoxy/gl.h>
 
 #include "iblkit/render/gl/context.h"
+#include "iblkit/render/gl/program.h"
 #include "iblkit/render/gl/renderer.h"
 #include "iblkit/render/gl/sh_glsl.h"
 #endif
@@ -226,6 +228,31 @@ TEST_F(RenderGl, GlslShBasisMatchesCpp) {
   }
 }
 
+// A shader that fails to compile names its file and line: the file's own lines (sh_eval.comp calls
+// sh_eval on its line 12, here left undefined), and lines of the generated code inserted before it.
+TEST_F(RenderGl, ShaderErrorsNameFileAndLine) {
+  gl::Context ctx;
+  auto message = [](const std::string& prelude) {
+    try {
+      gl::build_program({{GL_COMPUTE_SHADER, "sh_eval.comp", prelude}});
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("compiled");
+  };
+  EXPECT_NE(message("#define SH_K 4\n").find("sh_eval.comp:12: "), std::string::npos) << message("#define SH_K 4\n");
+  const std::string broken = "#define SH_K 4\nvoid sh_eval(vec3 d, out float Y[SH_K]) {\n  Y[0] = no_such_thing;\n}\n";
+  EXPECT_NE(message(broken).find("sh_eval.comp (generated prelude, line 3): "), std::string::npos) << message(broken);
+  // An included file's lines: shading.glsl without the SH definitions it needs (SH_BANDS, on its line 14).
+  std::string included;
+  try {
+    gl::build_program({{GL_COMPUTE_SHADER, "shade.comp", "", {"shading.glsl"}}});
+  } catch (const Error& e) {
+    included = e.what();
+  }
+  EXPECT_NE(included.find("shading.glsl:14: "), std::string::npos) << included;
+}
+
 // The table variant of sh_eval (a cube-map array of the C++ basis, bilinear) stays within its
 // interpolation error of sh::eval_basis, which falls as the square of the face size everywhere,
 // face edges and corners included (the lookups never filter across an edge).
@@ -238,20 +265,30 @@ TEST_F(RenderGl, GlslShTableMatchesCpp) {
     dirs.push_back({r * std::cos(ph), r * std::sin(ph), z});
   }
   for (Vec3 c : {Vec3{1, 1, 1}, Vec3{-1, 1, -1}, Vec3{1, 0, 1}, Vec3{0, -1, 1}, Vec3{1, 0, 0}, Vec3{0, 0, -1}}) dirs.push_back(normalize(c));
-  for (int i = 0; i < 200; ++i) dirs.push_back(normalize(Vec3{1, -1 + 0.01 * i, 0.999}));  // along an edge
+  for (double z : {0.999, 1.0, 1.001})  // along an edge: either side of it, and on it (ties)
+    for (int i = 0; i < 200; ++i) dirs.push_back(normalize(Vec3{1, -1 + 0.01 * i, z}));
   std::vector<double> cpu(dirs.size() * K);
   for (size_t i = 0; i < dirs.size(); ++i) sh::eval_basis(bands, dirs[i], cpu.data() + i * K);
   // Measured on llvmpipe: 0.037, 0.0088, 0.0021, 0.00053 for 16², 32², 64², 128² (the worst at the
-  // faces' centres, Y_40's peak).
-  constexpr double kQuadratic = 0.3;    // error ratio per doubling of the face size (¼ ideally)
-  constexpr double kTable64Tol = 3e-3;  // the renderer's default table
+  // faces' centres, Y_40's peak). GPUs with 8-bit filter weights add ~ΔY_texel/512 (≈ 2e-4), which
+  // matters only at the larger sizes: the ratio is checked up to 64², 128² against a bound.
+  constexpr double kQuadratic = 0.3;     // error ratio per doubling of the face size (¼ ideally)
+  constexpr double kTable64Tol = 3e-3;   // the size the docs recommend
+  constexpr double kTable128Tol = 1e-3;
   double previous = 0;
   for (int size : {16, 32, 64, 128}) {
     auto gpu = gl::sh_eval_on_gl(bands, dirs, size);
     double worst = 0;
     for (size_t i = 0; i < cpu.size(); ++i) worst = std::max(worst, std::abs(gpu[i] - cpu[i]));
-    if (previous > 0) EXPECT_LT(worst, previous * kQuadratic) << size;
-    if (size == 64) EXPECT_LT(worst, kTable64Tol);
+    if (previous > 0 && size <= 64) {
+      EXPECT_LT(worst, previous * kQuadratic) << size;
+    }
+    if (size == 64) {
+      EXPECT_LT(worst, kTable64Tol);
+    }
+    if (size == 128) {
+      EXPECT_LT(worst, kTable128Tol);
+    }
     previous = worst;
   }
 }
@@ -405,18 +442,32 @@ TEST_F(RenderGl, LayeredShadowPassEqualsPassPerLight) {
   }
   d.shadow_map_size = 512;
   d.spot_shadow_map_size = 256;
+  FrameDesc unshadowed = d;
+  for (auto& l : unshadowed.lighting.lights) l.shadow = false;
+  for (auto& l : unshadowed.lighting.point_lights) l.shadow = false;
+  for (auto& l : unshadowed.lighting.spotlights) l.shadow = false;
+  // Pixels that differ by more than float noise (relative to the brightest): none on llvmpipe; a
+  // driver may compile the two vertex shaders' transforms differently (fused multiply-adds), which
+  // can flip a comparison on a shadow edge.
+  auto differing = [](const RenderResult& a, const RenderResult& b, double* lit) {
+    int n = 0;
+    *lit = 0;
+    for (int y = 0; y < a.color.height(); ++y)
+      for (int x = 0; x < a.color.width(); ++x) *lit = std::max(*lit, luminance(b.color.rgb(x, y)));
+    for (int y = 0; y < a.color.height(); ++y)
+      for (int x = 0; x < a.color.width(); ++x) n += length(a.color.rgb(x, y) - b.color.rgb(x, y)) > 1e-6 * *lit;
+    return n;
+  };
+  constexpr int kEdgePixelsTol = 5;  // of 128×96
   for (bool deferred : {false, true}) {
-    RenderResult layered = gl::Renderer({deferred, true}).render(d);
-    RenderResult per_light = gl::Renderer({deferred, false}).render(d);
+    RenderResult layered = gl::Renderer({.deferred = deferred, .layered_shadows = true}).render(d);
+    RenderResult per_light = gl::Renderer({.deferred = deferred, .layered_shadows = false}).render(d);
+    RenderResult none = gl::Renderer({.deferred = deferred}).render(unshadowed);
     EXPECT_EQ(layered.unshadowed_lights, 0);
-    double worst = 0, lit = 0;
-    for (int y = 0; y < layered.color.height(); ++y)
-      for (int x = 0; x < layered.color.width(); ++x) {
-        worst = std::max(worst, length(layered.color.rgb(x, y) - per_light.color.rgb(x, y)));
-        lit = std::max(lit, luminance(per_light.color.rgb(x, y)));
-      }
+    double lit = 0;
+    EXPECT_LE(differing(layered, per_light, &lit), kEdgePixelsTol) << "deferred " << deferred;
     EXPECT_GT(lit, 0.05) << "deferred " << deferred;
-    EXPECT_LE(worst, 1e-6 * lit) << "deferred " << deferred;  // same depths, same comparisons
+    EXPECT_GT(differing(none, layered, &lit), 500) << "deferred " << deferred;  // the maps do cast shadows
   }
 }
 

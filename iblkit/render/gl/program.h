@@ -13,10 +13,11 @@ struct ShaderStage {
   unsigned type;        // GL_VERTEX_SHADER, GL_FRAGMENT_SHADER, …
   std::string name;     // file name, for messages
   std::string prelude;  // code inserted after the #version line (generated constants, defines)
+  std::vector<std::string> includes = {};  // embedded files inserted after the prelude (shading.glsl)
 };
 
-// Compiles and links; returns the program object. Line numbers in messages refer to the file
-// (the prelude is accounted for with a #line directive).
+// Compiles and links; returns the program object. Compile errors name the file and line they are
+// in: the stage's file, an included file, or "(generated prelude, line N)".
 unsigned build_program(const std::vector<ShaderStage>& stages);
 
 }  // namespace ibl::render::gl

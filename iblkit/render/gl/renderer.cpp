@@ -81,13 +81,12 @@ struct Renderer::Impl {
     auto it = programs.find(key);
     if (it != programs.end()) return it->second;
     const int b = std::get<0>(key);
-    std::string lib = (desc.sh_table_size > 0 ? sh_table_glsl_source(b) : sh_glsl_source(b)) + (glossy ? "#define GLOSSY 1\n" : "#define GLOSSY 0\n") +
-                      "#line 1\n" + shader_source("shading.glsl");
+    std::string defs = (desc.sh_table_size > 0 ? sh_table_glsl_source(b) : sh_glsl_source(b)) + (glossy ? "#define GLOSSY 1\n" : "#define GLOSSY 0\n");
     GLuint p = 0;
     switch (kind) {
-      case Forward: p = build_program({{GL_VERTEX_SHADER, "mesh.vert", ""}, {GL_FRAGMENT_SHADER, "shade.frag", lib}}); break;
+      case Forward: p = build_program({{GL_VERTEX_SHADER, "mesh.vert", ""}, {GL_FRAGMENT_SHADER, "shade.frag", defs, {"shading.glsl"}}}); break;
       case GBuffer: p = build_program({{GL_VERTEX_SHADER, "mesh.vert", ""}, {GL_FRAGMENT_SHADER, "visibility.frag", ""}}); break;
-      case Compute: p = build_program({{GL_COMPUTE_SHADER, "shade.comp", lib}}); break;
+      case Compute: p = build_program({{GL_COMPUTE_SHADER, "shade.comp", defs, {"shading.glsl"}}}); break;
     }
     programs[key] = p;
     return p;
@@ -102,10 +101,12 @@ struct Renderer::Impl {
 
 Renderer::Renderer(const RendererDesc& desc) : impl_(std::make_unique<Impl>()) {
   impl_->desc = desc;
-  if (desc.sh_table_size < 0 || desc.sh_table_size == 1 || desc.sh_table_size > 4096)
-    fail(ErrorKind::Value, "SH table size {} is out of range (0 for none, 2..4096)", desc.sh_table_size);
+  if (desc.sh_table_size < 0 || desc.sh_table_size == 1 || desc.sh_table_size > kMaxShTableSize)
+    fail(ErrorKind::Value, "SH table size {} is out of range (0 for none, 2..{})", desc.sh_table_size, kMaxShTableSize);
   impl_->shadow_program = build_program({{GL_VERTEX_SHADER, "shadow.vert", ""}, {GL_FRAGMENT_SHADER, "shadow.frag", ""}});
-  if (desc.layered_shadows && epoxy_has_gl_extension("GL_ARB_shader_viewport_layer_array"))
+  GLint vertex_ssbos = 0;  // the layered pass reads its matrices from a storage buffer (GL 4.5 may allow none)
+  glGetIntegerv(GL_MAX_VERTEX_SHADER_STORAGE_BLOCKS, &vertex_ssbos);
+  if (desc.layered_shadows && vertex_ssbos > 0 && epoxy_has_gl_extension("GL_ARB_shader_viewport_layer_array"))
     impl_->layered_shadow_program =
         build_program({{GL_VERTEX_SHADER, "shadow_layered.vert", ""}, {GL_FRAGMENT_SHADER, "shadow.frag", ""}});
 }

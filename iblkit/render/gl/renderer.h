@@ -28,8 +28,8 @@ struct RendererDesc {
   bool layered_shadows = true;
   // How shaders evaluate the SH basis at the normal and the reflection vector: 0 (default) by its
   // polynomials per fragment, as Löw et al. did; N > 0 by a lookup in a precomputed table of the
-  // basis (a cube-map array with N² faces, bilinear), the variant they suggested. Max |ΔY| of the
-  // table: 2e-3 at N = 64, 5e-4 at N = 128 (test RenderGl.GlslShTableMatchesCpp).
+  // basis (a cube-map array with faces of N×N texels, bilinear), the variant they suggested. Max
+  // |ΔY| of the table: about 2e-3 at N = 64, 5e-4 at N = 128 (test RenderGl.GlslShTableMatchesCpp).
   int sh_table_size = 0;
 };
 
@@ -42,6 +42,7 @@ class Renderer {
   RenderResult render(const FrameDesc& desc, int frames = 1, GpuTiming* timing = nullptr);
 
   static constexpr int kMaxShadowMaps = 16;  // shadow-casting lights per pass
+  static constexpr int kMaxShTableSize = 1024;  // 7 layers × 6 faces × 1024² × 16 B = 704 MB at 5 bands
 
  private:
   struct Impl;

@@ -58,7 +58,7 @@ std::string sh_table_glsl_source(int bands) {
       "         : (a.y >= a.z ? vec3(u_sh_table_warp, 1.0, u_sh_table_warp) : vec3(u_sh_table_warp, u_sh_table_warp, 1.0));\n"
       "  vec3 q = d * w;\n"
       "  for (int j = 0; j < {2}; ++j) {{\n"
-      "    vec4 v = texture(u_sh_table, vec4(q, float(j)));\n"
+      "    vec4 v = textureLod(u_sh_table, vec4(q, float(j)), 0.0);\n"
       "    for (int c = 0; c < 4; ++c) if (4 * j + c < SH_K) Y[4 * j + c] = v[c];\n"
       "  }}\n}}\n",
       bands, bands * bands, (bands * bands + 3) / 4);
@@ -115,8 +115,8 @@ unsigned make_sh_table_texture(int bands, int size) {
 }
 
 std::vector<float> sh_eval_on_gl(int bands, const std::vector<Vec3>& directions, int table_size) {
+  GLuint prog = build_program({{GL_COMPUTE_SHADER, "sh_eval.comp", table_size > 0 ? sh_table_glsl_source(bands) : sh_glsl_source(bands)}});
   GLuint table = table_size > 0 ? make_sh_table_texture(bands, table_size) : 0;
-  GLuint prog = build_program({{GL_COMPUTE_SHADER, "sh_eval.comp", table ? sh_table_glsl_source(bands) : sh_glsl_source(bands)}});
   if (table) {
     glBindTextureUnit(7, table);
     glProgramUniform1i(prog, glGetUniformLocation(prog, "u_sh_table"), 7);
