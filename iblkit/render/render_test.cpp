@@ -471,6 +471,69 @@ TEST_F(RenderGl, LayeredShadowPassEqualsPassPerLight) {
   }
 }
 
+// A renderer keeps its uploads between frames (the SH grid's texture while its values stay, the
+// spotlight textures while they are the same shared images, the colour target while its size
+// stays): a changed grid or new textures must show in the next frame exactly as on a fresh
+// renderer, and a frame left on the GPU is the frame that would have been read back.
+TEST_F(RenderGl, KeptUploadsFollowChangedLighting) {
+  gl::Context ctx;
+  Mesh blob = make_blob(3000, 0.5);
+  FrameDesc d = sphere_scene(&blob, 64, 48);
+  SHGridData g;
+  g.bands = 3;
+  g.nx = g.ny = g.nz = 3;
+  g.min = {-0.5, -0.5, -0.5};
+  g.max = {0.5, 0.5, 0.5};
+  g.data.assign(27 * 9 * 3, 0.1f);
+  for (size_t p = 0; p < 27; ++p) g.data[p * 27] = g.data[p * 27 + 1] = g.data[p * 27 + 2] = 1.0f;
+  d.lighting.grid = g;
+  gl::Renderer kept;
+  auto same = [](const RenderResult& a, const RenderResult& b) {
+    double worst = 0;
+    for (int y = 0; y < a.color.height(); ++y)
+      for (int x = 0; x < a.color.width(); ++x) worst = std::max(worst, length(a.color.rgb(x, y) - b.color.rgb(x, y)));
+    return worst;
+  };
+  RenderResult first = kept.render(d);
+  d.lighting.grid->data[((2 * 3 + 1) * 3 + 1) * 27] = 3.0f;  // the same grid object: point (1,1,2)'s red DC term
+  RenderResult changed = kept.render(d);
+  EXPECT_GT(same(first, changed), 1e-3);
+  EXPECT_EQ(same(changed, gl::Renderer().render(d)), 0.0);
+  // Spotlights: the same textures again, then new ones.
+  d.lighting = {};
+  Image tex(8, 8, 3);
+  for (size_t i = 0; i < tex.size(); ++i) tex.data()[i] = 20.0f;
+  auto mips = std::make_shared<const std::vector<Image>>(nearfield::build_mips(tex));
+  nearfield::TexturedSpotlight sp;
+  sp.position = {0.2, 1.2, 0.8};
+  sp.frame = Frame::from_normal(normalize(Vec3{-0.2, -1, -0.6}));
+  sp.plane_distance = 0.5;
+  sp.tex_min = {-0.5, -0.5};
+  sp.tex_max = {0.5, 0.5};
+  sp.mips = mips;
+  sp.support_area = 0.01;
+  sp.support_width = 0.05;
+  d.lighting.spotlights = {sp};
+  RenderResult lit = kept.render(d);
+  EXPECT_EQ(same(lit, kept.render(d)), 0.0);
+  for (size_t i = 0; i < tex.size(); ++i) tex.data()[i] = 5.0f;
+  d.lighting.spotlights[0].mips = std::make_shared<const std::vector<Image>>(nearfield::build_mips(tex));
+  RenderResult dimmer = kept.render(d);
+  EXPECT_EQ(same(dimmer, gl::Renderer().render(d)), 0.0);
+  EXPECT_GT(same(lit, dimmer), 1e-3);
+  // Left on the GPU: the colour texture holds the frame (GL's rows, bottom up).
+  EXPECT_TRUE(kept.render(d, 1, nullptr, false).color.empty());
+  std::vector<float> rgba(64 * 48 * 4);
+  glGetTextureImage(kept.color_texture(), 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(rgba.size() * 4), rgba.data());
+  double worst = 0;
+  for (int y = 0; y < 48; ++y)
+    for (int x = 0; x < 64; ++x) {
+      const float* p = rgba.data() + (static_cast<size_t>(47 - y) * 64 + x) * 4;
+      worst = std::max(worst, length(Vec3{p[0], p[1], p[2]} - dimmer.color.rgb(x, y)));
+    }
+  EXPECT_EQ(worst, 0.0);
+}
+
 // Albedo textures at the meshes' UVs and the Blinn-Phong lobe (lights exact; SH and maps through the
 // Phong lobe of s/4), on both renderers.
 TEST_F(RenderGl, TexturedBlinnPhongAgreesWithCpu) {

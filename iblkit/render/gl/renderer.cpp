@@ -68,6 +68,108 @@ struct Renderer::Impl {
   std::map<std::tuple<int, bool, int>, GLuint> programs;
   std::map<int, GLuint> sh_tables;  // by bands, when desc.sh_table_size > 0
 
+  // The last frame's colour (RGBA32F, GL's bottom-up rows, alpha = coverage), kept for
+  // color_texture() and reused while the size stays.
+  GLuint color_tex = 0;
+  int color_w = 0, color_h = 0;
+  GLuint color_texture(int w, int h) {
+    if (color_tex && color_w == w && color_h == h) return color_tex;
+    if (color_tex) glDeleteTextures(1, &color_tex);
+    glCreateTextures(GL_TEXTURE_2D, 1, &color_tex);
+    glTextureStorage2D(color_tex, 1, GL_RGBA32F, w, h);
+    color_w = w;
+    color_h = h;
+    return color_tex;
+  }
+
+  // The SH grid's texture, kept while the next frame's grid holds the same values (compared in
+  // full: a memcmp costs a tenth of packing and uploading them again).
+  GLuint grid_tex = 0;
+  SHGridData grid_key;
+  GLuint grid_texture(const SHGridData& g) {
+    if (grid_tex && g.nx == grid_key.nx && g.ny == grid_key.ny && g.nz == grid_key.nz && g.bands == grid_key.bands &&
+        g.data == grid_key.data)
+      return grid_tex;
+    if (grid_tex) glDeleteTextures(1, &grid_tex);
+    const int K = g.bands * g.bands;
+    const size_t points = static_cast<size_t>(g.nx) * g.ny * g.nz;
+    std::vector<float> packed(points * K * 4, 0.0f);
+    for (int k = 0; k < K; ++k)
+      for (size_t p = 0; p < points; ++p)
+        for (int c = 0; c < 3; ++c) packed[(static_cast<size_t>(k) * points + p) * 4 + c] = g.data[(p * K + k) * 3 + c];
+    glCreateTextures(GL_TEXTURE_3D, 1, &grid_tex);
+    glTextureStorage3D(grid_tex, 1, GL_RGBA16F, g.nx, g.ny, g.nz * K);
+    glTextureSubImage3D(grid_tex, 0, 0, 0, 0, g.nx, g.ny, g.nz * K, GL_RGBA, GL_FLOAT, packed.data());
+    glTextureParameteri(grid_tex, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTextureParameteri(grid_tex, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    for (GLenum w : {GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T, GL_TEXTURE_WRAP_R}) glTextureParameteri(grid_tex, w, GL_CLAMP_TO_EDGE);
+    grid_key = g;
+    return grid_tex;
+  }
+
+  // Spotlight textures in one mip-mapped RGBA16F 2D array, a layer per spotlight: kept while the
+  // next frame's spotlights hold the same (immutable, shared) textures, so that a viewer does not
+  // re-upload a 9×7 dataset's 63 textures every frame.
+  struct SpotTextures {
+    std::vector<std::shared_ptr<const std::vector<Image>>> keys;
+    GLuint tex = 0;
+    int levels = 0;
+    std::vector<float> scale;  // each layer is stored divided by this (its largest |texel|)
+  } spots;
+  const SpotTextures& spot_textures(const std::vector<nearfield::TexturedSpotlight>& lights) {
+    bool same = spots.keys.size() == lights.size();
+    for (size_t i = 0; same && i < lights.size(); ++i) same = spots.keys[i] == lights[i].mips;
+    if (same && spots.tex) return spots;
+    if (spots.tex) glDeleteTextures(1, &spots.tex);
+    spots = {};
+    const auto& first = lights[0];
+    if (!first.mips || first.mips->empty()) fail(ErrorKind::Value, "textured spotlight 0 has no texture");
+    const int tw = (*first.mips)[0].width(), th = (*first.mips)[0].height();
+    const int levels = static_cast<int>(first.mips->size());
+    for (size_t i = 0; i < lights.size(); ++i) {
+      const auto& sp = lights[i];
+      if (!sp.mips || sp.mips->size() != static_cast<size_t>(levels) || (*sp.mips)[0].width() != tw || (*sp.mips)[0].height() != th)
+        fail(ErrorKind::Unsupported, "the GL renderer takes textured spotlights of one texture size per frame (spotlight {} differs from spotlight 0)", i);
+      for (int lv = 0; lv < levels; ++lv)
+        if ((*sp.mips)[lv].channels() != 3) fail(ErrorKind::Value, "spotlight {} mip {} is not RGB", i, lv);
+    }
+    GLuint tex = 0;
+    glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, &tex);
+    // Half floats: half the memory of RGBA32F (the paper stored sRGBE, 4 bytes a texel, for the same
+    // reason); 11-bit mantissas, well inside the agreement test's tolerance.
+    glTextureStorage3D(tex, levels, GL_RGBA16F, tw, th, static_cast<GLsizei>(lights.size()));
+    std::vector<float> rgba;
+    for (size_t i = 0; i < lights.size(); ++i) {
+      const auto& sp = lights[i];
+      // Half floats hold up to 65504 with 11-bit mantissas: each texture is stored divided by its
+      // largest |texel| (measured radiance of a small LED reaches 10⁶ and more), the shader
+      // multiplies it back.
+      float peak = 0;
+      for (size_t k = 0; k < (*sp.mips)[0].size(); ++k) peak = std::max(peak, std::abs((*sp.mips)[0].data()[k]));
+      const float scale = peak > 0 && std::isfinite(peak) ? peak : 1.0f;
+      spots.scale.push_back(scale);
+      for (int lv = 0; lv < levels; ++lv) {
+        const Image& im = (*sp.mips)[lv];
+        rgba.assign(im.pixel_count() * 4, 0.0f);
+        for (size_t k = 0; k < im.pixel_count(); ++k)
+          for (int c = 0; c < 3; ++c) rgba[k * 4 + c] = im.data()[k * 3 + c] / scale;
+        glTextureSubImage3D(tex, lv, 0, 0, static_cast<GLint>(i), im.width(), im.height(), 1, GL_RGBA, GL_FLOAT, rgba.data());
+      }
+      spots.keys.push_back(sp.mips);
+    }
+    glTextureParameteri(tex, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+    glTextureParameteri(tex, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTextureParameteri(tex, GL_TEXTURE_BASE_LEVEL, 0);
+    glTextureParameteri(tex, GL_TEXTURE_MAX_LEVEL, levels - 1);
+    glTextureParameteri(tex, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_BORDER);
+    glTextureParameteri(tex, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_BORDER);
+    const float zero_border[4] = {0, 0, 0, 0};
+    glTextureParameterfv(tex, GL_TEXTURE_BORDER_COLOR, zero_border);
+    spots.tex = tex;
+    spots.levels = levels;
+    return spots;
+  }
+
   GLuint sh_table(int bands) {
     auto& t = sh_tables[bands];
     if (!t) t = make_sh_table_texture(bands, desc.sh_table_size);
@@ -96,6 +198,9 @@ struct Renderer::Impl {
     if (shadow_program) glDeleteProgram(shadow_program);
     if (layered_shadow_program) glDeleteProgram(layered_shadow_program);
     for (auto& [b, t] : sh_tables) glDeleteTextures(1, &t);
+    if (color_tex) glDeleteTextures(1, &color_tex);
+    if (spots.tex) glDeleteTextures(1, &spots.tex);
+    if (grid_tex) glDeleteTextures(1, &grid_tex);
   }
 };
 
@@ -112,7 +217,9 @@ Renderer::Renderer(const RendererDesc& desc) : impl_(std::make_unique<Impl>()) {
 }
 Renderer::~Renderer() = default;
 
-RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing) {
+unsigned Renderer::color_texture() const { return impl_->color_tex; }
+
+RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing, bool read_back) {
   const Camera& cam = d.camera;
   const int W = cam.width, H = cam.height;
   if (W <= 0 || H <= 0 || W > 16384 || H > 16384) fail(ErrorKind::Value, "frame size {}x{} is invalid", W, H);
@@ -192,37 +299,15 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing)
   std::vector<Mat4f> spot_mats;
   GLuint spot_tex = 0;
   int spot_levels = 0;
-  std::vector<float> spot_scale;
+  const std::vector<float>* spot_scale = nullptr;
   if (!L.spotlights.empty()) {
-    const auto& first = L.spotlights[0];
-    if (!first.mips || first.mips->empty()) fail(ErrorKind::Value, "textured spotlight 0 has no texture");
-    const int tw = (*first.mips)[0].width(), th = (*first.mips)[0].height();
-    spot_levels = static_cast<int>(first.mips->size());
-    glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, &spot_tex);
-    // Half floats: half the memory of RGBA32F (the paper stored sRGBE, 4 bytes a texel, for the same
-    // reason); 11-bit mantissas, well inside the agreement test's tolerance.
-    glTextureStorage3D(spot_tex, spot_levels, GL_RGBA16F, tw, th, static_cast<GLsizei>(L.spotlights.size()));
-    std::vector<float> rgba;
+    const Impl::SpotTextures& st = impl_->spot_textures(L.spotlights);
+    spot_tex = st.tex;
+    spot_levels = st.levels;
+    spot_scale = &st.scale;
+    const int tw = (*L.spotlights[0].mips)[0].width(), th = (*L.spotlights[0].mips)[0].height();
     for (size_t i = 0; i < L.spotlights.size(); ++i) {
       const auto& sp = L.spotlights[i];
-      if (!sp.mips || sp.mips->size() != static_cast<size_t>(spot_levels) || (*sp.mips)[0].width() != tw ||
-          (*sp.mips)[0].height() != th)
-        fail(ErrorKind::Unsupported, "the GL renderer takes textured spotlights of one texture size per frame (spotlight {} differs from spotlight 0)", i);
-      // Half floats hold up to 65504 with 11-bit mantissas: each texture is stored divided by its
-      // largest |texel| (measured radiance of a small LED reaches 10⁶ and more), the shader
-      // multiplies it back.
-      float peak = 0;
-      for (size_t k = 0; k < (*sp.mips)[0].size(); ++k) peak = std::max(peak, std::abs((*sp.mips)[0].data()[k]));
-      const float scale = peak > 0 && std::isfinite(peak) ? peak : 1.0f;
-      spot_scale.push_back(scale);
-      for (int lv = 0; lv < spot_levels; ++lv) {
-        const Image& im = (*sp.mips)[lv];
-        if (im.channels() != 3) fail(ErrorKind::Value, "spotlight {} mip {} is not RGB", i, lv);
-        rgba.assign(im.pixel_count() * 4, 0.0f);
-        for (size_t k = 0; k < im.pixel_count(); ++k)
-          for (int c = 0; c < 3; ++c) rgba[k * 4 + c] = im.data()[k * 3 + c] / scale;
-        glTextureSubImage3D(spot_tex, lv, 0, 0, static_cast<GLint>(i), im.width(), im.height(), 1, GL_RGBA, GL_FLOAT, rgba.data());
-      }
       float layer = -1;
       if (sp.shadow) {
         // Perspective frustum along forward through the texture's extent (a texel of margin).
@@ -250,17 +335,9 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing)
                              static_cast<float>(sp.frame.b.x), static_cast<float>(sp.frame.b.y), static_cast<float>(sp.frame.b.z), static_cast<float>(sp.tex_min.y),
                              static_cast<float>(sp.frame.n.x), static_cast<float>(sp.frame.n.y), static_cast<float>(sp.frame.n.z), static_cast<float>(sp.plane_distance),
                              static_cast<float>(sp.tex_max.x), static_cast<float>(sp.tex_max.y), static_cast<float>(sp.support_area), static_cast<float>(sp.support_width),
-                             static_cast<float>(texel), static_cast<float>(spot_levels), static_cast<float>(i), spot_scale.back()};
+                             static_cast<float>(texel), static_cast<float>(spot_levels), static_cast<float>(i), (*spot_scale)[i]};
       spot_data.insert(spot_data.end(), row, row + 24);
     }
-    glTextureParameteri(spot_tex, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
-    glTextureParameteri(spot_tex, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    glTextureParameteri(spot_tex, GL_TEXTURE_BASE_LEVEL, 0);
-    glTextureParameteri(spot_tex, GL_TEXTURE_MAX_LEVEL, spot_levels - 1);
-    glTextureParameteri(spot_tex, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_BORDER);
-    glTextureParameteri(spot_tex, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_BORDER);
-    const float zero_border[4] = {0, 0, 0, 0};
-    glTextureParameterfv(spot_tex, GL_TEXTURE_BORDER_COLOR, zero_border);
   }
   GLuint spot_ssbo[2];
   glCreateBuffers(2, spot_ssbo);
@@ -294,7 +371,8 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing)
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, ssbo[1]);
 
   // Shadow-map array and its framebuffer.
-  int S = d.shadow_map_size, layers = std::max<int>(1, static_cast<int>(shadow_mats.size()));
+  // (A 1×1 placeholder when no light casts shadows: the sampler needs a texture.)
+  int S = shadow_mats.empty() ? 1 : d.shadow_map_size, layers = std::max<int>(1, static_cast<int>(shadow_mats.size()));
   GLuint shadow_tex, shadow_fbo;
   glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, &shadow_tex);
   glTextureStorage3D(shadow_tex, 1, GL_DEPTH_COMPONENT32F, S, S, layers);
@@ -317,24 +395,12 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing)
     glGetIntegerv(GL_MAX_3D_TEXTURE_SIZE, &max3d);
     if (g.nz * K > max3d)
       fail(ErrorKind::Unsupported, "SH grid needs a 3D texture {} deep; this GL allows {}", g.nz * K, max3d);
-    const size_t points = static_cast<size_t>(g.nx) * g.ny * g.nz;
-    std::vector<float> packed(points * K * 4, 0.0f);
-    for (size_t p = 0; p < points; ++p)
-      for (int k = 0; k < K; ++k)
-        for (int c = 0; c < 3; ++c) packed[(static_cast<size_t>(k) * points + p) * 4 + c] = g.data[(p * K + k) * 3 + c];
-    glCreateTextures(GL_TEXTURE_3D, 1, &grid_tex);
-    glTextureStorage3D(grid_tex, 1, GL_RGBA16F, g.nx, g.ny, g.nz * K);
-    glTextureSubImage3D(grid_tex, 0, 0, 0, 0, g.nx, g.ny, g.nz * K, GL_RGBA, GL_FLOAT, packed.data());
-    glTextureParameteri(grid_tex, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-    glTextureParameteri(grid_tex, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    for (GLenum w : {GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T, GL_TEXTURE_WRAP_R}) glTextureParameteri(grid_tex, w, GL_CLAMP_TO_EDGE);
+    grid_tex = impl_->grid_texture(g);
   }
 
   // Colour target (the forward pass renders into it; the deferred pass writes it as an image), and
   // the deferred G-buffer.
-  GLuint color_tex, depth_rb, fbo, vis_tex = 0, geom_ssbo[4] = {0, 0, 0, 0}, uv_ssbo = 0;
-  glCreateTextures(GL_TEXTURE_2D, 1, &color_tex);
-  glTextureStorage2D(color_tex, 1, GL_RGBA32F, W, H);
+  GLuint color_tex = impl_->color_texture(W, H), depth_rb, fbo, vis_tex = 0, geom_ssbo[4] = {0, 0, 0, 0}, uv_ssbo = 0;
   glCreateRenderbuffers(1, &depth_rb);
   glNamedRenderbufferStorage(depth_rb, GL_DEPTH_COMPONENT32F, W, H);
   glCreateFramebuffers(1, &fbo);
@@ -626,15 +692,19 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing)
     timing->wall_ms_per_frame = wall_ms / nframes;
   }
 
-  RenderResult out{Image(W, H, 3), Image(W, H, 1), unshadowed};
-  std::vector<float> rgba(static_cast<size_t>(W) * H * 4);
-  glGetTextureImage(color_tex, 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(rgba.size() * sizeof(float)), rgba.data());
-  for (int y = 0; y < H; ++y)
-    for (int x = 0; x < W; ++x) {
-      const float* p = rgba.data() + (static_cast<size_t>(H - 1 - y) * W + x) * 4;  // GL rows go up
-      out.color.set_rgb(x, y, {p[0], p[1], p[2]});
-      out.coverage.at(x, y, 0) = p[3];
-    }
+  RenderResult out{Image(), Image(), unshadowed};
+  if (read_back) {
+    out.color = Image(W, H, 3);
+    out.coverage = Image(W, H, 1);
+    std::vector<float> rgba(static_cast<size_t>(W) * H * 4);
+    glGetTextureImage(color_tex, 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(rgba.size() * sizeof(float)), rgba.data());
+    for (int y = 0; y < H; ++y)
+      for (int x = 0; x < W; ++x) {
+        const float* p = rgba.data() + (static_cast<size_t>(H - 1 - y) * W + x) * 4;  // GL rows go up
+        out.color.set_rgb(x, y, {p[0], p[1], p[2]});
+        out.coverage.at(x, y, 0) = p[3];
+      }
+  }
   GLenum err = glGetError();
   glDeleteQueries(nframes, queries.data());
   glDeleteFramebuffers(1, &fbo);
@@ -646,11 +716,8 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing)
     glDeleteBuffers(1, &uv_ssbo);
   }
   glDeleteBuffers(1, &material_ssbo);
-  glDeleteTextures(1, &color_tex);
   glDeleteTextures(1, &shadow_tex);
-  if (grid_tex) glDeleteTextures(1, &grid_tex);
   if (glossy_tex) glDeleteTextures(1, &glossy_tex);
-  if (spot_tex) glDeleteTextures(1, &spot_tex);
   if (albedo_tex) glDeleteTextures(1, &albedo_tex);
   if (spot_shadow_tex) glDeleteTextures(1, &spot_shadow_tex);
   glDeleteBuffers(2, spot_ssbo);

@@ -38,8 +38,12 @@ class Renderer {
   // Needs a current context (the Context must outlive the Renderer).
   explicit Renderer(const RendererDesc& desc = {});
   ~Renderer();
-  // Renders `frames` times (uploads once; frames > 1 for timing) and reads back the last frame.
-  RenderResult render(const FrameDesc& desc, int frames = 1, GpuTiming* timing = nullptr);
+  // Renders `frames` times (uploads once; frames > 1 for timing) and reads back the last frame —
+  // or, with read_back false, leaves it on the GPU in color_texture() (the result's images empty).
+  RenderResult render(const FrameDesc& desc, int frames = 1, GpuTiming* timing = nullptr, bool read_back = true);
+  // The last frame: an RGBA32F texture (rgb linear radiance, alpha coverage; GL's rows, bottom up),
+  // valid until the next render() or the renderer's end; 0 before the first frame.
+  unsigned color_texture() const;
 
   static constexpr int kMaxShadowMaps = 16;  // shadow-casting lights per pass
   static constexpr int kMaxShTableSize = 1024;  // 7 layers × 6 faces × 1024² × 16 B = 704 MB at 5 bands
