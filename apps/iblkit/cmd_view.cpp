@@ -19,6 +19,7 @@
 #include "iblkit/core/error.h"
 #include "iblkit/io/image_io.h"
 #include "iblkit/io/tonemap.h"
+#include "iblkit/render/gl/present.h"
 #include "iblkit/render/gl/renderer.h"
 
 namespace {
@@ -48,6 +49,7 @@ struct State {
   int lighting = 0;     // index into the loaded lightings
   bool glossy = true;
   double exposure = 0;  // stops added to the auto exposure
+  bool remeter = false;  // measure the auto exposure again on the next frame
   bool dragging = false;
   double last_x = 0, last_y = 0;
   double step = 0.05;   // metres per key press
@@ -108,6 +110,7 @@ void run(const ViewOpts& o, const ibl::io::EnvReadDesc& rd) {
       case GLFW_KEY_PAGE_UP: s.offset.y += s.step; break;
       case GLFW_KEY_PAGE_DOWN: s.offset.y -= s.step; break;
       case GLFW_KEY_G: s.glossy = !s.glossy; break;
+      case GLFW_KEY_E: s.remeter = true; break;
       case GLFW_KEY_EQUAL: case GLFW_KEY_KP_ADD: s.exposure += 0.5; break;
       case GLFW_KEY_MINUS: case GLFW_KEY_KP_SUBTRACT: s.exposure -= 0.5; break;
       case GLFW_KEY_TAB: ++s.lighting; break;
@@ -136,14 +139,10 @@ void run(const ViewOpts& o, const ibl::io::EnvReadDesc& rd) {
 
   auto renderer_ptr = std::make_unique<gl::Renderer>();  // released before the window's context goes
   gl::Renderer& renderer = *renderer_ptr;
-  GLuint tex = 0, fbo = 0;
-  glCreateTextures(GL_TEXTURE_2D, 1, &tex);
-  glCreateFramebuffers(1, &fbo);
-  int tex_w = 0, tex_h = 0;
-  std::vector<float> rgba;
+  auto present = std::make_unique<gl::Presenter>();
   Image last;
-  double ms_sum = 0;
-  int frame = 0;
+  double ms_sum = 0, meter = 1;
+  int frame = 0, metered_lighting = -1;
   std::string renderer_name = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
   while (!glfwWindowShouldClose(win) && (o.frames == 0 || frame < o.frames)) {
     if (o.frames > 0) st.orbit.azimuth = 2 * kPi * frame / o.frames;  // scripted: one turn
@@ -171,31 +170,17 @@ void run(const ViewOpts& o, const ibl::io::EnvReadDesc& rd) {
     d.lighting = lightings[li];
     gl::GpuTiming t;
     auto t0 = std::chrono::steady_clock::now();
-    RenderResult f = renderer.render(d, 1, &t);
-    io::ToneMapDesc td;
-    td.exposure_stops = st.exposure;
-    last = io::tonemap(f.color, td);
-    // Show it: upload (rows top-down), blit flipped to the window.
-    if (tex_w != fw || tex_h != fh) {
-      glDeleteTextures(1, &tex);
-      glCreateTextures(GL_TEXTURE_2D, 1, &tex);
-      glTextureStorage2D(tex, 1, GL_RGBA8, fw, fh);
-      glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, tex, 0);
-      tex_w = fw;
-      tex_h = fh;
+    // The frame stays on the GPU and is tone-mapped there; it is read back only to meter the auto
+    // exposure (median luminance, as `render` does) when the lighting changes or on key E.
+    const bool meter_now = li != metered_lighting || st.remeter;
+    RenderResult f = renderer.render(d, 1, &t, meter_now);
+    if (meter_now) {
+      meter = io::auto_exposure_scale(f.color);
+      metered_lighting = li;
+      st.remeter = false;
     }
-    rgba.resize(static_cast<size_t>(fw) * fh * 4);
-    for (size_t i = 0; i < last.pixel_count(); ++i) {
-      for (int c = 0; c < 3; ++c) {
-        float v = std::clamp(last.data()[i * 3 + c], 0.0f, 1.0f);
-        rgba[i * 4 + c] = v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1 / 2.4f) - 0.055f;  // sRGB
-      }
-      rgba[i * 4 + 3] = 1;
-    }
-    glTextureSubImage2D(tex, 0, 0, 0, fw, fh, GL_RGBA, GL_FLOAT, rgba.data());
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    glViewport(0, 0, fw, fh);
-    glBlitNamedFramebuffer(fbo, 0, 0, 0, fw, fh, 0, fh, fw, 0, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    present->draw(renderer.color_texture(), fw, fh, meter * std::exp2(st.exposure));
     if (!o.screenshot.empty() && o.frames > 0 && frame + 1 == o.frames) {
       // The screenshot reads the window's own back buffer: what the display path shows.
       std::vector<float> px(static_cast<size_t>(fw) * fh * 3);
@@ -220,8 +205,7 @@ void run(const ViewOpts& o, const ibl::io::EnvReadDesc& rd) {
                                         st.glossy ? ", glossy" : "").c_str());
     glfwPollEvents();
   }
-  glDeleteTextures(1, &tex);
-  glDeleteFramebuffers(1, &fbo);
+  present.reset();
   renderer_ptr.reset();
   glfwDestroyWindow(win);
   if (!o.screenshot.empty() && !last.empty()) io::write_image(o.screenshot, last);
@@ -254,7 +238,7 @@ void setup(CLI::App& app) {
   auto& rd = iblcli::add_probe_read_options(app);
   app.footer(
       "Keys: drag = orbit, scroll = zoom, arrows / PageUp / PageDown = move the object, 1-9 / Tab = lighting,\n"
-      "G = glossy on/off, + / - = exposure, Esc = quit. The title shows the frame time.\n"
+      "G = glossy on/off, + / - = exposure, E = meter the auto exposure again, Esc = quit. The title shows the frame time.\n"
       "Examples:\n  iblkit view blob --light grid.shgrid --at 0,1,0 --object-size 0.3\n"
       "  iblkit view blob --light probe.exr --light lights.json\n"
       "  xvfb-run -a iblkit view sphere --light probe.exr --frames 10 --screenshot view.png");

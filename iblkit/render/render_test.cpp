@@ -17,6 +17,7 @@
 #include <epoxy/gl.h>
 
 #include "iblkit/render/gl/context.h"
+#include "iblkit/render/gl/present.h"
 #include "iblkit/render/gl/program.h"
 #include "iblkit/render/gl/renderer.h"
 #include "iblkit/render/gl/sh_glsl.h"
@@ -532,6 +533,52 @@ TEST_F(RenderGl, KeptUploadsFollowChangedLighting) {
       worst = std::max(worst, length(Vec3{p[0], p[1], p[2]} - dimmer.color.rgb(x, y)));
     }
   EXPECT_EQ(worst, 0.0);
+}
+
+// The viewer's GPU tone mapping gives io::tonemap's picture (then sRGB-encoded, as a PNG stores it),
+// for each tone curve, with the frame never leaving the GPU.
+TEST_F(RenderGl, PresentMatchesCpuToneMapping) {
+  gl::Context ctx;
+  Mesh m = make_sphere(0.4, 32, 64);
+  FrameDesc d = sphere_scene(&m, 80, 60);
+  d.lighting.lights = {{normalize(Vec3{0.3, 1, 0.5}), {6, 5, 4}, false}};
+  d.objects[0].material.specular = {0.4, 0.4, 0.4};
+  d.objects[0].material.exponent = 40;  // a highlight far above 1: the curves' shoulders
+  d.background = {0.02, 0.03, 0.05};
+  gl::Renderer r;
+  RenderResult f = r.render(d);
+  const double scale = 1.7;
+  GLuint target, fbo;
+  glCreateTextures(GL_TEXTURE_2D, 1, &target);
+  glTextureStorage2D(target, 1, GL_RGBA32F, 80, 60);
+  glCreateFramebuffers(1, &fbo);
+  glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, target, 0);
+  gl::Presenter present;
+  auto srgb = [](double v) { return v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1 / 2.4) - 0.055; };
+  for (io::ToneCurve curve : {io::ToneCurve::Clamp, io::ToneCurve::Reinhard, io::ToneCurve::Aces}) {
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    present.draw(r.color_texture(), 80, 60, scale, curve);
+    std::vector<float> rgba(80 * 60 * 4);
+    glGetTextureImage(target, 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(rgba.size() * 4), rgba.data());
+    io::ToneMapDesc td;
+    td.auto_exposure = false;
+    td.exposure_stops = std::log2(scale);
+    td.curve = curve;
+    Image want = io::tonemap(f.color, td);
+    double worst = 0, brightest = 0;
+    for (int y = 0; y < 60; ++y)
+      for (int x = 0; x < 80; ++x)
+        for (int c = 0; c < 3; ++c) {
+          const double v = srgb(want.at(x, y, c));
+          brightest = std::max(brightest, v);
+          worst = std::max(worst, std::abs(rgba[(static_cast<size_t>(59 - y) * 80 + x) * 4 + c] - v));
+        }
+    EXPECT_LT(worst, 1e-4) << static_cast<int>(curve);  // float against double
+    EXPECT_GT(brightest, 0.9) << static_cast<int>(curve);
+  }
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  glDeleteFramebuffers(1, &fbo);
+  glDeleteTextures(1, &target);
 }
 
 // Albedo textures at the meshes' UVs and the Blinn-Phong lobe (lights exact; SH and maps through the
