@@ -183,6 +183,35 @@ Agreement compare(const RenderResult& a, const RenderResult& b) {
   return r;
 }
 
+// An SH grid of nx × ny × nz points over the box ±0.5, its values zero.
+SHGridData unit_box_grid(int bands, int nx, int ny, int nz) {
+  SHGridData g;
+  g.bands = bands;
+  g.nx = nx;
+  g.ny = ny;
+  g.nz = nz;
+  g.min = {-0.5, -0.5, -0.5};
+  g.max = {0.5, 0.5, 0.5};
+  g.data.assign(static_cast<size_t>(nx) * ny * nz * bands * bands * 3, 0.0f);
+  return g;
+}
+
+// A textured spotlight at `at` shining along `forward`, its texture over ±half on a plane 0.5 m
+// ahead, a filter support of 0.01 m² and the given width.
+nearfield::TexturedSpotlight square_spot(Vec3 at, Vec3 forward, double half, std::shared_ptr<const std::vector<Image>> mips,
+                                         double support_width) {
+  nearfield::TexturedSpotlight sp;
+  sp.position = at;
+  sp.frame = Frame::from_normal(normalize(forward));
+  sp.plane_distance = 0.5;
+  sp.tex_min = {-half, -half};
+  sp.tex_max = {half, half};
+  sp.mips = std::move(mips);
+  sp.support_area = 0.01;
+  sp.support_width = support_width;
+  return sp;
+}
+
 // Renders d on GL (forward and deferred) and holds each frame to the CPU reference `cpu`: at least
 // `min_pixels` covered in both, coverage mismatch under kCoverageTol, median and 99th-percentile
 // relative differences under the test's named tolerances. With IBLKIT_TEST_PICTURES=DIR set, writes
@@ -318,12 +347,7 @@ TEST_F(RenderGl, ShGridAgreesWithCpu) {
   gl::Context ctx;
   Mesh m = make_blob(6000, 0.5);
   FrameDesc d = sphere_scene(&m, 96, 72);
-  SHGridData g;
-  g.bands = 5;
-  g.nx = 4; g.ny = 5; g.nz = 3;
-  g.min = {-0.5, -0.5, -0.5};
-  g.max = {0.5, 0.5, 0.5};
-  g.data.resize(static_cast<size_t>(g.nx) * g.ny * g.nz * 25 * 3);
+  SHGridData g = unit_box_grid(5, 4, 5, 3);
   for (size_t i = 0; i < g.data.size(); ++i) g.data[i] = static_cast<float>((i % 75 < 3 ? 2.0 : 0.1) * (1 + 0.5 * std::sin(0.37 * i)));
   d.lighting.grid = g;
   d.objects[0].material.specular = {0.3, 0.3, 0.3};
@@ -430,16 +454,7 @@ TEST_F(RenderGl, LayeredShadowPassEqualsPassPerLight) {
     for (int x = 0; x < 8; ++x) tex.set_rgb(x, y, {50.0 + x, 40.0 + y, 30.0});
   auto mips = std::make_shared<const std::vector<Image>>(nearfield::build_mips(tex));
   for (int i = 0; i < 4; ++i) {
-    nearfield::TexturedSpotlight sp;
-    sp.position = {-0.4 + 0.25 * i, 1.2, 0.3};
-    sp.frame = Frame::from_normal(normalize(Vec3{0.1, -1, -0.2}));
-    sp.plane_distance = 0.5;
-    sp.tex_min = {-0.4, -0.4};
-    sp.tex_max = {0.4, 0.4};
-    sp.mips = mips;
-    sp.support_area = 0.01;
-    sp.support_width = 0.1;
-    d.lighting.spotlights.push_back(sp);
+    d.lighting.spotlights.push_back(square_spot({-0.4 + 0.25 * i, 1.2, 0.3}, {0.1, -1, -0.2}, 0.4, mips, 0.1));
   }
   d.shadow_map_size = 512;
   d.spot_shadow_map_size = 256;
@@ -480,12 +495,8 @@ TEST_F(RenderGl, KeptUploadsFollowChangedLighting) {
   gl::Context ctx;
   Mesh blob = make_blob(3000, 0.5);
   FrameDesc d = sphere_scene(&blob, 64, 48);
-  SHGridData g;
-  g.bands = 3;
-  g.nx = g.ny = g.nz = 3;
-  g.min = {-0.5, -0.5, -0.5};
-  g.max = {0.5, 0.5, 0.5};
-  g.data.assign(27 * 9 * 3, 0.1f);
+  SHGridData g = unit_box_grid(3, 3, 3, 3);
+  std::fill(g.data.begin(), g.data.end(), 0.1f);
   for (size_t p = 0; p < 27; ++p) g.data[p * 27] = g.data[p * 27 + 1] = g.data[p * 27 + 2] = 1.0f;
   d.lighting.grid = g;
   gl::Renderer kept;
@@ -505,16 +516,7 @@ TEST_F(RenderGl, KeptUploadsFollowChangedLighting) {
   Image tex(8, 8, 3);
   for (size_t i = 0; i < tex.size(); ++i) tex.data()[i] = 20.0f;
   auto mips = std::make_shared<const std::vector<Image>>(nearfield::build_mips(tex));
-  nearfield::TexturedSpotlight sp;
-  sp.position = {0.2, 1.2, 0.8};
-  sp.frame = Frame::from_normal(normalize(Vec3{-0.2, -1, -0.6}));
-  sp.plane_distance = 0.5;
-  sp.tex_min = {-0.5, -0.5};
-  sp.tex_max = {0.5, 0.5};
-  sp.mips = mips;
-  sp.support_area = 0.01;
-  sp.support_width = 0.05;
-  d.lighting.spotlights = {sp};
+  d.lighting.spotlights = {square_spot({0.2, 1.2, 0.8}, {-0.2, -1, -0.6}, 0.5, mips, 0.05)};
   RenderResult lit = kept.render(d);
   EXPECT_EQ(same(lit, kept.render(d)), 0.0);
   for (size_t i = 0; i < tex.size(); ++i) tex.data()[i] = 5.0f;

@@ -9,6 +9,7 @@
 #include "iblkit/core/vec.h"
 #include "iblkit/render/gl/program.h"
 #include "iblkit/sh/basis.h"
+#include "iblkit/sphere/mapping.h"
 
 namespace ibl::render::gl {
 
@@ -66,20 +67,6 @@ std::string sh_table_glsl_source(int bands) {
 
 float sh_table_warp(int size) { return static_cast<float>(size - 1) / static_cast<float>(size); }
 
-namespace {
-// Direction through face coordinates (sc, tc) ∈ [−1, 1]² of cube face f (GL's table 8.19 inverted).
-Vec3 cube_direction(int face, double sc, double tc) {
-  switch (face) {
-    case 0: return {1, -tc, -sc};
-    case 1: return {-1, -tc, sc};
-    case 2: return {sc, 1, tc};
-    case 3: return {sc, -1, -tc};
-    case 4: return {sc, -tc, 1};
-    default: return {-sc, -tc, -1};
-  }
-}
-}  // namespace
-
 std::vector<float> sh_table_texels(int bands, int size) {
   if (bands < 1 || bands > 10) fail(ErrorKind::Value, "SH table supports 1..10 bands (got {})", bands);
   if (size < 2 || size > 4096) fail(ErrorKind::Value, "SH table face size {} is out of range 2..4096", size);
@@ -91,7 +78,7 @@ std::vector<float> sh_table_texels(int bands, int size) {
       for (int s = 0; s < size; ++s) {
         // Texel centres from edge to edge: face coordinate (2i + 1 − size)/(size − 1) ∈ [−1, 1].
         const double sc = (2.0 * s + 1 - size) / (size - 1), tc = (2.0 * t + 1 - size) / (size - 1);
-        sh::eval_basis(bands, normalize(cube_direction(f, sc, tc)), Y.data());
+        sh::eval_basis(bands, normalize(sphere::cube_face_point(f, sc, tc)), Y.data());  // GL's face order and axes
         for (int k = 0; k < K; ++k) {
           const size_t layer_face = static_cast<size_t>(k / 4) * 6 + f;
           out[((layer_face * size + t) * size + s) * 4 + k % 4] = static_cast<float>(Y[k]);
