@@ -205,6 +205,13 @@ int main(int argc, char** argv) {
         d.camera.eye = {1.5, 1.7, 3.2};
         d.camera.target = {-0.8, 0.6, -1.2};
         run("nearfield_9x7_crypt");
+        // What the shadows cost: smaller maps, and none.
+        d.spot_shadow_map_size = 256;
+        run("nearfield_9x7_crypt_shadow256");
+        d.spot_shadow_map_size = 512;
+        for (auto& sp : d.lighting.spotlights) sp.shadow = false;
+        run("nearfield_9x7_crypt_no_shadows");
+        for (auto& sp : d.lighting.spotlights) sp.shadow = true;
         if (deferred) {
           gl::Renderer per_pass({.deferred = deferred, .layered_shadows = false});
           gl::GpuTiming t;

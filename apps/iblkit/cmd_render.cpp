@@ -40,7 +40,7 @@ void setup(CLI::App& app) {
     std::string scene = "blob", out = "frame.png", backend = "auto", size = "1024x768", eye = "0,0.5,1.6",
                 target = "0,0,0", at = "0,0,0";
     double object_size = 0.8;
-    int frames = 1, bands = 5, triangles = 100000, shadows = 4, sh_table = 0;
+    int frames = 1, bands = 5, triangles = 100000, shadows = 4, sh_table = 0, shadow_map = 2048, spot_shadow_map = 512;
     double gloss = 0, exponent = 20;
     std::string glossy = "map";
     std::string truth;
@@ -69,6 +69,13 @@ void setup(CLI::App& app) {
   app.add_option("--frames", o->frames, "GL: render this many frames and report the median GPU time")->check(CLI::Range(1, 10000));
   app.add_option("--shadows", o->shadows, "lights (in the file's priority order) that cast shadows")
       ->check(CLI::Range(0, 16))
+      ->capture_default_str();
+  app.add_option("--shadow-map", o->shadow_map, "GL: shadow map size of each directional or point light (cube faces too)")
+      ->check(CLI::Range(16, 8192))
+      ->capture_default_str();
+  app.add_option("--spot-shadow-map", o->spot_shadow_map,
+                 "GL: shadow map size of each textured spotlight (a 9×7 dataset draws 63 of them a frame)")
+      ->check(CLI::Range(16, 8192))
       ->capture_default_str();
   app.add_option("--bands", o->bands, "SH bands when projecting a probe")->check(CLI::Range(1, 9))->capture_default_str();
   app.add_option("--triangles", o->triangles, "triangles of the blob")->check(CLI::Range(100, 5000000))->capture_default_str();
@@ -118,6 +125,8 @@ void setup(CLI::App& app) {
     FrameDesc d;
     d.camera.width = w;
     d.camera.height = h;
+    d.shadow_map_size = o->shadow_map;
+    d.spot_shadow_map_size = o->spot_shadow_map;
     d.camera.eye = iblcli::parse_vec3(o->eye, "--eye");
     d.camera.target = iblcli::parse_vec3(o->target, "--target");
     d.camera.fov_y_deg = o->fov;
