@@ -141,8 +141,22 @@ void run(const ViewOpts& o, const ibl::io::EnvReadDesc& rd) {
   gl::Renderer& renderer = *renderer_ptr;
   auto present = std::make_unique<gl::Presenter>();
   Image last;
-  double ms_sum = 0, meter = 1;
-  int frame = 0, metered_lighting = -1;
+  double ms_sum = 0, meter = 1, shown_scale = 1;
+  int frame = 0, metered_lighting = -1, shown_w = 0, shown_h = 0;
+  // The window's back buffer, read back and turned into linear radiance (what the display shows).
+  auto capture = [](int fw, int fh) {
+    std::vector<float> px(static_cast<size_t>(fw) * fh * 3);
+    glReadBuffer(GL_BACK);
+    glReadnPixels(0, 0, fw, fh, GL_RGB, GL_FLOAT, static_cast<GLsizei>(px.size() * sizeof(float)), px.data());
+    Image shot(fw, fh, 3);
+    for (int y = 0; y < fh; ++y)
+      for (int x = 0; x < fw; ++x)
+        for (int c = 0; c < 3; ++c) {
+          float v = px[(static_cast<size_t>(fh - 1 - y) * fw + x) * 3 + c];  // GL rows go up
+          shot.at(x, y, c) = v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);  // back to linear
+        }
+    return shot;
+  };
   std::string renderer_name = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
   while (!glfwWindowShouldClose(win) && (o.frames == 0 || frame < o.frames)) {
     if (o.frames > 0) st.orbit.azimuth = 2 * kPi * frame / o.frames;  // scripted: one turn
@@ -168,34 +182,32 @@ void run(const ViewOpts& o, const ibl::io::EnvReadDesc& rd) {
     floor.transform(1.0, {at.x + st.offset.x, 0, at.z + st.offset.z});
     Material mat{{0.75, 0.75, 0.75}, Vec3{1, 1, 1} * (st.glossy ? std::max(o.gloss, 0.15) : 0.0), o.exponent};
     d.objects = {{&object, mat}, {&floor, Material{{0.5, 0.5, 0.5}, {0, 0, 0}, 1}}};
-    d.lighting = lightings[li];
+    d.lighting = std::move(lightings[li]);  // lent to the frame, not copied (an SH grid is megabytes)
     gl::GpuTiming t;
     auto t0 = std::chrono::steady_clock::now();
     // The frame stays on the GPU and is tone-mapped there; it is read back only to meter the auto
     // exposure (median luminance, as `render` does) when the lighting changes or on key E.
     const bool meter_now = li != metered_lighting || st.remeter;
-    RenderResult f = renderer.render(d, 1, &t, meter_now);
+    RenderResult f;
+    try {
+      f = renderer.render(d, 1, &t, meter_now);
+    } catch (...) {
+      lightings[li] = std::move(d.lighting);
+      throw;
+    }
+    lightings[li] = std::move(d.lighting);
     if (meter_now) {
       meter = io::auto_exposure_scale(f.color);
       metered_lighting = li;
       st.remeter = false;
     }
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    present->draw(renderer.color_texture(), fw, fh, meter * std::exp2(st.exposure));
-    if (!o.screenshot.empty() && o.frames > 0 && frame + 1 == o.frames) {
-      // The screenshot reads the window's own back buffer: what the display path shows.
-      std::vector<float> px(static_cast<size_t>(fw) * fh * 3);
-      glReadBuffer(GL_BACK);
-      glReadnPixels(0, 0, fw, fh, GL_RGB, GL_FLOAT, static_cast<GLsizei>(px.size() * sizeof(float)), px.data());
-      Image shot(fw, fh, 3);
-      for (int y = 0; y < fh; ++y)
-        for (int x = 0; x < fw; ++x)
-          for (int c = 0; c < 3; ++c) {
-            float v = px[(static_cast<size_t>(fh - 1 - y) * fw + x) * 3 + c];  // GL rows go up
-            shot.at(x, y, c) = v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);  // back to linear
-          }
-      last = std::move(shot);
-    }
+    shown_w = fw;
+    shown_h = fh;
+    shown_scale = meter * std::exp2(st.exposure);
+    present->draw(renderer.color_texture(), fw, fh, shown_scale);
+    // The screenshot reads the window's own back buffer: what the display path shows.
+    if (!o.screenshot.empty() && o.frames > 0 && frame + 1 == o.frames) last = capture(fw, fh);
     glfwSwapBuffers(win);
     double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     ms_sum += ms;
@@ -205,6 +217,12 @@ void run(const ViewOpts& o, const ibl::io::EnvReadDesc& rd) {
                                         software ? "wall" : "GPU", software ? ms : t.frame_ms[0], kinds[li],
                                         st.glossy ? ", glossy" : "").c_str());
     glfwPollEvents();
+  }
+  if (!o.screenshot.empty() && last.empty() && frame > 0) {
+    // Interactive: the last frame shown, drawn once more (the back buffer is undefined after a swap).
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    present->draw(renderer.color_texture(), shown_w, shown_h, shown_scale);
+    last = capture(shown_w, shown_h);
   }
   present.reset();
   renderer_ptr.reset();

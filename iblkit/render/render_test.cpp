@@ -519,7 +519,8 @@ TEST_F(RenderGl, KeptUploadsFollowChangedLighting) {
   d.lighting.spotlights = {square_spot({0.2, 1.2, 0.8}, {-0.2, -1, -0.6}, 0.5, mips, 0.05)};
   RenderResult lit = kept.render(d);
   EXPECT_EQ(same(lit, kept.render(d)), 0.0);
-  for (size_t i = 0; i < tex.size(); ++i) tex.data()[i] = 5.0f;
+  for (int y = 0; y < 8; ++y)  // a pattern, not only a level: each layer is stored divided by its peak
+    for (int x = 0; x < 8; ++x) tex.set_rgb(x, y, Vec3{5.0, 4.0, 3.0} * (1 + (x + y) % 3));
   d.lighting.spotlights[0].mips = std::make_shared<const std::vector<Image>>(nearfield::build_mips(tex));
   RenderResult dimmer = kept.render(d);
   EXPECT_EQ(same(dimmer, gl::Renderer().render(d)), 0.0);
@@ -535,6 +536,14 @@ TEST_F(RenderGl, KeptUploadsFollowChangedLighting) {
       worst = std::max(worst, length(Vec3{p[0], p[1], p[2]} - dimmer.color.rgb(x, y)));
     }
   EXPECT_EQ(worst, 0.0);
+  // Two spotlights, then their textures swapped (the same images, in the other layers).
+  d.lighting.spotlights = {square_spot({0.2, 1.2, 0.8}, {-0.2, -1, -0.6}, 0.5, mips, 0.05),
+                           square_spot({-0.3, 1.2, 0.6}, {0.2, -1, -0.5}, 0.5, d.lighting.spotlights[0].mips, 0.05)};
+  RenderResult before = kept.render(d);
+  std::swap(d.lighting.spotlights[0].mips, d.lighting.spotlights[1].mips);
+  RenderResult swapped = kept.render(d);
+  EXPECT_GT(same(before, swapped), 1e-3);
+  EXPECT_EQ(same(swapped, gl::Renderer().render(d)), 0.0);
 }
 
 // The viewer's GPU tone mapping gives io::tonemap's picture (then sRGB-encoded, as a PNG stores it),

@@ -31,6 +31,7 @@ void Presenter::draw(unsigned texture, int width, int height, double scale, io::
   glDisable(GL_BLEND);
   glBindVertexArray(vao_);
   glDrawArrays(GL_TRIANGLES, 0, 3);
+  glBindTextureUnit(0, 0);  // the frame is the renderer's target again next frame
 }
 
 }  // namespace ibl::render::gl

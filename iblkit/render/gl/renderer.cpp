@@ -91,6 +91,8 @@ struct Renderer::Impl {
         g.data == grid_key.data)
       return grid_tex;
     if (grid_tex) glDeleteTextures(1, &grid_tex);
+    grid_tex = 0;  // (nothing stale is left if what follows throws)
+    grid_key = {};
     const int K = g.bands * g.bands;
     const size_t points = static_cast<size_t>(g.nx) * g.ny * g.nz;
     std::vector<float> packed(points * K * 4, 0.0f);
@@ -372,6 +374,8 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing,
 
   // Shadow-map array and its framebuffer.
   // (A 1×1 placeholder when no light casts shadows: the sampler needs a texture.)
+  if (!shadow_mats.empty() && (d.shadow_map_size < 16 || d.shadow_map_size > 8192))
+    fail(ErrorKind::Value, "shadow map size {} is out of range 16..8192", d.shadow_map_size);
   int S = shadow_mats.empty() ? 1 : d.shadow_map_size, layers = std::max<int>(1, static_cast<int>(shadow_mats.size()));
   GLuint shadow_tex, shadow_fbo;
   glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, &shadow_tex);
