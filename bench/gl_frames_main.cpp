@@ -209,6 +209,11 @@ int main(int argc, char** argv) {
         d.spot_shadow_map_size = 256;
         run("nearfield_9x7_crypt_shadow256");
         d.spot_shadow_map_size = 512;
+        d.spot_shadow_share = 0.011;  // 13 maps for the 63 terms 5 mm apart
+        run("nearfield_9x7_crypt_share11mm");
+        d.spot_shadow_share = 0.021;  // 4 maps
+        run("nearfield_9x7_crypt_share21mm");
+        d.spot_shadow_share = 0;
         for (auto& sp : d.lighting.spotlights) sp.shadow = false;
         run("nearfield_9x7_crypt_no_shadows");
         for (auto& sp : d.lighting.spotlights) sp.shadow = true;

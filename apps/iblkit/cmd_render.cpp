@@ -48,7 +48,7 @@ void setup(CLI::App& app) {
     double floor_size = 6;
     std::string luminaire = "0,1,0", luminaire_dir = "0,0,1";
     std::string texture, lobe = "phong", albedo = "0.75,0.75,0.75";
-    double exposure = 0, fov = 40;
+    double exposure = 0, fov = 40, spot_shadow_share = 0;
   };
   auto* o = new Opts();
   app.add_option("scene", o->scene,
@@ -76,6 +76,10 @@ void setup(CLI::App& app) {
   app.add_option("--spot-shadow-map", o->spot_shadow_map,
                  "GL: shadow map size of each textured spotlight (a 9×7 dataset draws 63 of them a frame)")
       ->check(CLI::Range(16, 8192))
+      ->capture_default_str();
+  app.add_option("--spot-shadow-share", o->spot_shadow_share,
+                 "GL: textured spotlights within this many metres of each other share one shadow map (0: one each)")
+      ->check(CLI::Range(0.0, 100.0))
       ->capture_default_str();
   app.add_option("--bands", o->bands, "SH bands when projecting a probe")->check(CLI::Range(1, 9))->capture_default_str();
   app.add_option("--triangles", o->triangles, "triangles of the blob")->check(CLI::Range(100, 5000000))->capture_default_str();
@@ -127,6 +131,7 @@ void setup(CLI::App& app) {
     d.camera.height = h;
     d.shadow_map_size = o->shadow_map;
     d.spot_shadow_map_size = o->spot_shadow_map;
+    d.spot_shadow_share = o->spot_shadow_share;
     d.camera.eye = iblcli::parse_vec3(o->eye, "--eye");
     d.camera.target = iblcli::parse_vec3(o->target, "--target");
     d.camera.fov_y_deg = o->fov;

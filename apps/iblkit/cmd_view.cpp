@@ -32,6 +32,7 @@ struct ViewOpts {
   std::vector<std::string> lights;
   double object_size = 0.8, gloss = 0.15, exponent = 20, exposure = 0, floor_size = 6;
   int triangles = 100000, bands = 5, shadows = 4, frames = 0, spot_shadow_map = 512;
+  double spot_shadow_share = 0;
 };
 
 // Orbit camera around a target: azimuth, elevation (radians) and distance.
@@ -171,6 +172,7 @@ void run(const ViewOpts& o, const ibl::io::EnvReadDesc& rd) {
     d.camera.width = fw;
     d.camera.height = fh;
     d.spot_shadow_map_size = o.spot_shadow_map;
+    d.spot_shadow_share = o.spot_shadow_share;
     d.camera.target = at + st.offset;
     st.orbit.target = d.camera.target;
     d.camera.eye = st.orbit.eye();
@@ -256,6 +258,10 @@ void setup(CLI::App& app) {
   app.add_option("--screenshot", o->screenshot, "write the last frame here on exit (.png)");
   app.add_option("--spot-shadow-map", o->spot_shadow_map, "shadow map size of each textured spotlight of a near-field dataset")
       ->check(CLI::Range(16, 8192))
+      ->capture_default_str();
+  app.add_option("--spot-shadow-share", o->spot_shadow_share,
+                 "textured spotlights within this many metres of each other share one shadow map (0: one each)")
+      ->check(CLI::Range(0.0, 100.0))
       ->capture_default_str();
   auto& rd = iblcli::add_probe_read_options(app);
   app.footer(

@@ -20,6 +20,9 @@ struct FrameDesc {
   int shadow_map_size = 2048;  // GPU only: shadow map resolution
   int spot_shadow_map_size = 512;   // GPU only: shadow map resolution of each textured spotlight (63 of
                                     // them for a 9×7 luminaire: 16 M depth texels a frame at 512²)
+  double spot_shadow_share = 0;  // GPU only, metres: textured spotlights shining the same way within
+                                 // this distance of a group's first member share one shadow map,
+                                 // from the group's mean position (0: a map each)
   double shadow_bias = 2e-3;   // offset along the normal before shadow tests, metres
 };
 

@@ -436,6 +436,10 @@ TEST_F(RenderGl, TexturedSpotlightsWithShadowsAgreeWithCpu) {
   constexpr double kSpotMedianTol = 2e-3;  // float math and GL's 8-bit filter weights (bilinear and between mips)
   constexpr double kSpotP99Tol = 0.5;      // shadow-map edges against exact shadow rays
   expect_gl_agrees(d, cpu, {kSpotMedianTol, kSpotP99Tol, 4000}, "spotlights");
+  // The nine sharing shadow maps (those within 8 cm of a group's first: 4 maps): still the same
+  // picture away from shadow edges.
+  d.spot_shadow_share = 0.08;
+  expect_gl_agrees(d, cpu, {kSpotMedianTol, kSpotP99Tol, 4000}, "spotlights_shared_maps");
 }
 
 // One instanced draw into all layers of a shadow-map array gives the maps that one pass per light

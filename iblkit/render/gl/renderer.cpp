@@ -308,25 +308,56 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing,
     spot_levels = st.levels;
     spot_scale = &st.scale;
     const int tw = (*L.spotlights[0].mips)[0].width(), th = (*L.spotlights[0].mips)[0].height();
+    // Shadow maps shared by spotlights that shine the same way from within spot_shadow_share of a
+    // group's first member (a near-field dataset's terms lie millimetres apart): one map per group,
+    // from the group's mean position.
+    std::vector<int> group_of(L.spotlights.size(), -1), group_seed;
+    std::vector<Vec3> group_sum;
+    std::vector<int> group_count;
+    for (size_t i = 0; i < L.spotlights.size(); ++i) {
+      const auto& sp = L.spotlights[i];
+      if (!sp.shadow) continue;
+      for (size_t g = 0; g < group_seed.size() && group_of[i] < 0; ++g) {
+        const auto& seed = L.spotlights[group_seed[g]];
+        if (d.spot_shadow_share > 0 && dot(seed.frame.n, sp.frame.n) > 0.99999 && length(seed.position - sp.position) <= d.spot_shadow_share)
+          group_of[i] = static_cast<int>(g);
+      }
+      if (group_of[i] < 0) {
+        group_of[i] = static_cast<int>(group_seed.size());
+        group_seed.push_back(static_cast<int>(i));
+        group_sum.push_back({0, 0, 0});
+        group_count.push_back(0);
+      }
+      group_sum[group_of[i]] = group_sum[group_of[i]] + sp.position;
+      ++group_count[group_of[i]];
+    }
+    std::vector<float> group_layer(group_seed.size(), -1.0f);
     for (size_t i = 0; i < L.spotlights.size(); ++i) {
       const auto& sp = L.spotlights[i];
       float layer = -1;
-      if (sp.shadow) {
-        // Perspective frustum along forward through the texture's extent (a texel of margin).
-        const double d = sp.plane_distance, margin = std::max((sp.tex_max.x - sp.tex_min.x) / tw, (sp.tex_max.y - sp.tex_min.y) / th);
-        const double tx = (std::max(std::abs(sp.tex_min.x), std::abs(sp.tex_max.x)) + margin) / d;
-        const double ty = (std::max(std::abs(sp.tex_min.y), std::abs(sp.tex_max.y)) + margin) / d;
+      if (sp.shadow && group_layer[group_of[i]] >= 0) {
+        layer = group_layer[group_of[i]];
+      } else if (sp.shadow) {
+        // Perspective frustum along forward through the texture's extent (a texel of margin), from
+        // the group's mean position (the spotlight's own when it has the map to itself), widened by
+        // the group's spread.
+        const Vec3 eye = group_sum[group_of[i]] * (1.0 / group_count[group_of[i]]);
+        const double spread = group_count[group_of[i]] > 1 ? d.spot_shadow_share : 0.0;
+        const double pd = sp.plane_distance, margin = std::max((sp.tex_max.x - sp.tex_min.x) / tw, (sp.tex_max.y - sp.tex_min.y) / th) + spread;
+        const double tx = (std::max(std::abs(sp.tex_min.x), std::abs(sp.tex_max.x)) + margin) / pd;
+        const double ty = (std::max(std::abs(sp.tex_min.y), std::abs(sp.tex_max.y)) + margin) / pd;
         Camera c;
-        c.eye = sp.position;
-        c.target = sp.position + sp.frame.n;
+        c.eye = eye;
+        c.target = eye + sp.frame.n;
         c.up = sp.frame.b;
         c.fov_y_deg = 2 * std::atan(ty) * 180 / kPi;
         c.width = 1000;
         c.height = std::max(1, static_cast<int>(std::lround(1000 * ty / tx)));
-        const double far_d = length(centre - sp.position) + radius;
+        const double far_d = length(centre - eye) + radius;
         c.zfar = far_d * 1.01;
-        c.znear = std::max(far_d * 1e-3, (length(centre - sp.position) - radius) * 0.95);
+        c.znear = std::max(far_d * 1e-3, (length(centre - eye) - radius) * 0.95);
         layer = static_cast<float>(spot_mats.size());
+        group_layer[group_of[i]] = layer;
         Mat4f proj = c.projection();
         proj[0] = static_cast<float>(1.0 / tx);  // exact horizontal extent (the aspect above is rounded)
         spot_mats.push_back(mul(proj, c.view()));
