@@ -491,10 +491,10 @@ TEST_F(RenderGl, LayeredShadowPassEqualsPassPerLight) {
   }
 }
 
-// A renderer keeps its uploads between frames (the SH grid's texture while its values stay, the
-// spotlight textures while they are the same shared images, the colour target while its size
-// stays): a changed grid or new textures must show in the next frame exactly as on a fresh
-// renderer, and a frame left on the GPU is the frame that would have been read back.
+// A renderer keeps its uploads between frames (meshes and the SH grid's texture while their values
+// stay, the spotlight textures while they are the same shared images, the colour target while its
+// size stays): a moved mesh, a changed grid or new textures must show in the next frame exactly as
+// on a fresh renderer, and a frame left on the GPU is the frame that would have been read back.
 TEST_F(RenderGl, KeptUploadsFollowChangedLighting) {
   gl::Context ctx;
   Mesh blob = make_blob(3000, 0.5);
@@ -515,6 +515,18 @@ TEST_F(RenderGl, KeptUploadsFollowChangedLighting) {
   RenderResult changed = kept.render(d);
   EXPECT_GT(same(first, changed), 1e-3);
   EXPECT_EQ(same(changed, gl::Renderer().render(d)), 0.0);
+  // The same mesh object moved in place (its vertices rewritten, as the viewer does).
+  blob.transform(1.0, {0.05, 0.02, 0});
+  for (bool deferred : {true, false}) {
+    gl::Renderer kept_path({.deferred = deferred});
+    RenderResult before_move = kept_path.render(d);
+    blob.transform(1.0, {-0.05, -0.02, 0});
+    RenderResult moved = kept_path.render(d);
+    EXPECT_GT(same(before_move, moved), 1e-3) << "deferred " << deferred;
+    EXPECT_EQ(same(moved, gl::Renderer({.deferred = deferred}).render(d)), 0.0) << "deferred " << deferred;
+    blob.transform(1.0, {0.05, 0.02, 0});
+  }
+  blob.transform(1.0, {-0.05, -0.02, 0});
   // Spotlights: the same textures again, then new ones.
   d.lighting = {};
   Image tex(8, 8, 3);

@@ -82,6 +82,58 @@ struct Renderer::Impl {
     return color_tex;
   }
 
+  // The objects' vertex buffers (and, for the deferred path, all objects' geometry in storage
+  // buffers), kept while the next frame's meshes hold the same values (compared in full against
+  // copies: a few MB for 10⁵ triangles, far cheaper than uploading them again).
+  struct Geometry {
+    std::vector<Mesh> keys;
+    std::vector<MeshBuffers> meshes;
+    GLuint ssbo[5] = {0, 0, 0, 0, 0};  // object table, positions, normals, indices, uvs
+    void release() {
+      for (auto& m : meshes) gl::release(m);
+      if (ssbo[0]) glDeleteBuffers(5, ssbo);
+      *this = {};
+    }
+  } geometry;
+  const Geometry& geometry_for(const std::vector<RenderObject>& objects, bool deferred) {
+    bool same = geometry.keys.size() == objects.size();
+    for (size_t i = 0; same && i < objects.size(); ++i) {
+      const Mesh& a = *objects[i].mesh;
+      const Mesh& b = geometry.keys[i];
+      same = a.positions == b.positions && a.normals == b.normals && a.uvs == b.uvs && a.indices == b.indices;
+    }
+    if (!same) {
+      geometry.release();
+      for (const auto& o : objects) {
+        geometry.meshes.push_back(upload(*o.mesh));
+        geometry.keys.push_back(*o.mesh);
+      }
+    }
+    if (deferred && !geometry.ssbo[0]) {
+      // Geometry for the compute pass: all objects' vertices and indices, and where each starts.
+      if (objects.size() > 255) fail(ErrorKind::Value, "the deferred path draws at most 255 objects ({} given)", objects.size());
+      std::vector<uint32_t> object_table;
+      std::vector<float> pos, nrm, uvs;
+      std::vector<uint32_t> idx;
+      for (const auto& o : objects) {
+        if (o.mesh->triangle_count() >= (1u << 24)) fail(ErrorKind::Value, "a mesh of {} triangles is over the deferred path's 2^24", o.mesh->triangle_count());
+        object_table.insert(object_table.end(), {static_cast<uint32_t>(pos.size() / 3), static_cast<uint32_t>(idx.size()), 0u, 0u});
+        pos.insert(pos.end(), o.mesh->positions.begin(), o.mesh->positions.end());
+        nrm.insert(nrm.end(), o.mesh->normals.begin(), o.mesh->normals.end());
+        const std::vector<float> uv = gpu_uvs(*o.mesh);
+        uvs.insert(uvs.end(), uv.begin(), uv.end());
+        idx.insert(idx.end(), o.mesh->indices.begin(), o.mesh->indices.end());
+      }
+      glCreateBuffers(5, geometry.ssbo);
+      glNamedBufferStorage(geometry.ssbo[0], static_cast<GLsizeiptr>(std::max<size_t>(4, object_table.size()) * 4), object_table.data(), 0);
+      glNamedBufferStorage(geometry.ssbo[1], static_cast<GLsizeiptr>(std::max<size_t>(1, pos.size()) * 4), pos.data(), 0);
+      glNamedBufferStorage(geometry.ssbo[2], static_cast<GLsizeiptr>(std::max<size_t>(1, nrm.size()) * 4), nrm.data(), 0);
+      glNamedBufferStorage(geometry.ssbo[3], static_cast<GLsizeiptr>(std::max<size_t>(1, idx.size()) * 4), idx.data(), 0);
+      glNamedBufferStorage(geometry.ssbo[4], static_cast<GLsizeiptr>(std::max<size_t>(1, uvs.size()) * 4), uvs.data(), 0);
+    }
+    return geometry;
+  }
+
   // The SH grid's texture, kept while the next frame's grid holds the same values (compared in
   // full: a memcmp costs a tenth of packing and uploading them again).
   GLuint grid_tex = 0;
@@ -203,6 +255,7 @@ struct Renderer::Impl {
     if (color_tex) glDeleteTextures(1, &color_tex);
     if (spots.tex) glDeleteTextures(1, &spots.tex);
     if (grid_tex) glDeleteTextures(1, &grid_tex);
+    geometry.release();
   }
 };
 
@@ -236,13 +289,13 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing,
 
   // Scene bounds for the shadow maps' orthographic frusta.
   Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
-  std::vector<MeshBuffers> meshes;
   for (const auto& o : d.objects) {
     Vec3 a, b;
     o.mesh->bounds(&a, &b);
     for (int k = 0; k < 3; ++k) { lo[k] = std::min(lo[k], a[k]); hi[k] = std::max(hi[k], b[k]); }
-    meshes.push_back(upload(*o.mesh));
   }
+  const Impl::Geometry& geometry = impl_->geometry_for(d.objects, deferred);
+  const std::vector<MeshBuffers>& meshes = geometry.meshes;
   Vec3 centre = (lo + hi) * 0.5;
   double radius = std::max(1e-6, 0.5 * length(hi - lo));
 
@@ -435,7 +488,7 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing,
 
   // Colour target (the forward pass renders into it; the deferred pass writes it as an image), and
   // the deferred G-buffer.
-  GLuint color_tex = impl_->color_texture(W, H), depth_rb, fbo, vis_tex = 0, geom_ssbo[4] = {0, 0, 0, 0}, uv_ssbo = 0;
+  GLuint color_tex = impl_->color_texture(W, H), depth_rb, fbo, vis_tex = 0;
   glCreateRenderbuffers(1, &depth_rb);
   glNamedRenderbufferStorage(depth_rb, GL_DEPTH_COMPONENT32F, W, H);
   glCreateFramebuffers(1, &fbo);
@@ -445,29 +498,8 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing,
     glTextureParameteri(vis_tex, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     glTextureParameteri(vis_tex, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
     glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, vis_tex, 0);
-    // Geometry for the compute pass: all objects' vertices and indices, and where each starts.
-    std::vector<uint32_t> object_table;
-    std::vector<float> pos, nrm, uvs;
-    std::vector<uint32_t> idx;
-    for (const auto& o : d.objects) {
-      if (o.mesh->triangle_count() >= (1u << 24)) fail(ErrorKind::Value, "a mesh of {} triangles is over the deferred path's 2^24", o.mesh->triangle_count());
-      object_table.insert(object_table.end(), {static_cast<uint32_t>(pos.size() / 3), static_cast<uint32_t>(idx.size()), 0u, 0u});
-      pos.insert(pos.end(), o.mesh->positions.begin(), o.mesh->positions.end());
-      nrm.insert(nrm.end(), o.mesh->normals.begin(), o.mesh->normals.end());
-      const std::vector<float> uv = gpu_uvs(*o.mesh);
-      uvs.insert(uvs.end(), uv.begin(), uv.end());
-      idx.insert(idx.end(), o.mesh->indices.begin(), o.mesh->indices.end());
-    }
-    if (d.objects.size() > 255) fail(ErrorKind::Value, "the deferred path draws at most 255 objects ({} given)", d.objects.size());
-    glCreateBuffers(4, geom_ssbo);
-    glNamedBufferStorage(geom_ssbo[0], static_cast<GLsizeiptr>(std::max<size_t>(4, object_table.size()) * 4), object_table.data(), 0);
-    glNamedBufferStorage(geom_ssbo[1], static_cast<GLsizeiptr>(std::max<size_t>(1, pos.size()) * 4), pos.data(), 0);
-    glNamedBufferStorage(geom_ssbo[2], static_cast<GLsizeiptr>(std::max<size_t>(1, nrm.size()) * 4), nrm.data(), 0);
-    glNamedBufferStorage(geom_ssbo[3], static_cast<GLsizeiptr>(std::max<size_t>(1, idx.size()) * 4), idx.data(), 0);
-    for (int i = 0; i < 4; ++i) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3 + i, geom_ssbo[i]);
-    glCreateBuffers(1, &uv_ssbo);
-    glNamedBufferStorage(uv_ssbo, static_cast<GLsizeiptr>(std::max<size_t>(1, uvs.size()) * 4), uvs.data(), 0);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 10, uv_ssbo);
+    for (int i = 0; i < 4; ++i) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3 + i, geometry.ssbo[i]);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 10, geometry.ssbo[4]);
   } else {
     glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, color_tex, 0);
   }
@@ -747,8 +779,6 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing,
   glDeleteRenderbuffers(1, &depth_rb);
   if (deferred) {
     glDeleteTextures(1, &vis_tex);
-    glDeleteBuffers(4, geom_ssbo);
-    glDeleteBuffers(1, &uv_ssbo);
   }
   glDeleteBuffers(1, &material_ssbo);
   glDeleteTextures(1, &shadow_tex);
@@ -758,7 +788,6 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing,
   glDeleteBuffers(2, spot_ssbo);
   glDeleteBuffers(2, ssbo);
   glDeleteBuffers(1, &point_ssbo);
-  for (auto& m : meshes) release(m);
   if (err != GL_NO_ERROR) fail(ErrorKind::Internal, "OpenGL error 0x{:x} while rendering", err);
   return out;
 }
