@@ -40,7 +40,8 @@ void setup(CLI::App& app) {
     std::string scene = "blob", out = "frame.png", backend = "auto", size = "1024x768", eye = "0,0.5,1.6",
                 target = "0,0,0", at = "0,0,0";
     double object_size = 0.8;
-    int frames = 1, bands = 5, triangles = 100000, shadows = 4, sh_table = 0, shadow_map = 2048, spot_shadow_map = 512;
+    int frames = 1, bands = 5, triangles = 100000, shadows = 4, sh_table = 0;
+    iblcli::ShadowMapOptions shadow_maps;
     double gloss = 0, exponent = 20;
     std::string glossy = "map";
     std::string truth;
@@ -48,7 +49,7 @@ void setup(CLI::App& app) {
     double floor_size = 6;
     std::string luminaire = "0,1,0", luminaire_dir = "0,0,1";
     std::string texture, lobe = "phong", albedo = "0.75,0.75,0.75";
-    double exposure = 0, fov = 40, spot_shadow_share = 0;
+    double exposure = 0, fov = 40;
   };
   auto* o = new Opts();
   app.add_option("scene", o->scene,
@@ -70,17 +71,7 @@ void setup(CLI::App& app) {
   app.add_option("--shadows", o->shadows, "lights (in the file's priority order) that cast shadows")
       ->check(CLI::Range(0, 16))
       ->capture_default_str();
-  app.add_option("--shadow-map", o->shadow_map, "GL: shadow map size of each directional or point light (cube faces too)")
-      ->check(CLI::Range(16, 8192))
-      ->capture_default_str();
-  app.add_option("--spot-shadow-map", o->spot_shadow_map,
-                 "GL: shadow map size of each textured spotlight (a 9×7 dataset draws 63 of them a frame)")
-      ->check(CLI::Range(16, 8192))
-      ->capture_default_str();
-  app.add_option("--spot-shadow-share", o->spot_shadow_share,
-                 "GL: textured spotlights within this many metres of each other share one shadow map (0: one each)")
-      ->check(CLI::Range(0.0, 100.0))
-      ->capture_default_str();
+  iblcli::add_shadow_map_options(app, &o->shadow_maps);
   app.add_option("--bands", o->bands, "SH bands when projecting a probe")->check(CLI::Range(1, 9))->capture_default_str();
   app.add_option("--triangles", o->triangles, "triangles of the blob")->check(CLI::Range(100, 5000000))->capture_default_str();
   app.add_option("--gloss", o->gloss, "weight of the glossy Phong lobe (0..1)")->check(CLI::Range(0.0, 1.0));
@@ -129,9 +120,7 @@ void setup(CLI::App& app) {
     FrameDesc d;
     d.camera.width = w;
     d.camera.height = h;
-    d.shadow_map_size = o->shadow_map;
-    d.spot_shadow_map_size = o->spot_shadow_map;
-    d.spot_shadow_share = o->spot_shadow_share;
+    o->shadow_maps.apply(&d);
     d.camera.eye = iblcli::parse_vec3(o->eye, "--eye");
     d.camera.target = iblcli::parse_vec3(o->target, "--target");
     d.camera.fov_y_deg = o->fov;

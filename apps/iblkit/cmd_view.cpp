@@ -31,8 +31,8 @@ struct ViewOpts {
   std::string scene = "blob", size = "960x720", at = "0,0,0", screenshot;
   std::vector<std::string> lights;
   double object_size = 0.8, gloss = 0.15, exponent = 20, exposure = 0, floor_size = 6;
-  int triangles = 100000, bands = 5, shadows = 4, frames = 0, spot_shadow_map = 512;
-  double spot_shadow_share = 0;
+  int triangles = 100000, bands = 5, shadows = 4, frames = 0;
+  iblcli::ShadowMapOptions shadow_maps;
 };
 
 // Orbit camera around a target: azimuth, elevation (radians) and distance.
@@ -171,8 +171,7 @@ void run(const ViewOpts& o, const ibl::io::EnvReadDesc& rd) {
     FrameDesc d;
     d.camera.width = fw;
     d.camera.height = fh;
-    d.spot_shadow_map_size = o.spot_shadow_map;
-    d.spot_shadow_share = o.spot_shadow_share;
+    o.shadow_maps.apply(&d);
     d.camera.target = at + st.offset;
     st.orbit.target = d.camera.target;
     d.camera.eye = st.orbit.eye();
@@ -256,13 +255,7 @@ void setup(CLI::App& app) {
   app.add_option("--shadows", o->shadows, "lights of a light set that cast shadows")->check(CLI::Range(0, 16))->capture_default_str();
   app.add_option("--frames", o->frames, "run this many frames (one orbit) and exit; 0: interactive")->check(CLI::Range(0, 100000));
   app.add_option("--screenshot", o->screenshot, "write the last frame here on exit (.png)");
-  app.add_option("--spot-shadow-map", o->spot_shadow_map, "shadow map size of each textured spotlight of a near-field dataset")
-      ->check(CLI::Range(16, 8192))
-      ->capture_default_str();
-  app.add_option("--spot-shadow-share", o->spot_shadow_share,
-                 "textured spotlights within this many metres of each other share one shadow map (0: one each)")
-      ->check(CLI::Range(0.0, 100.0))
-      ->capture_default_str();
+  iblcli::add_shadow_map_options(app, &o->shadow_maps);
   auto& rd = iblcli::add_probe_read_options(app);
   app.footer(
       "Keys: drag = orbit, scroll = zoom, arrows / PageUp / PageDown = move the object, 1-9 / Tab = lighting,\n"

@@ -17,6 +17,20 @@
 
 namespace iblcli {
 
+void add_shadow_map_options(CLI::App& app, ShadowMapOptions* o) {
+  app.add_option("--shadow-map", o->size, "GL: shadow map size of each directional or point light (cube faces too)")
+      ->check(CLI::Range(16, 8192))
+      ->capture_default_str();
+  app.add_option("--spot-shadow-map", o->spot_size,
+                 "GL: shadow map size of each textured spotlight (a 9×7 dataset draws 63 of them a frame)")
+      ->check(CLI::Range(16, 8192))
+      ->capture_default_str();
+  app.add_option("--spot-shadow-share", o->spot_share,
+                 "GL: textured spotlights within this many metres of each other share one shadow map (0: one each)")
+      ->check(CLI::Range(0.0, 100.0))
+      ->capture_default_str();
+}
+
 namespace fs = std::filesystem;
 using namespace ibl;
 using namespace ibl::render;

@@ -4,8 +4,11 @@
 #ifdef IBLKIT_HAVE_GEOMETRY
 #include <string>
 
+#include <CLI/CLI.hpp>
+
 #include "iblkit/io/envmap_io.h"
 #include "iblkit/nearfield/spotlight.h"
+#include "iblkit/render/frame.h"
 #include "iblkit/render/mesh.h"
 #include "iblkit/render/shading.h"
 
@@ -19,6 +22,20 @@ struct LightingOptions {
   ibl::io::EnvReadDesc read;      // probe reading (--mapping, --dead-angle, --sanitize)
   ibl::nearfield::Placement luminaire;  // where a near-field dataset's luminaire sits and shines
 };
+
+// The GL renderer's shadow maps (render and view share the options): --shadow-map,
+// --spot-shadow-map and --spot-shadow-share.
+struct ShadowMapOptions {
+  int size = 2048;       // each directional or point light's (cube faces too)
+  int spot_size = 512;   // each textured spotlight's
+  double spot_share = 0; // metres: spotlights this close share a map (0: one each)
+  void apply(ibl::render::FrameDesc* d) const {
+    d->shadow_map_size = size;
+    d->spot_shadow_map_size = spot_size;
+    d->spot_shadow_share = spot_share;
+  }
+};
+void add_shadow_map_options(CLI::App& app, ShadowMapOptions* o);
 
 // Reads a --light file into L: an SH grid (.shgrid), an iblkit.lights/1 file (lights with a
 // position and a set origin become point lights), an iblkit.nearfield/1 dataset (a textured
