@@ -27,6 +27,17 @@ else
   echo "no GL here: the --sh-table checks are skipped"; skip=$((skip+1))
 fi
 
+# Without OpenGL (EGL finds no vendor library): auto says so and renders on the CPU; an explicit
+# --backend gl fails with the reason.
+if "$BIN" render sphere --light "$T/g4.shgrid" --size 8x8 --backend gl --out "$T/gl_probe.png" 2>&1 | grep -q "this build has no OpenGL"; then
+  echo "a build without the GL renderer: the no-GL checks are skipped"; skip=$((skip+1))
+else
+  check no-gl-auto ok "no OpenGL here.*rendering on the CPU" -- env __EGL_VENDOR_LIBRARY_FILENAMES=/nonexistent.json \
+    "$BIN" render sphere --light "$T/g4.shgrid" --size 16x12 --out "$T/nogl.png"
+  check no-gl-explicit fail "no OpenGL here" -- env __EGL_VENDOR_LIBRARY_FILENAMES=/nonexistent.json \
+    "$BIN" render sphere --light "$T/g4.shgrid" --size 16x12 --backend gl --out "$T/nogl.png"
+fi
+
 # Two lightings, one photograph: one frame each and the comparison sheet.
 check truth-two-lights ok "object relative L1" -- "$BIN" render blob --light "$T/g4.shgrid" --light "$PROBE" --at 0,0.85,0 \
   --object-size 0.35 --floor-size 0.8 --eye 0,1.45,1.5 --target 0,0.8,0 --size 64x48 --backend cpu --truth low-scene2 \

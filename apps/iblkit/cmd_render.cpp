@@ -145,7 +145,7 @@ void setup(CLI::App& app) {
         ctx = std::make_unique<gl::Context>();
         backend = "gl";
       } catch (const Error& e) {
-        if (backend == "gl") throw;
+        if (backend == "gl") fail(ErrorKind::Unsupported, "no OpenGL here ({}); --backend cpu or auto renders on the CPU", e.what());
         iblcli::info(fmt::format("no OpenGL here ({}); rendering on the CPU", e.what()));
         backend = "cpu";
       }
