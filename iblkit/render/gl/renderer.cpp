@@ -10,49 +10,12 @@
 #include "iblkit/core/error.h"
 #include "iblkit/render/gl/program.h"
 #include "iblkit/render/gl/sh_glsl.h"
+#include "iblkit/render/gl/uploads.h"
 #include "iblkit/sh/convolve.h"
 
 namespace ibl::render::gl {
 
 namespace {
-
-struct MeshBuffers {
-  GLuint vao = 0, vbo[3] = {0, 0, 0}, ebo = 0;
-  GLsizei count = 0;
-};
-
-// UVs of a mesh for the GPU: its own, or zeros.
-std::vector<float> gpu_uvs(const Mesh& m) {
-  return m.has_uvs() ? m.uvs : std::vector<float>(2 * m.vertex_count(), 0.0f);
-}
-
-MeshBuffers upload(const Mesh& m) {
-  MeshBuffers b;
-  glCreateVertexArrays(1, &b.vao);
-  glCreateBuffers(3, b.vbo);
-  glCreateBuffers(1, &b.ebo);
-  const std::vector<float> uv = gpu_uvs(m);
-  glNamedBufferStorage(b.vbo[0], static_cast<GLsizeiptr>(m.positions.size() * sizeof(float)), m.positions.data(), 0);
-  glNamedBufferStorage(b.vbo[1], static_cast<GLsizeiptr>(m.normals.size() * sizeof(float)), m.normals.data(), 0);
-  glNamedBufferStorage(b.vbo[2], static_cast<GLsizeiptr>(std::max<size_t>(1, uv.size()) * sizeof(float)), uv.data(), 0);
-  glNamedBufferStorage(b.ebo, static_cast<GLsizeiptr>(m.indices.size() * sizeof(uint32_t)), m.indices.data(), 0);
-  for (int a = 0; a < 3; ++a) {
-    const int n = a == 2 ? 2 : 3;
-    glVertexArrayVertexBuffer(b.vao, a, b.vbo[a], 0, n * sizeof(float));
-    glVertexArrayAttribFormat(b.vao, a, n, GL_FLOAT, GL_FALSE, 0);
-    glVertexArrayAttribBinding(b.vao, a, a);
-    glEnableVertexArrayAttrib(b.vao, a);
-  }
-  glVertexArrayElementBuffer(b.vao, b.ebo);
-  b.count = static_cast<GLsizei>(m.indices.size());
-  return b;
-}
-
-void release(MeshBuffers& b) {
-  glDeleteVertexArrays(1, &b.vao);
-  glDeleteBuffers(3, b.vbo);
-  glDeleteBuffers(1, &b.ebo);
-}
 
 void set_vec3(GLuint prog, const char* name, Vec3 v) {
   glProgramUniform3f(prog, glGetUniformLocation(prog, name), static_cast<float>(v.x), static_cast<float>(v.y),
@@ -68,161 +31,7 @@ struct Renderer::Impl {
   std::map<std::tuple<int, bool, int>, GLuint> programs;
   std::map<int, GLuint> sh_tables;  // by bands, when desc.sh_table_size > 0
 
-  // The last frame's colour (RGBA32F, GL's bottom-up rows, alpha = coverage), kept for
-  // color_texture() and reused while the size stays.
-  GLuint color_tex = 0;
-  int color_w = 0, color_h = 0;
-  GLuint color_texture(int w, int h) {
-    if (color_tex && color_w == w && color_h == h) return color_tex;
-    if (color_tex) glDeleteTextures(1, &color_tex);
-    glCreateTextures(GL_TEXTURE_2D, 1, &color_tex);
-    glTextureStorage2D(color_tex, 1, GL_RGBA32F, w, h);
-    color_w = w;
-    color_h = h;
-    return color_tex;
-  }
-
-  // The objects' vertex buffers (and, for the deferred path, all objects' geometry in storage
-  // buffers), kept while the next frame's meshes hold the same values (compared in full against
-  // copies: a few MB for 10⁵ triangles, far cheaper than uploading them again).
-  struct Geometry {
-    std::vector<Mesh> keys;
-    std::vector<MeshBuffers> meshes;
-    GLuint ssbo[5] = {0, 0, 0, 0, 0};  // object table, positions, normals, indices, uvs
-    void release() {
-      for (auto& m : meshes) gl::release(m);
-      if (ssbo[0]) glDeleteBuffers(5, ssbo);
-      *this = {};
-    }
-  } geometry;
-  const Geometry& geometry_for(const std::vector<RenderObject>& objects, bool deferred) {
-    bool same = geometry.keys.size() == objects.size();
-    for (size_t i = 0; same && i < objects.size(); ++i) {
-      const Mesh& a = *objects[i].mesh;
-      const Mesh& b = geometry.keys[i];
-      same = a.positions == b.positions && a.normals == b.normals && a.uvs == b.uvs && a.indices == b.indices;
-    }
-    if (!same) {
-      geometry.release();
-      for (const auto& o : objects) {
-        geometry.meshes.push_back(upload(*o.mesh));
-        geometry.keys.push_back(*o.mesh);
-      }
-    }
-    if (deferred && !geometry.ssbo[0]) {
-      // Geometry for the compute pass: all objects' vertices and indices, and where each starts.
-      if (objects.size() > 255) fail(ErrorKind::Value, "the deferred path draws at most 255 objects ({} given)", objects.size());
-      std::vector<uint32_t> object_table;
-      std::vector<float> pos, nrm, uvs;
-      std::vector<uint32_t> idx;
-      for (const auto& o : objects) {
-        if (o.mesh->triangle_count() >= (1u << 24)) fail(ErrorKind::Value, "a mesh of {} triangles is over the deferred path's 2^24", o.mesh->triangle_count());
-        object_table.insert(object_table.end(), {static_cast<uint32_t>(pos.size() / 3), static_cast<uint32_t>(idx.size()), 0u, 0u});
-        pos.insert(pos.end(), o.mesh->positions.begin(), o.mesh->positions.end());
-        nrm.insert(nrm.end(), o.mesh->normals.begin(), o.mesh->normals.end());
-        const std::vector<float> uv = gpu_uvs(*o.mesh);
-        uvs.insert(uvs.end(), uv.begin(), uv.end());
-        idx.insert(idx.end(), o.mesh->indices.begin(), o.mesh->indices.end());
-      }
-      glCreateBuffers(5, geometry.ssbo);
-      glNamedBufferStorage(geometry.ssbo[0], static_cast<GLsizeiptr>(std::max<size_t>(4, object_table.size()) * 4), object_table.data(), 0);
-      glNamedBufferStorage(geometry.ssbo[1], static_cast<GLsizeiptr>(std::max<size_t>(1, pos.size()) * 4), pos.data(), 0);
-      glNamedBufferStorage(geometry.ssbo[2], static_cast<GLsizeiptr>(std::max<size_t>(1, nrm.size()) * 4), nrm.data(), 0);
-      glNamedBufferStorage(geometry.ssbo[3], static_cast<GLsizeiptr>(std::max<size_t>(1, idx.size()) * 4), idx.data(), 0);
-      glNamedBufferStorage(geometry.ssbo[4], static_cast<GLsizeiptr>(std::max<size_t>(1, uvs.size()) * 4), uvs.data(), 0);
-    }
-    return geometry;
-  }
-
-  // The SH grid's texture, kept while the next frame's grid holds the same values (compared in
-  // full: a memcmp costs a tenth of packing and uploading them again).
-  GLuint grid_tex = 0;
-  SHGridData grid_key;
-  GLuint grid_texture(const SHGridData& g) {
-    if (grid_tex && g.nx == grid_key.nx && g.ny == grid_key.ny && g.nz == grid_key.nz && g.bands == grid_key.bands &&
-        g.data == grid_key.data)
-      return grid_tex;
-    if (grid_tex) glDeleteTextures(1, &grid_tex);
-    grid_tex = 0;  // (nothing stale is left if what follows throws)
-    grid_key = {};
-    const int K = g.bands * g.bands;
-    const size_t points = static_cast<size_t>(g.nx) * g.ny * g.nz;
-    std::vector<float> packed(points * K * 4, 0.0f);
-    for (int k = 0; k < K; ++k)
-      for (size_t p = 0; p < points; ++p)
-        for (int c = 0; c < 3; ++c) packed[(static_cast<size_t>(k) * points + p) * 4 + c] = g.data[(p * K + k) * 3 + c];
-    glCreateTextures(GL_TEXTURE_3D, 1, &grid_tex);
-    glTextureStorage3D(grid_tex, 1, GL_RGBA16F, g.nx, g.ny, g.nz * K);
-    glTextureSubImage3D(grid_tex, 0, 0, 0, 0, g.nx, g.ny, g.nz * K, GL_RGBA, GL_FLOAT, packed.data());
-    glTextureParameteri(grid_tex, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-    glTextureParameteri(grid_tex, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    for (GLenum w : {GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T, GL_TEXTURE_WRAP_R}) glTextureParameteri(grid_tex, w, GL_CLAMP_TO_EDGE);
-    grid_key = g;
-    return grid_tex;
-  }
-
-  // Spotlight textures in one mip-mapped RGBA16F 2D array, a layer per spotlight: kept while the
-  // next frame's spotlights hold the same (immutable, shared) textures, so that a viewer does not
-  // re-upload a 9×7 dataset's 63 textures every frame.
-  struct SpotTextures {
-    std::vector<std::shared_ptr<const std::vector<Image>>> keys;
-    GLuint tex = 0;
-    int levels = 0;
-    std::vector<float> scale;  // each layer is stored divided by this (its largest |texel|)
-  } spots;
-  const SpotTextures& spot_textures(const std::vector<nearfield::TexturedSpotlight>& lights) {
-    bool same = spots.keys.size() == lights.size();
-    for (size_t i = 0; same && i < lights.size(); ++i) same = spots.keys[i] == lights[i].mips;
-    if (same && spots.tex) return spots;
-    if (spots.tex) glDeleteTextures(1, &spots.tex);
-    spots = {};
-    const auto& first = lights[0];
-    if (!first.mips || first.mips->empty()) fail(ErrorKind::Value, "textured spotlight 0 has no texture");
-    const int tw = (*first.mips)[0].width(), th = (*first.mips)[0].height();
-    const int levels = static_cast<int>(first.mips->size());
-    for (size_t i = 0; i < lights.size(); ++i) {
-      const auto& sp = lights[i];
-      if (!sp.mips || sp.mips->size() != static_cast<size_t>(levels) || (*sp.mips)[0].width() != tw || (*sp.mips)[0].height() != th)
-        fail(ErrorKind::Unsupported, "the GL renderer takes textured spotlights of one texture size per frame (spotlight {} differs from spotlight 0)", i);
-      for (int lv = 0; lv < levels; ++lv)
-        if ((*sp.mips)[lv].channels() != 3) fail(ErrorKind::Value, "spotlight {} mip {} is not RGB", i, lv);
-    }
-    GLuint tex = 0;
-    glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, &tex);
-    // Half floats: half the memory of RGBA32F (the paper stored sRGBE, 4 bytes a texel, for the same
-    // reason); 11-bit mantissas, well inside the agreement test's tolerance.
-    glTextureStorage3D(tex, levels, GL_RGBA16F, tw, th, static_cast<GLsizei>(lights.size()));
-    std::vector<float> rgba;
-    for (size_t i = 0; i < lights.size(); ++i) {
-      const auto& sp = lights[i];
-      // Half floats hold up to 65504 with 11-bit mantissas: each texture is stored divided by its
-      // largest |texel| (measured radiance of a small LED reaches 10⁶ and more), the shader
-      // multiplies it back.
-      float peak = 0;
-      for (size_t k = 0; k < (*sp.mips)[0].size(); ++k) peak = std::max(peak, std::abs((*sp.mips)[0].data()[k]));
-      const float scale = peak > 0 && std::isfinite(peak) ? peak : 1.0f;
-      spots.scale.push_back(scale);
-      for (int lv = 0; lv < levels; ++lv) {
-        const Image& im = (*sp.mips)[lv];
-        rgba.assign(im.pixel_count() * 4, 0.0f);
-        for (size_t k = 0; k < im.pixel_count(); ++k)
-          for (int c = 0; c < 3; ++c) rgba[k * 4 + c] = im.data()[k * 3 + c] / scale;
-        glTextureSubImage3D(tex, lv, 0, 0, static_cast<GLint>(i), im.width(), im.height(), 1, GL_RGBA, GL_FLOAT, rgba.data());
-      }
-      spots.keys.push_back(sp.mips);
-    }
-    glTextureParameteri(tex, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
-    glTextureParameteri(tex, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    glTextureParameteri(tex, GL_TEXTURE_BASE_LEVEL, 0);
-    glTextureParameteri(tex, GL_TEXTURE_MAX_LEVEL, levels - 1);
-    glTextureParameteri(tex, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_BORDER);
-    glTextureParameteri(tex, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_BORDER);
-    const float zero_border[4] = {0, 0, 0, 0};
-    glTextureParameterfv(tex, GL_TEXTURE_BORDER_COLOR, zero_border);
-    spots.tex = tex;
-    spots.levels = levels;
-    return spots;
-  }
+  Uploads uploads;  // what stays on the GPU between frames
 
   GLuint sh_table(int bands) {
     auto& t = sh_tables[bands];
@@ -252,10 +61,6 @@ struct Renderer::Impl {
     if (shadow_program) glDeleteProgram(shadow_program);
     if (layered_shadow_program) glDeleteProgram(layered_shadow_program);
     for (auto& [b, t] : sh_tables) glDeleteTextures(1, &t);
-    if (color_tex) glDeleteTextures(1, &color_tex);
-    if (spots.tex) glDeleteTextures(1, &spots.tex);
-    if (grid_tex) glDeleteTextures(1, &grid_tex);
-    geometry.release();
   }
 };
 
@@ -272,7 +77,7 @@ Renderer::Renderer(const RendererDesc& desc) : impl_(std::make_unique<Impl>()) {
 }
 Renderer::~Renderer() = default;
 
-unsigned Renderer::color_texture() const { return impl_->color_tex; }
+unsigned Renderer::color_texture() const { return impl_->uploads.last_color_texture(); }
 
 RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing, bool read_back) {
   const Camera& cam = d.camera;
@@ -294,7 +99,7 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing,
     o.mesh->bounds(&a, &b);
     for (int k = 0; k < 3; ++k) { lo[k] = std::min(lo[k], a[k]); hi[k] = std::max(hi[k], b[k]); }
   }
-  const Impl::Geometry& geometry = impl_->geometry_for(d.objects, deferred);
+  const Uploads::Geometry& geometry = impl_->uploads.geometry(d.objects, deferred);
   const std::vector<MeshBuffers>& meshes = geometry.meshes;
   Vec3 centre = (lo + hi) * 0.5;
   double radius = std::max(1e-6, 0.5 * length(hi - lo));
@@ -356,7 +161,7 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing,
   int spot_levels = 0;
   const std::vector<float>* spot_scale = nullptr;
   if (!L.spotlights.empty()) {
-    const Impl::SpotTextures& st = impl_->spot_textures(L.spotlights);
+    const Uploads::SpotTextures& st = impl_->uploads.spot_textures(L.spotlights);
     spot_tex = st.tex;
     spot_levels = st.levels;
     spot_scale = &st.scale;
@@ -483,12 +288,12 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing,
     glGetIntegerv(GL_MAX_3D_TEXTURE_SIZE, &max3d);
     if (g.nz * K > max3d)
       fail(ErrorKind::Unsupported, "SH grid needs a 3D texture {} deep; this GL allows {}", g.nz * K, max3d);
-    grid_tex = impl_->grid_texture(g);
+    grid_tex = impl_->uploads.grid_texture(g);
   }
 
   // Colour target (the forward pass renders into it; the deferred pass writes it as an image), and
   // the deferred G-buffer.
-  GLuint color_tex = impl_->color_texture(W, H), depth_rb, fbo, vis_tex = 0;
+  GLuint color_tex = impl_->uploads.color_texture(W, H), depth_rb, fbo, vis_tex = 0;
   glCreateRenderbuffers(1, &depth_rb);
   glNamedRenderbufferStorage(depth_rb, GL_DEPTH_COMPONENT32F, W, H);
   glCreateFramebuffers(1, &fbo);

@@ -1,4 +1,5 @@
-// The real-time renderer: OpenGL 4.5 core, headless through EGL. Draws a FrameDesc (render/frame.h)
+// The real-time renderer: OpenGL 4.5 core, headless through EGL (what it keeps on the GPU between
+// frames: uploads.h). Draws a FrameDesc (render/frame.h)
 // with the shading model of render/shading.h: SH environment or SH grid (coefficients in RGB16F 3D
 // textures with hardware trilinear filtering, zonal harmonics rotated per fragment), and any number
 // of directional lights in one pass, the shadow-casting ones through a shadow-map array.

@@ -1,0 +1,189 @@
+#include "iblkit/render/gl/uploads.h"
+
+#include <epoxy/gl.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "iblkit/core/error.h"
+
+namespace ibl::render::gl {
+
+namespace {
+
+// UVs of a mesh for the GPU: its own, or zeros.
+std::vector<float> gpu_uvs(const Mesh& m) {
+  return m.has_uvs() ? m.uvs : std::vector<float>(2 * m.vertex_count(), 0.0f);
+}
+
+MeshBuffers upload(const Mesh& m) {
+  MeshBuffers b;
+  glCreateVertexArrays(1, &b.vao);
+  glCreateBuffers(3, b.vbo);
+  glCreateBuffers(1, &b.ebo);
+  const std::vector<float> uv = gpu_uvs(m);
+  glNamedBufferStorage(b.vbo[0], static_cast<GLsizeiptr>(m.positions.size() * sizeof(float)), m.positions.data(), 0);
+  glNamedBufferStorage(b.vbo[1], static_cast<GLsizeiptr>(m.normals.size() * sizeof(float)), m.normals.data(), 0);
+  glNamedBufferStorage(b.vbo[2], static_cast<GLsizeiptr>(std::max<size_t>(1, uv.size()) * sizeof(float)), uv.data(), 0);
+  glNamedBufferStorage(b.ebo, static_cast<GLsizeiptr>(m.indices.size() * sizeof(uint32_t)), m.indices.data(), 0);
+  for (int a = 0; a < 3; ++a) {
+    const int n = a == 2 ? 2 : 3;
+    glVertexArrayVertexBuffer(b.vao, a, b.vbo[a], 0, n * sizeof(float));
+    glVertexArrayAttribFormat(b.vao, a, n, GL_FLOAT, GL_FALSE, 0);
+    glVertexArrayAttribBinding(b.vao, a, a);
+    glEnableVertexArrayAttrib(b.vao, a);
+  }
+  glVertexArrayElementBuffer(b.vao, b.ebo);
+  b.count = static_cast<int>(m.indices.size());
+  return b;
+}
+
+void release_buffers(MeshBuffers& b) {
+  glDeleteVertexArrays(1, &b.vao);
+  glDeleteBuffers(3, b.vbo);
+  glDeleteBuffers(1, &b.ebo);
+}
+
+}  // namespace
+
+Uploads::~Uploads() {
+  if (color_tex_) glDeleteTextures(1, &color_tex_);
+  if (spots_.tex) glDeleteTextures(1, &spots_.tex);
+  if (grid_tex_) glDeleteTextures(1, &grid_tex_);
+  geometry_.release();
+}
+
+unsigned Uploads::color_texture(int w, int h) {
+  if (color_tex_ && color_w_ == w && color_h_ == h) return color_tex_;
+  if (color_tex_) glDeleteTextures(1, &color_tex_);
+  glCreateTextures(GL_TEXTURE_2D, 1, &color_tex_);
+  glTextureStorage2D(color_tex_, 1, GL_RGBA32F, w, h);
+  color_w_ = w;
+  color_h_ = h;
+  return color_tex_;
+}
+
+void Uploads::Geometry::release() {
+  for (auto& m : meshes) release_buffers(m);
+  if (ssbo[0]) glDeleteBuffers(5, ssbo);
+  *this = {};
+}
+
+const Uploads::Geometry& Uploads::geometry(const std::vector<RenderObject>& objects, bool deferred) {
+  bool same = geometry_.keys.size() == objects.size();
+  for (size_t i = 0; same && i < objects.size(); ++i) {
+    const Mesh& a = *objects[i].mesh;
+    const Mesh& b = geometry_.keys[i];
+    same = a.positions == b.positions && a.normals == b.normals && a.uvs == b.uvs && a.indices == b.indices;
+  }
+  if (!same) {
+    geometry_.release();
+    for (const auto& o : objects) {
+      geometry_.meshes.push_back(upload(*o.mesh));
+      geometry_.keys.push_back(*o.mesh);
+    }
+  }
+  if (deferred && !geometry_.ssbo[0]) {
+    // Geometry for the compute pass: all objects' vertices and indices, and where each starts.
+    if (objects.size() > 255) fail(ErrorKind::Value, "the deferred path draws at most 255 objects ({} given)", objects.size());
+    std::vector<uint32_t> object_table;
+    std::vector<float> pos, nrm, uvs;
+    std::vector<uint32_t> idx;
+    for (const auto& o : objects) {
+      if (o.mesh->triangle_count() >= (1u << 24)) fail(ErrorKind::Value, "a mesh of {} triangles is over the deferred path's 2^24", o.mesh->triangle_count());
+      object_table.insert(object_table.end(), {static_cast<uint32_t>(pos.size() / 3), static_cast<uint32_t>(idx.size()), 0u, 0u});
+      pos.insert(pos.end(), o.mesh->positions.begin(), o.mesh->positions.end());
+      nrm.insert(nrm.end(), o.mesh->normals.begin(), o.mesh->normals.end());
+      const std::vector<float> uv = gpu_uvs(*o.mesh);
+      uvs.insert(uvs.end(), uv.begin(), uv.end());
+      idx.insert(idx.end(), o.mesh->indices.begin(), o.mesh->indices.end());
+    }
+    glCreateBuffers(5, geometry_.ssbo);
+    glNamedBufferStorage(geometry_.ssbo[0], static_cast<GLsizeiptr>(std::max<size_t>(4, object_table.size()) * 4), object_table.data(), 0);
+    glNamedBufferStorage(geometry_.ssbo[1], static_cast<GLsizeiptr>(std::max<size_t>(1, pos.size()) * 4), pos.data(), 0);
+    glNamedBufferStorage(geometry_.ssbo[2], static_cast<GLsizeiptr>(std::max<size_t>(1, nrm.size()) * 4), nrm.data(), 0);
+    glNamedBufferStorage(geometry_.ssbo[3], static_cast<GLsizeiptr>(std::max<size_t>(1, idx.size()) * 4), idx.data(), 0);
+    glNamedBufferStorage(geometry_.ssbo[4], static_cast<GLsizeiptr>(std::max<size_t>(1, uvs.size()) * 4), uvs.data(), 0);
+  }
+  return geometry_;
+}
+
+// (Compared in full: a memcmp costs a tenth of packing and uploading the values again.)
+unsigned Uploads::grid_texture(const SHGridData& g) {
+  if (grid_tex_ && g.nx == grid_key_.nx && g.ny == grid_key_.ny && g.nz == grid_key_.nz && g.bands == grid_key_.bands &&
+      g.data == grid_key_.data)
+    return grid_tex_;
+  if (grid_tex_) glDeleteTextures(1, &grid_tex_);
+  grid_tex_ = 0;  // (nothing stale is left if what follows throws)
+  grid_key_ = {};
+  const int K = g.bands * g.bands;
+  const size_t points = static_cast<size_t>(g.nx) * g.ny * g.nz;
+  std::vector<float> packed(points * K * 4, 0.0f);
+  for (int k = 0; k < K; ++k)
+    for (size_t p = 0; p < points; ++p)
+      for (int c = 0; c < 3; ++c) packed[(static_cast<size_t>(k) * points + p) * 4 + c] = g.data[(p * K + k) * 3 + c];
+  glCreateTextures(GL_TEXTURE_3D, 1, &grid_tex_);
+  glTextureStorage3D(grid_tex_, 1, GL_RGBA16F, g.nx, g.ny, g.nz * K);
+  glTextureSubImage3D(grid_tex_, 0, 0, 0, 0, g.nx, g.ny, g.nz * K, GL_RGBA, GL_FLOAT, packed.data());
+  glTextureParameteri(grid_tex_, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTextureParameteri(grid_tex_, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  for (GLenum w : {GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T, GL_TEXTURE_WRAP_R}) glTextureParameteri(grid_tex_, w, GL_CLAMP_TO_EDGE);
+  grid_key_ = g;
+  return grid_tex_;
+}
+
+const Uploads::SpotTextures& Uploads::spot_textures(const std::vector<nearfield::TexturedSpotlight>& lights) {
+  bool same = spots_.keys.size() == lights.size();
+  for (size_t i = 0; same && i < lights.size(); ++i) same = spots_.keys[i] == lights[i].mips;
+  if (same && spots_.tex) return spots_;
+  if (spots_.tex) glDeleteTextures(1, &spots_.tex);
+  spots_ = {};
+  const auto& first = lights[0];
+  if (!first.mips || first.mips->empty()) fail(ErrorKind::Value, "textured spotlight 0 has no texture");
+  const int tw = (*first.mips)[0].width(), th = (*first.mips)[0].height();
+  const int levels = static_cast<int>(first.mips->size());
+  for (size_t i = 0; i < lights.size(); ++i) {
+    const auto& sp = lights[i];
+    if (!sp.mips || sp.mips->size() != static_cast<size_t>(levels) || (*sp.mips)[0].width() != tw || (*sp.mips)[0].height() != th)
+      fail(ErrorKind::Unsupported, "the GL renderer takes textured spotlights of one texture size per frame (spotlight {} differs from spotlight 0)", i);
+    for (int lv = 0; lv < levels; ++lv)
+      if ((*sp.mips)[lv].channels() != 3) fail(ErrorKind::Value, "spotlight {} mip {} is not RGB", i, lv);
+  }
+  GLuint tex = 0;
+  glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, &tex);
+  // Half floats: half the memory of RGBA32F (the paper stored sRGBE, 4 bytes a texel, for the same
+  // reason); 11-bit mantissas, well inside the agreement test's tolerance.
+  glTextureStorage3D(tex, levels, GL_RGBA16F, tw, th, static_cast<GLsizei>(lights.size()));
+  std::vector<float> rgba;
+  for (size_t i = 0; i < lights.size(); ++i) {
+    const auto& sp = lights[i];
+    // Half floats hold up to 65504 with 11-bit mantissas: each texture is stored divided by its
+    // largest |texel| (measured radiance of a small LED reaches 10⁶ and more), the shader
+    // multiplies it back.
+    float peak = 0;
+    for (size_t k = 0; k < (*sp.mips)[0].size(); ++k) peak = std::max(peak, std::abs((*sp.mips)[0].data()[k]));
+    const float scale = peak > 0 && std::isfinite(peak) ? peak : 1.0f;
+    spots_.scale.push_back(scale);
+    for (int lv = 0; lv < levels; ++lv) {
+      const Image& im = (*sp.mips)[lv];
+      rgba.assign(im.pixel_count() * 4, 0.0f);
+      for (size_t k = 0; k < im.pixel_count(); ++k)
+        for (int c = 0; c < 3; ++c) rgba[k * 4 + c] = im.data()[k * 3 + c] / scale;
+      glTextureSubImage3D(tex, lv, 0, 0, static_cast<GLint>(i), im.width(), im.height(), 1, GL_RGBA, GL_FLOAT, rgba.data());
+    }
+    spots_.keys.push_back(sp.mips);
+  }
+  glTextureParameteri(tex, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+  glTextureParameteri(tex, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTextureParameteri(tex, GL_TEXTURE_BASE_LEVEL, 0);
+  glTextureParameteri(tex, GL_TEXTURE_MAX_LEVEL, levels - 1);
+  glTextureParameteri(tex, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_BORDER);
+  glTextureParameteri(tex, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_BORDER);
+  const float zero_border[4] = {0, 0, 0, 0};
+  glTextureParameterfv(tex, GL_TEXTURE_BORDER_COLOR, zero_border);
+  spots_.tex = tex;
+  spots_.levels = levels;
+  return spots_;
+}
+
+}  // namespace ibl::render::gl
