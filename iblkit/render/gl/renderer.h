@@ -1,8 +1,9 @@
-// The real-time renderer: OpenGL 4.5 core, headless through EGL (what it keeps on the GPU between
-// frames: uploads.h). Draws a FrameDesc (render/frame.h)
-// with the shading model of render/shading.h: SH environment or SH grid (coefficients in RGB16F 3D
-// textures with hardware trilinear filtering, zonal harmonics rotated per fragment), and any number
-// of directional lights in one pass, the shadow-casting ones through a shadow-map array.
+// The real-time renderer: OpenGL 4.5 core, headless through EGL. Draws a FrameDesc (render/frame.h)
+// with the shading model of render/shading.h: an SH environment or SH grid (RGBA16F 3D texture,
+// hardware trilinear; zonal harmonics rotated per fragment, or the basis from a table), a probe's
+// prefiltered glossy maps, any number of directional and point lights and textured spotlights in
+// one pass with shadow maps, constant or textured Lambert + Phong/Blinn-Phong materials. What it
+// keeps on the GPU between frames: uploads.h.
 #pragma once
 #include <memory>
 #include <vector>
