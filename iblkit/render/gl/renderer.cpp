@@ -17,6 +17,31 @@ namespace ibl::render::gl {
 
 namespace {
 
+// A shader storage buffer holding `v` (at least one element's room: GL refuses empty storage),
+// bound at `binding`.
+template <typename T>
+GLuint storage_buffer(const std::vector<T>& v, GLuint binding) {
+  GLuint b = 0;
+  glCreateBuffers(1, &b);
+  glNamedBufferStorage(b, static_cast<GLsizeiptr>(std::max<size_t>(1, v.size()) * sizeof(T)), v.empty() ? nullptr : v.data(), 0);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding, b);
+  return b;
+}
+
+// A depth-texture array for shadow maps: `layers` of size², bilinear depth comparisons (2×2 PCF).
+GLuint shadow_map_array(int size, int layers) {
+  GLuint t = 0;
+  glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, &t);
+  glTextureStorage3D(t, 1, GL_DEPTH_COMPONENT32F, size, size, layers);
+  glTextureParameteri(t, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTextureParameteri(t, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTextureParameteri(t, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTextureParameteri(t, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  glTextureParameteri(t, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+  glTextureParameteri(t, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+  return t;
+}
+
 void set_vec3(GLuint prog, const char* name, Vec3 v) {
   glProgramUniform3f(prog, glGetUniformLocation(prog, name), static_cast<float>(v.x), static_cast<float>(v.y),
                      static_cast<float>(v.z));
@@ -147,11 +172,7 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing,
                                          static_cast<float>(l.position.z), layer, static_cast<float>(l.intensity.x),
                                          static_cast<float>(l.intensity.y), static_cast<float>(l.intensity.z), cube});
   }
-  GLuint point_ssbo;
-  glCreateBuffers(1, &point_ssbo);
-  glNamedBufferStorage(point_ssbo, static_cast<GLsizeiptr>(std::max<size_t>(1, point_data.size()) * sizeof(float)),
-                       point_data.empty() ? nullptr : point_data.data(), 0);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, point_ssbo);
+  const GLuint point_ssbo = storage_buffer(point_data, 7);
   // Textured spotlights: their textures in one mip-mapped 2D array (one layer each, all of one
   // size), their parameters in an SSBO, and a perspective shadow map each (its own array) covering
   // the frustum through its texture's extent on M.
@@ -230,51 +251,22 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing,
       spot_data.insert(spot_data.end(), row, row + 24);
     }
   }
-  GLuint spot_ssbo[2];
-  glCreateBuffers(2, spot_ssbo);
-  glNamedBufferStorage(spot_ssbo[0], static_cast<GLsizeiptr>(std::max<size_t>(1, spot_data.size()) * sizeof(float)),
-                       spot_data.empty() ? nullptr : spot_data.data(), 0);
-  glNamedBufferStorage(spot_ssbo[1], static_cast<GLsizeiptr>(std::max<size_t>(1, spot_mats.size()) * sizeof(Mat4f)),
-                       spot_mats.empty() ? nullptr : spot_mats.data(), 0);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 8, spot_ssbo[0]);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 9, spot_ssbo[1]);
+  const GLuint spot_ssbo[2] = {storage_buffer(spot_data, 8), storage_buffer(spot_mats, 9)};
   const int SS = d.spot_shadow_map_size;
   GLuint spot_shadow_tex = 0;
   if (!spot_mats.empty()) {
     if (SS < 16 || SS > 8192) fail(ErrorKind::Value, "spotlight shadow map size {} is out of range 16..8192", SS);
-    glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, &spot_shadow_tex);
-    glTextureStorage3D(spot_shadow_tex, 1, GL_DEPTH_COMPONENT32F, SS, SS, static_cast<GLsizei>(spot_mats.size()));
-    glTextureParameteri(spot_shadow_tex, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-    glTextureParameteri(spot_shadow_tex, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    glTextureParameteri(spot_shadow_tex, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    glTextureParameteri(spot_shadow_tex, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    glTextureParameteri(spot_shadow_tex, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
-    glTextureParameteri(spot_shadow_tex, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+    spot_shadow_tex = shadow_map_array(SS, static_cast<int>(spot_mats.size()));
   }
 
-  GLuint ssbo[2];
-  glCreateBuffers(2, ssbo);
-  glNamedBufferStorage(ssbo[0], static_cast<GLsizeiptr>(std::max<size_t>(1, light_data.size()) * sizeof(float)),
-                       light_data.empty() ? nullptr : light_data.data(), 0);
-  glNamedBufferStorage(ssbo[1], static_cast<GLsizeiptr>(std::max<size_t>(1, shadow_mats.size()) * sizeof(Mat4f)),
-                       shadow_mats.empty() ? nullptr : shadow_mats.data(), 0);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, ssbo[0]);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, ssbo[1]);
+  const GLuint ssbo[2] = {storage_buffer(light_data, 0), storage_buffer(shadow_mats, 1)};
 
   // Shadow-map array and its framebuffer.
   // (A 1×1 placeholder when no light casts shadows: the sampler needs a texture.)
   if (!shadow_mats.empty() && (d.shadow_map_size < 16 || d.shadow_map_size > 8192))
     fail(ErrorKind::Value, "shadow map size {} is out of range 16..8192", d.shadow_map_size);
   int S = shadow_mats.empty() ? 1 : d.shadow_map_size, layers = std::max<int>(1, static_cast<int>(shadow_mats.size()));
-  GLuint shadow_tex, shadow_fbo;
-  glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, &shadow_tex);
-  glTextureStorage3D(shadow_tex, 1, GL_DEPTH_COMPONENT32F, S, S, layers);
-  glTextureParameteri(shadow_tex, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-  glTextureParameteri(shadow_tex, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-  glTextureParameteri(shadow_tex, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-  glTextureParameteri(shadow_tex, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-  glTextureParameteri(shadow_tex, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
-  glTextureParameteri(shadow_tex, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+  GLuint shadow_tex = shadow_map_array(S, layers), shadow_fbo;
   glCreateFramebuffers(1, &shadow_fbo);
 
   // SH grid: one RGBA16F 3D texture, coefficient k in slices [k·nz, (k+1)·nz).
@@ -400,11 +392,7 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing,
     row[21] = m.lobe == Lobe::BlinnPhong ? 1.0f : 0.0f;
     materials.insert(materials.end(), row, row + kMaterialFloats);
   }
-  GLuint material_ssbo;
-  glCreateBuffers(1, &material_ssbo);
-  glNamedBufferStorage(material_ssbo, static_cast<GLsizeiptr>(std::max<size_t>(1, materials.size()) * sizeof(float)),
-                       materials.empty() ? nullptr : materials.data(), 0);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, material_ssbo);
+  const GLuint material_ssbo = storage_buffer(materials, 2);
 
   // Uniforms of the shading program.
   Mat4f vp = mul(cam.projection(), cam.view());
