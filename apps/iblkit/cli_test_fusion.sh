@@ -29,7 +29,7 @@ check eval ok "footprint \| on" -- "$BIN" fuse eval "$T/tc/probes.json" --scene 
 check no-point fail "exactly one of --at and --path" -- "$BIN" fuse "$T/tc/probes.json" --out "$T/x.exr"
 check point-in-wall fail "inside geometry or outside the proxy" -- "$BIN" fuse "$T/tc/probes.json" --at 0,1.5,12 --out "$T/x.exr"
 check bad-blend fail "unknown blend" -- "$BIN" fuse "$T/tc/probes.json" --at 0,1.5,1 --blend median --out "$T/x.exr"
-check missing-set fail "cannot open" -- "$BIN" fuse "$T/none.json" --at 0,1.5,1 --out "$T/x.exr"
+check missing-set fail "none.json: no such file" -- "$BIN" fuse "$T/none.json" --at 0,1.5,1 --out "$T/x.exr"
 printf '{"format":"iblkit.probes/1","proxy":"proxy.obj","probes":[{"image":"probes/p0.exr","position":[0,1.5,-1]},{"image":"probes/p1.exr","position":[0,1.5,14]}]}' > "$T/tc/outside.json"
 check probe-outside fail "probe 1.*outside the proxy" -- "$BIN" fuse "$T/tc/outside.json" --at 0,1.5,1 --out "$T/x.exr"
 cp "$T/tc/probes.json" "$T/tc/mismatch.json"

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "iblkit/core/error.h"
+#include "iblkit/core/json_file.h"
 #include "iblkit/geometry/mesh_io.h"
 #include "iblkit/ilf/shgrid.h"
 #include "iblkit/lights/light_set.h"
@@ -55,14 +56,7 @@ void load_lighting(const std::string& path, const LightingOptions& o, Lighting* 
     return;
   }
   if (ext == ".json") {
-    std::ifstream in(path);
-    if (!in) fail(ErrorKind::Io, "{}: cannot open", path);
-    nlohmann::json j;
-    try {
-      in >> j;
-    } catch (const std::exception& e) {
-      fail(ErrorKind::Format, "{}: not valid JSON ({})", path, e.what());
-    }
+    const nlohmann::json j = read_json_file(path);
     std::string format = j.value("format", "");
     if (format == "iblkit.lights/1") {
       lights::LightSet set = lights::from_json(j, path);

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "iblkit/core/error.h"
+#include "iblkit/core/json_file.h"
 #include "iblkit/lights/cut.h"
 #include "iblkit/lights/evaluate.h"
 #include "iblkit/sphere/pointset.h"
@@ -56,18 +57,10 @@ lights::LightSet localize_lights(const LocalMap& map, const LocalLightsDesc& des
 // ---- paths ------------------------------------------------------------------------------------
 
 std::vector<PathPoint> read_path(const std::string& path) {
-  std::ifstream f(path);
-  if (!f) fail(ErrorKind::Io, "cannot open path file {}", path);
-  nlohmann::json j;
-  try {
-    f >> j;
-  } catch (const nlohmann::json::exception& e) {
-    fail(ErrorKind::Format, "{}: not valid JSON ({})", path, e.what());
-  }
+  const nlohmann::json j = read_json_file(path);
   const nlohmann::json* pts = &j;
   if (j.is_object()) {
-    if (j.value("format", "") != "iblkit.path/1")
-      fail(ErrorKind::Format, "{}: not an iblkit.path/1 file (\"format\" is missing or different)", path);
+    require_format(j, path, "iblkit.path/1");
     if (!j.contains("points")) fail(ErrorKind::Format, "{}: field \"points\" is missing", path);
     pts = &j["points"];
   }

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "iblkit/core/error.h"
+#include "iblkit/core/json_file.h"
 #include "iblkit/core/parallel.h"
 #include "iblkit/geometry/mesh_io.h"
 #include "iblkit/io/envmap_io.h"
@@ -188,16 +189,8 @@ void prepare(ProbeSet& set, const ProgressFn& progress) {
 }
 
 ProbeSet load_probe_set(const std::string& manifest, const LoadDesc& desc) {
-  std::ifstream f(manifest);
-  if (!f) fail(ErrorKind::Io, "cannot open probe set {}", manifest);
-  json j;
-  try {
-    f >> j;
-  } catch (const json::exception& e) {
-    fail(ErrorKind::Format, "{}: not valid JSON ({})", manifest, e.what());
-  }
-  if (!j.is_object() || j.value("format", "") != "iblkit.probes/1")
-    fail(ErrorKind::Format, "{}: not an iblkit.probes/1 file (\"format\" is missing or different)", manifest);
+  const json j = read_json_file(manifest);
+  require_format(j, manifest, "iblkit.probes/1");
   if (!j.contains("proxy") || !j["proxy"].is_string())
     fail(ErrorKind::Format, "{}: field \"proxy\" (the proxy mesh file) is missing", manifest);
   if (!j.contains("probes") || !j["probes"].is_array() || j["probes"].empty())

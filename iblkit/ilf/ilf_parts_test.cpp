@@ -49,7 +49,7 @@ TEST(IlfSequence, BadManifests) {
   auto d = temp_dir("manifest");
   auto m = d + "/s.json";
   write_text(m, "{ not json");
-  expect_error([&] { read_sequence(m); }, {"s.json", "does not parse"});
+  expect_error([&] { read_sequence(m); }, {"s.json", "not valid JSON"});
   write_text(m, R"({"format":"iblkit.sequence/2","probes":[]})");
   expect_error([&] { read_sequence(m); }, {"\"format\""});
   write_text(m, R"({"format":"iblkit.sequence/1","mapping":"fisheye","probes":[]})");

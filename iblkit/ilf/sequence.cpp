@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "iblkit/core/error.h"
+#include "iblkit/core/json_file.h"
 
 namespace ibl::ilf {
 namespace fs = std::filesystem;
@@ -30,16 +31,8 @@ Vec3 vec3_field(const json& j, const std::string& what) {
 }  // namespace
 
 Sequence read_sequence(const std::string& path, const SequenceReadDesc& desc, SequenceReport* report) {
-  std::ifstream in(path);
-  if (!in) fail(ErrorKind::Io, "{}: cannot open the sequence manifest", path);
-  json j;
-  try {
-    j = json::parse(in);
-  } catch (const json::exception& e) {
-    fail(ErrorKind::Format, "{}: the manifest does not parse as JSON ({})", path, e.what());
-  }
-  if (!j.is_object() || j.value("format", "") != "iblkit.sequence/1")
-    fail(ErrorKind::Format, "{}: field \"format\" must be \"iblkit.sequence/1\"", path);
+  const json j = read_json_file(path);
+  require_format(j, path, "iblkit.sequence/1");
   Sequence seq;
   seq.manifest = path;
   std::string mapping = j.value("mapping", "mirrorball");

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "iblkit/core/error.h"
+#include "iblkit/core/json_file.h"
 #include "iblkit/geometry/mesh_io.h"
 #include "iblkit/io/envmap_io.h"
 #include "iblkit/io/image_io.h"
@@ -253,14 +254,7 @@ std::string resolve_scene_path(const std::string& name) {
 
 Scene load_scene(const std::string& name_or_path, bool build) {
   std::string path = resolve_scene_path(name_or_path);
-  std::ifstream in(path);
-  if (!in) fail(ErrorKind::Io, "{}: cannot open", path);
-  json j;
-  try {
-    j = json::parse(in);
-  } catch (const json::exception& e) {
-    fail(ErrorKind::Format, "{}: not valid JSON ({})", path, e.what());
-  }
+  const json j = read_json_file(path);
   Ctx c{path, fs::path(path).parent_path(), "scene"};
   if (j.value("format", "") != "iblkit.scene/1") c.bad("format", "expected \"iblkit.scene/1\"");
   Scene s;

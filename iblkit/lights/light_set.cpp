@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "iblkit/core/error.h"
+#include "iblkit/core/json_file.h"
 #include "iblkit/core/parallel.h"
 
 namespace ibl::lights {
@@ -236,15 +237,7 @@ void write_lights(const std::string& path, const LightSet& set) {
 }
 
 LightSet read_lights(const std::string& path) {
-  std::ifstream f(path);
-  if (!f) fail(ErrorKind::Io, "cannot open {}", path);
-  nlohmann::json j;
-  try {
-    f >> j;
-  } catch (const nlohmann::json::exception& e) {
-    fail(ErrorKind::Format, "{}: not valid JSON ({})", path, e.what());
-  }
-  return from_json(j, path);
+  return from_json(read_json_file(path), path);
 }
 
 }  // namespace ibl::lights

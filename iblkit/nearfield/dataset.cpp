@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "iblkit/core/error.h"
+#include "iblkit/core/json_file.h"
 #include "iblkit/io/image_io.h"
 #include "iblkit/nearfield/basis.h"
 
@@ -85,16 +86,8 @@ Vec2 vec2(const json& j, const std::string& what) {
 }  // namespace
 
 Dataset read_dataset(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) fail(ErrorKind::Io, "{}: no such file or not readable", path);
-  json j;
-  try {
-    j = json::parse(in);
-  } catch (const json::exception& e) {
-    fail(ErrorKind::Format, "{}: not JSON ({})", path, e.what());
-  }
-  if (!j.is_object() || j.value("format", "") != "iblkit.nearfield/1")
-    fail(ErrorKind::Format, "{}: not an iblkit.nearfield/1 manifest (\"format\" is missing or different)", path);
+  const json j = read_json_file(path);
+  require_format(j, path, "iblkit.nearfield/1");
   Dataset ds;
   ds.name = j.value("name", fs::path(path).stem().string());
   ds.luminaire = j.value("luminaire", "");

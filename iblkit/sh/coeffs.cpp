@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "iblkit/core/error.h"
+#include "iblkit/core/json_file.h"
 #include "iblkit/sh/basis.h"
 
 namespace ibl::sh {
@@ -86,15 +87,7 @@ void write_coeffs(const std::string& path, const Coeffs& c) {
 }
 
 Coeffs read_coeffs(const std::string& path) {
-  std::ifstream f(path);
-  if (!f) fail(ErrorKind::Io, "{}: cannot open", path);
-  nlohmann::json j;
-  try {
-    f >> j;
-  } catch (const nlohmann::json::exception& e) {
-    fail(ErrorKind::Format, "{}: not valid JSON ({})", path, e.what());
-  }
-  return coeffs_from_json(j, path);
+  return coeffs_from_json(read_json_file(path), path);
 }
 
 }  // namespace ibl::sh
