@@ -559,18 +559,26 @@ LightSet optimize_lights_from(const sphere::EnvMap& env, const std::vector<Vec3>
   return set;
 }
 
-LightSet optimize_lights(const sphere::EnvMap& env, const OptimizeDesc& desc, OptimizeReport* out_report) {
-  validate_probe(env, desc.count);
-  if (desc.normals_level < 0 || desc.normals_level > 7)
-    fail(ErrorKind::Value, "optimiser: normals level must be in [0, 7] (got {})", desc.normals_level);
-  auto normals = sphere::icosphere_face_centres(desc.normals_level);
-  auto gt = irradiance_ground_truth(env, normals);
+void check_normals_level(int level) {
+  if (level < kMinNormalsLevel || level > kMaxNormalsLevel)
+    fail(ErrorKind::Value, "optimiser: normals level must be in [{}, {}] (got {})", kMinNormalsLevel, kMaxNormalsLevel,
+         level);
+}
+
+LightSet initial_lights(const sphere::EnvMap& env, const OptimizeDesc& desc) {
   CutDesc cd;
   cd.count = desc.count;
-  LightSet init;
-  if (desc.init == "variance-cut") init = variance_cut(env, cd);
-  else if (desc.init == "median-cut") init = median_cut(env, cd);
-  else fail(ErrorKind::Value, "optimiser: unknown initialisation \"{}\" (variance-cut, median-cut)", desc.init);
+  if (desc.init == "variance-cut") return variance_cut(env, cd);
+  if (desc.init == "median-cut") return median_cut(env, cd);
+  fail(ErrorKind::Value, "optimiser: unknown initialisation \"{}\" (variance-cut, median-cut)", desc.init);
+}
+
+LightSet optimize_lights(const sphere::EnvMap& env, const OptimizeDesc& desc, OptimizeReport* out_report) {
+  validate_probe(env, desc.count);
+  check_normals_level(desc.normals_level);
+  auto normals = sphere::icosphere_face_centres(desc.normals_level);
+  auto gt = irradiance_ground_truth(env, normals);
+  LightSet init = initial_lights(env, desc);
   return optimize_lights_from(env, normals, gt, init.lights, desc, out_report);
 }
 

@@ -44,6 +44,9 @@
 
 namespace ibl::lights {
 
+// The icosphere levels the M normals may have: 20·4^level face centres, 20 to 327680.
+inline constexpr int kMinNormalsLevel = 0, kMaxNormalsLevel = 7;
+
 struct OptimizeDesc {
   int count = 16;                  // number of lights N ≥ 1
   int normals_level = 5;           // icosphere level of the M normals (5: the 20480 of Madsen & Laursen)
@@ -73,6 +76,13 @@ struct OptimizeReport {
 
 // The optimiser is part of every build (it needs only Eigen).
 inline constexpr bool kHaveOptimizer = true;
+
+// Throws ibl::Error (Value) unless level ∈ [kMinNormalsLevel, kMaxNormalsLevel].
+void check_normals_level(int level);
+
+// The starting lights of the optimiser: desc.init's cut ("variance-cut" or "median-cut") of desc.count
+// lights. Throws ibl::Error for another name.
+LightSet initial_lights(const sphere::EnvMap& env, const OptimizeDesc& desc);
 
 // Optimises N lights for a probe; normals and their ground truth are computed from desc.
 LightSet optimize_lights(const sphere::EnvMap& env, const OptimizeDesc& desc, OptimizeReport* report = nullptr);
