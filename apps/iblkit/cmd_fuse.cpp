@@ -14,6 +14,7 @@
 #include "fusion_pictures.h"
 #include "iblkit/core/error.h"
 #include "iblkit/fusion/local_lights.h"
+#include "iblkit/fusion/path.h"
 #include "iblkit/io/draw.h"
 #include "iblkit/io/image_io.h"
 #include "iblkit/io/tonemap.h"
@@ -138,82 +139,65 @@ void run_path(const FuseOpts& o, const std::string& probes, const std::string& p
               int nlights, double tau, bool no_filter) {
   auto set = load_probes_cli(probes, o.proxy_depth);
   auto path = fu::read_path(path_file);
-  fu::FuseDesc fd = fuse_desc(o);
-  if (fd.mapping != ibl::sphere::MappingKind::LatLong)
+  fu::PathDesc pd;
+  pd.fuse = fuse_desc(o);
+  if (pd.fuse.mapping != ibl::sphere::MappingKind::LatLong)
     ibl::fail(ibl::ErrorKind::Value, "--path writes lat-long maps (the lights are cut from them); drop --mapping {}", o.mapping);
-  if (nlights < 1) nlights = 16;
+  if (nlights >= 1) pd.lights = nlights;  // else the library's default
+  pd.track.filter = !no_filter;
+  pd.track.time_constant = tau;
   fs::path dir(out);
   fs::create_directories(dir / "frames");
   fs::create_directories(dir / "lights");
-  fu::LightTracker raw_tr({false, tau}), filt_tr({!no_filter, tau});
-  std::vector<ibl::lights::LightSet> raw_sets, filt_sets;
-  std::vector<std::vector<int>> raw_ids, filt_ids;
-  std::vector<ibl::sphere::EnvMap> maps;
   std::vector<std::pair<std::string, ibl::Image>> pics;
-  auto bar = progress_bar();
-  auto t0 = std::chrono::steady_clock::now();
   size_t every = std::max<size_t>(1, path.size() / 8);
-  for (size_t k = 0; k < path.size(); ++k) {
-    fu::LocalMap m = fu::fuse(set, path[k].position, fd);
-    for (const auto& w : m.warnings) info(fmt::format("warning: frame {}: {}", k, w));
-    auto raw = fu::localize_lights(m, {nlights});
-    double dt = k == 0 ? 0.0 : path[k].time - path[k - 1].time;
-    raw_sets.push_back(raw_tr.update(raw, dt));
-    raw_ids.push_back(raw_tr.ids());
-    auto filt = filt_tr.update(raw, dt);
-    filt_sets.push_back(filt);
-    filt_ids.push_back(filt_tr.ids());
-    maps.push_back(m.radiance);
-    std::string name = fmt::format("{:04d}", k);
-    ibl::io::write_image((dir / "frames" / (name + ".exr")).string(), m.radiance.image);
-    ibl::io::write_image((dir / "frames" / (name + "_depth.exr")).string(), m.depth);
-    auto lj = ibl::lights::to_json(filt);
-    for (size_t i = 0; i < filt.lights.size(); ++i) lj["lights"][i]["id"] = filt_tr.ids()[i];
-    lj["time"] = path[k].time;
+  auto write_frame = [&](const fu::PathFrame& f) {
+    for (const auto& w : f.map.warnings) info(fmt::format("warning: frame {}: {}", f.index, w));
+    std::string name = fmt::format("{:04d}", f.index);
+    ibl::io::write_image((dir / "frames" / (name + ".exr")).string(), f.map.radiance.image);
+    ibl::io::write_image((dir / "frames" / (name + "_depth.exr")).string(), f.map.depth);
+    auto lj = ibl::lights::to_json(f.filtered);
+    for (size_t i = 0; i < f.filtered.lights.size(); ++i) lj["lights"][i]["id"] = f.filtered_ids[i];
+    lj["time"] = f.point.time;
     std::ofstream(dir / "lights" / (name + ".json")) << lj.dump(1) << "\n";
-    if (k % every == 0 && pics.size() < 8) {
-      filt.regions = raw.regions;  // outlines of this frame's cut; markers at the filtered lights
-      pics.push_back({fmt::format("frame {} at ({:.2f}, {:.2f}, {:.2f})", k, path[k].position.x, path[k].position.y,
-                                  path[k].position.z),
-                      light_overlay(m.radiance, filt, 512, 8)});
+    if (f.index % every == 0 && pics.size() < 8) {
+      ibl::lights::LightSet filt = f.filtered;
+      filt.regions = f.cut.regions;  // outlines of this frame's cut; markers at the filtered lights
+      pics.push_back({fmt::format("frame {} at ({:.2f}, {:.2f}, {:.2f})", f.index, f.point.position.x, f.point.position.y,
+                                  f.point.position.z),
+                      light_overlay(f.map.radiance, filt, 512, 8)});
     }
-    if (bar) bar("path", static_cast<double>(k + 1) / path.size());
-  }
+  };
+  pd.progress = progress_bar();
+  auto r = fu::fuse_path(set, path, pd, write_frame);
   progress_done();
-  double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  auto fr = fu::light_flicker(raw_sets), ff = fu::light_flicker(filt_sets), fm = fu::map_flicker(maps);
-  double err_raw = fu::lights_vs_maps(raw_sets, maps), err_filt = fu::lights_vs_maps(filt_sets, maps);
-  double ex_raw = fu::excess_flicker(raw_sets, maps), ex_filt = fu::excess_flicker(filt_sets, maps);
-  constexpr int kShadowLights = 4;  // the lights a renderer would give shadow maps
-  double jit_raw = fu::shadow_light_jitter(raw_sets, raw_ids, kShadowLights);
-  double jit_filt = fu::shadow_light_jitter(filt_sets, filt_ids, kShadowLights);
   nlohmann::json j = {{"frames", path.size()},
-                      {"lights", nlights},
+                      {"lights", pd.lights},
                       {"time_constant", tau},
                       {"filter", !no_filter},
-                      {"seconds", secs},
-                      {"flicker", {{"map", {{"mean", fm.mean}, {"max", fm.max}}},
-                                   {"lights_unfiltered", {{"mean", fr.mean}, {"max", fr.max}}},
-                                   {"lights_filtered", {{"mean", ff.mean}, {"max", ff.max}}}}},
-                      {"excess_flicker", {{"unfiltered", ex_raw}, {"filtered", ex_filt}}},
-                      {"shadow_light_jitter_deg", {{"unfiltered", jit_raw * 180 / ibl::kPi}, {"filtered", jit_filt * 180 / ibl::kPi}}},
-                      {"lights_vs_map", {{"unfiltered", err_raw}, {"filtered", err_filt}}},
+                      {"seconds", r.seconds},
+                      {"flicker", {{"map", {{"mean", r.map_flicker.mean}, {"max", r.map_flicker.max}}},
+                                   {"lights_unfiltered", {{"mean", r.raw_flicker.mean}, {"max", r.raw_flicker.max}}},
+                                   {"lights_filtered", {{"mean", r.filtered_flicker.mean}, {"max", r.filtered_flicker.max}}}}},
+                      {"excess_flicker", {{"unfiltered", r.raw_excess}, {"filtered", r.filtered_excess}}},
+                      {"shadow_light_jitter_deg", {{"unfiltered", r.raw_jitter * 180 / ibl::kPi}, {"filtered", r.filtered_jitter * 180 / ibl::kPi}}},
+                      {"lights_vs_map", {{"unfiltered", r.raw_vs_maps}, {"filtered", r.filtered_vs_maps}}},
                       {"out", out}};
   std::ofstream(dir / "path_summary.json") << j.dump(1) << "\n";
   std::string png = (dir / "path.png").string();
   ibl::io::write_image(png, ibl::io::contact_sheet(pics, 2, 512, 256,
-                                                   fmt::format("{} frames, {} tracked lights (filter time constant {})", path.size(), nlights, tau)));
+                                                   fmt::format("{} frames, {} tracked lights (filter time constant {})", path.size(), pd.lights, tau)));
   emit(j, [&] {
-    fmt::print("fused {} frames along {} in {:.2f} s, {} lights each (tracked{})\n", path.size(), path_file, secs, nlights,
+    fmt::print("fused {} frames along {} in {:.2f} s, {} lights each (tracked{})\n", path.size(), path_file, r.seconds, pd.lights,
                no_filter ? "" : fmt::format(", low-pass τ = {}", tau));
     fmt::print("  flicker (frame-to-frame RMS change of the irradiance field / its mean), mean / max over frames:\n");
-    fmt::print("    the fused maps themselves   {:7.4f} / {:7.4f}\n", fm.mean, fm.max);
-    fmt::print("    lights, unfiltered          {:7.4f} / {:7.4f}\n", fr.mean, fr.max);
-    fmt::print("    lights, filtered            {:7.4f} / {:7.4f}\n", ff.mean, ff.max);
-    fmt::print("  change the maps do not make (RMS / mean): unfiltered {:.4f}, filtered {:.4f}\n", ex_raw, ex_filt);
+    fmt::print("    the fused maps themselves   {:7.4f} / {:7.4f}\n", r.map_flicker.mean, r.map_flicker.max);
+    fmt::print("    lights, unfiltered          {:7.4f} / {:7.4f}\n", r.raw_flicker.mean, r.raw_flicker.max);
+    fmt::print("    lights, filtered            {:7.4f} / {:7.4f}\n", r.filtered_flicker.mean, r.filtered_flicker.max);
+    fmt::print("  change the maps do not make (RMS / mean): unfiltered {:.4f}, filtered {:.4f}\n", r.raw_excess, r.filtered_excess);
     fmt::print("  shadow lights' jump per frame (first {}, luminance-weighted): unfiltered {:.2f}°, filtered {:.2f}°\n",
-               kShadowLights, jit_raw * 180 / ibl::kPi, jit_filt * 180 / ibl::kPi);
-    fmt::print("  lights vs their map's irradiance (RMS / mean): unfiltered {:.4f}, filtered {:.4f}\n", err_raw, err_filt);
+               pd.shadow_lights, r.raw_jitter * 180 / ibl::kPi, r.filtered_jitter * 180 / ibl::kPi);
+    fmt::print("  lights vs their map's irradiance (RMS / mean): unfiltered {:.4f}, filtered {:.4f}\n", r.raw_vs_maps, r.filtered_vs_maps);
     fmt::print("  wrote {}/frames/NNNN.exr (+_depth), {}/lights/NNNN.json, {}/path_summary.json, {}\n", out, out, out, png);
   });
 }

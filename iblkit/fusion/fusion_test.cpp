@@ -18,6 +18,7 @@
 #include "iblkit/core/error.h"
 #include "iblkit/fusion/fuse.h"
 #include "iblkit/fusion/local_lights.h"
+#include "iblkit/fusion/path.h"
 #include "iblkit/fusion/probe_set.h"
 #include "iblkit/geometry/mesh_io.h"
 #include "iblkit/io/image_io.h"
@@ -460,6 +461,78 @@ TEST(FusionPath, PathFilesWithAndWithoutTimes) {
   std::ofstream((dir / "d.json").string()) << R"([[0,1]])";
   expect_error([&] { read_path((dir / "d.json").string()); }, "points[0]");
   fs::remove_all(dir);
+}
+
+TEST(FusionPath, FusePathHandsOutEveryFrameAndMeasuresThem) {
+  // A bright patch on the ceiling of the box room; six timed points pass under it.
+  auto paint = [](Vec3 p, Vec3) {
+    bool in = std::abs(p.y - 3) < 1e-6 && std::abs(p.x - 0.5) < 0.3 && std::abs(p.z + 1) < 0.3;
+    return in ? Vec3{100, 95, 90} : Vec3{0.1, 0.12, 0.1};
+  };
+  auto set = painted_set(box_room(), {{0, 1.5, 0}, {1, 1.0, -1}}, {}, 64, paint);
+  std::vector<PathPoint> path;
+  for (int k = 0; k < 6; ++k) path.push_back({{-0.5 + 0.25 * k, 1.2, -0.5}, 0.5 * k});
+  PathDesc pd;
+  pd.fuse.size = 32;
+  pd.lights = 6;
+  pd.track.time_constant = 1.0;
+  std::vector<lights::LightSet> raw, filt;
+  std::vector<std::vector<int>> raw_ids, filt_ids;
+  std::vector<sphere::EnvMap> maps;
+  size_t calls = 0;
+  auto r = fuse_path(set, path, pd, [&](const PathFrame& f) {
+    EXPECT_EQ(f.index, calls++);
+    EXPECT_EQ(f.point.time, path[f.index].time);
+    // The frame's map is fuse() at the point, its lights the localised cut of that map, tracked.
+    LocalMap m = fuse(set, path[f.index].position, pd.fuse);
+    ASSERT_EQ(f.map.radiance.image.size(), m.radiance.image.size());
+    EXPECT_TRUE(std::equal(m.radiance.image.data(), m.radiance.image.data() + m.radiance.image.size(),
+                           f.map.radiance.image.data()));
+    auto cut = localize_lights(m, {pd.lights});
+    ASSERT_EQ(f.cut.lights.size(), cut.lights.size());
+    EXPECT_EQ(f.cut.regions.label, cut.regions.label);
+    ASSERT_EQ(f.raw.lights.size(), cut.lights.size());
+    ASSERT_EQ(f.filtered.lights.size(), cut.lights.size());
+    EXPECT_EQ(f.raw_ids.size(), cut.lights.size());
+    EXPECT_EQ(f.filtered_ids.size(), cut.lights.size());
+    for (size_t i = 0; i < cut.lights.size(); ++i)  // the raw tracker only names the lights
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(f.raw.lights[i].irradiance[c], cut.lights[i].irradiance[c], 1e-12);
+    // The filter keeps the frame's total power.
+    double y = luminance(lights::total_irradiance(cut));
+    EXPECT_NEAR(luminance(lights::total_irradiance(f.filtered)), y, 1e-9 * y);
+    raw.push_back(f.raw);
+    filt.push_back(f.filtered);
+    raw_ids.push_back(f.raw_ids);
+    filt_ids.push_back(f.filtered_ids);
+    maps.push_back(f.map.radiance);
+  });
+  EXPECT_EQ(calls, path.size());
+  EXPECT_EQ(r.frames, path.size());
+  EXPECT_GE(r.seconds, 0);
+  // The measures are local_lights.h's of the frames it handed out.
+  EXPECT_EQ(r.map_flicker.mean, map_flicker(maps).mean);
+  EXPECT_EQ(r.raw_flicker.mean, light_flicker(raw).mean);
+  EXPECT_EQ(r.filtered_flicker.max, light_flicker(filt).max);
+  EXPECT_EQ(r.raw_excess, excess_flicker(raw, maps));
+  EXPECT_EQ(r.filtered_excess, excess_flicker(filt, maps));
+  EXPECT_EQ(r.raw_jitter, shadow_light_jitter(raw, raw_ids, pd.shadow_lights));
+  EXPECT_EQ(r.filtered_jitter, shadow_light_jitter(filt, filt_ids, pd.shadow_lights));
+  EXPECT_EQ(r.raw_vs_maps, lights_vs_maps(raw, maps));
+  EXPECT_EQ(r.filtered_vs_maps, lights_vs_maps(filt, maps));
+  EXPECT_GT(r.map_flicker.mean, 0);  // the points move: the maps change
+  // Without the filter the two trackers are the same.
+  pd.track.filter = false;
+  auto same = fuse_path(set, path, pd);
+  EXPECT_EQ(same.raw_flicker.mean, same.filtered_flicker.mean);
+  EXPECT_EQ(same.raw_vs_maps, same.filtered_vs_maps);
+  // Bad settings are named.
+  pd.fuse.mapping = sphere::MappingKind::CubeHCross;
+  expect_error([&] { fuse_path(set, path, pd); }, "lat-long");
+  pd.fuse.mapping = sphere::MappingKind::LatLong;
+  pd.lights = 0;
+  expect_error([&] { fuse_path(set, path, pd); }, "lights = 0");
+  pd.lights = 4;
+  expect_error([&] { fuse_path(set, {}, pd); }, "no points");
 }
 
 }  // namespace
