@@ -230,16 +230,18 @@ void setup(CLI::App& app) {
     FuseOpts f;
     std::string probes, at, out, path;
     int lights = 0, bands = 3;
-    double tau = 2.0;
-    bool no_filter = false, force = false;
+    double tau = fu::PathDesc{}.track.time_constant;
+    bool no_filter = !fu::PathDesc{}.track.filter, force = false;
     std::string depth_probes;
   };
   auto* o = new Opts();
+  o->f.size = 128;  // --at and --path write the maps themselves: finer than the library's default
   app.add_option("probes", o->probes, "probe set (iblkit.probes/1)");
   app.add_option("--at", o->at, "the point x,y,z");
   app.add_option("--path", o->path, "a path file (iblkit.path/1 or [[x,y,z], …]): a map and lights per point");
   app.add_option("-o,--out", o->out, "--at: the map (.exr; _depth, _coverage, _sh.json, _lights.json, .png beside it); --path: a folder");
-  app.add_option("--lights", o->lights, "median-cut lights localised by depth (--at: 0 = none; --path: default 16)");
+  app.add_option("--lights", o->lights,
+                 fmt::format("median-cut lights localised by depth (--at: 0 = none; --path: default {})", fu::PathDesc{}.lights));
   app.add_option("--bands", o->bands, "SH bands of the map's projection (0: none)")->capture_default_str();
   app.add_option("--tau", o->tau, "--path: time constant of the lights' low-pass filter (path time units; frames when untimed)")
       ->capture_default_str();

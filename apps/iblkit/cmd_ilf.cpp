@@ -69,20 +69,47 @@ nlohmann::json report_json(const ilf::BuildReport& r) {
           {"samples_per_s", r.t_total > 0 ? r.samples / r.t_total : 0.0}};
 }
 
+// Inverse of parse_bytes for the --memory default: whole gibibytes or mebibytes as "2G", "512M".
+std::string format_bytes(size_t bytes) {
+  if (bytes % (size_t(1) << 30) == 0) return fmt::format("{}G", bytes >> 30);
+  if (bytes % (size_t(1) << 20) == 0) return fmt::format("{}M", bytes >> 20);
+  return fmt::format("{}B", bytes);
+}
+
+// --directions of BucketDesc::octahedral: −1 auto, 0 pixel, n an n×n octahedral grid.
+std::string directions_name(int octahedral) {
+  return octahedral < 0 ? "auto" : octahedral == 0 ? "pixel" : std::to_string(octahedral);
+}
+
+// A CLI11 check: empty when `v` is a number > 0 (or no number at all: the conversion then says so).
+std::string positive_number(const std::string& v) {
+  char* end = nullptr;
+  double d = std::strtod(v.c_str(), &end);
+  if (end == v.c_str() || *end != '\0') return "";
+  return d > 0 ? "" : "must be > 0, got " + v;
+}
+
 void setup_build(CLI::App& app) {
+  // Defaults come from BuildDesc (and the descs it holds); the strings are their parsed forms.
   struct Opts {
-    std::string seq, out, grid = "16", volume, repair = "mip", memory = "2G", buckets, vdb, directions = "auto";
-    int bands = 5;
-    double kernel = 3.0, subsample = -1, subsample_dist = 0.05;
-    bool skip_bad = false, sanitize = false, no_reuse = false;
+    ilf::BuildDesc bd;
+    std::string seq, out, volume, buckets, vdb;
+    std::string grid = bd.nx == bd.ny && bd.ny == bd.nz ? std::to_string(bd.nx) : fmt::format("{},{},{}", bd.nx, bd.ny, bd.nz);
+    std::string repair = ilf::repair_name(bd.project.repair), memory = format_bytes(bd.buckets.memory_bytes);
+    std::string directions = directions_name(bd.buckets.octahedral);
+    double subsample = -1, subsample_dist = ilf::SubsampleDesc{}.max_distance;  // subsample < 0: off
+    bool no_reuse = !bd.buckets.reuse;
   };
   auto* o = new Opts();
+  auto& bd0 = o->bd;
   app.add_option("sequence", o->seq, "iblkit.sequence/1 manifest")->required();
   app.add_option("-o,--out", o->out, "output .shgrid")->required();
   app.add_option("--grid", o->grid, "grid points: N or NX,NY,NZ")->capture_default_str();
-  app.add_option("--bands", o->bands, "SH bands (5 = 25 coefficients)")->capture_default_str()->check(CLI::Range(1, 10));
+  app.add_option("--bands", bd0.bands, "SH bands (5 = 25 coefficients)")->capture_default_str()
+      ->check(CLI::Range(ilf::kMinBuildBands, ilf::kMaxBuildBands));
   app.add_option("--volume", o->volume, "grid volume minx,miny,minz,maxx,maxy,maxz (default: the sequence's)");
-  app.add_option("--kernel", o->kernel, "Gaussian kernel support diameter in grid cells")->capture_default_str();
+  app.add_option("--kernel", bd0.project.kernel_cells, "Gaussian kernel support diameter in grid cells")->capture_default_str()
+      ->check(positive_number);
   app.add_option("--repair", o->repair, "filling of grid points no ray reached: mip (the paper's), pullpush, none")->capture_default_str();
   app.add_option("--memory", o->memory, "peak memory budget (e.g. 2G, 512M)")->capture_default_str();
   app.add_option("--buckets", o->buckets, "folder for the direction buckets (default: OUT.buckets; reused by re-runs)");
@@ -90,23 +117,19 @@ void setup_build(CLI::App& app) {
   app.add_option("--subsample", o->subsample, "drop probes whose difference energy to both neighbours is below this (e.g. 0.05)");
   app.add_option("--subsample-distance", o->subsample_dist, "… and whose neighbours lie within this many metres")->capture_default_str();
   app.add_option("--vdb", o->vdb, "also write the grid as OpenVDB (one Vec3f grid per coefficient)");
-  app.add_flag("--skip-bad", o->skip_bad, "skip bad probes (missing/unreadable frames, wrong size, NaN, outside the volume, duplicates) and report how many");
-  app.add_flag("--sanitize", o->sanitize, "replace NaN/Inf/negative pixels by 0 instead of failing");
+  app.add_flag("--skip-bad", bd0.buckets.skip_bad, "skip bad probes (missing/unreadable frames, wrong size, NaN, outside the volume, duplicates) and report how many");
+  app.add_flag("--sanitize", bd0.buckets.sanitize, "replace NaN/Inf/negative pixels by 0 instead of failing");
   app.add_flag("--no-reuse", o->no_reuse, "rebuild the direction buckets even when an earlier run's match");
   app.footer("Example:\n  iblkit ilf build captures/sequence.json --grid 32 --bands 5 --out room.shgrid");
   app.callback([o] {
     auto grid = parse_grid(o->grid);
     if (!o->vdb.empty() && !ilf::have_vdb()) ilf::write_vdb(o->vdb, ilf::SHGrid());  // fails now, not after the build
-    ilf::BuildDesc bd;
+    ilf::BuildDesc bd = o->bd;
     bd.nx = grid[0]; bd.ny = grid[1]; bd.nz = grid[2];
-    bd.bands = o->bands;
     if (!o->volume.empty()) bd.volume = parse_box(o->volume);
-    bd.project.kernel_cells = o->kernel;
     bd.project.repair = ilf::parse_repair(o->repair);
     bd.buckets.memory_bytes = parse_bytes(o->memory);
     bd.buckets.dir = o->buckets.empty() ? o->out + ".buckets" : o->buckets;
-    bd.buckets.skip_bad = o->skip_bad;
-    bd.buckets.sanitize = o->sanitize;
     bd.buckets.reuse = !o->no_reuse;
     if (o->directions == "auto") bd.buckets.octahedral = -1;
     else if (o->directions == "pixel") bd.buckets.octahedral = 0;
@@ -117,7 +140,7 @@ void setup_build(CLI::App& app) {
     }
     if (o->subsample >= 0) bd.subsample = ilf::SubsampleDesc{o->subsample, o->subsample_dist};
     ilf::SequenceReadDesc rd;
-    rd.skip_bad = o->skip_bad;
+    rd.skip_bad = bd.buckets.skip_bad;
     ilf::SequenceReport srep;
     auto seq = ilf::read_sequence(o->seq, rd, &srep);
     ilf::BuildReport rep;
@@ -264,7 +287,7 @@ void setup_info(CLI::App& app) {
 
 void setup_synth(CLI::App& app) {
   auto* d = new ilf::SynthDesc();
-  bool* pfm = new bool(false);
+  bool* pfm = new bool(!d->half);
   app.add_option("-o,--out", d->out_dir, "output folder (frames/ and sequence.json)")->required();
   app.add_option("--probes", d->probes, "number of probes")->capture_default_str()->check(CLI::Range(1, 1000000));
   app.add_option("--size", d->size, "mirror-ball frame size in pixels")->capture_default_str()->check(CLI::Range(8, 4096));

@@ -6,15 +6,18 @@
 
 #include "iblkit/fusion/fuse.h"
 #include "iblkit/fusion/probe_set.h"
+#include "iblkit/sphere/mapping.h"
 
 namespace iblcli {
 
-// The fusing options every `fuse` form takes.
+// The fusing options every `fuse` form takes, initialised from the library's FuseDesc defaults (a
+// command that wants another default sets it before add_fuse_options, which shows it in --help).
 struct FuseOpts {
-  std::string mapping = "latlong", blend = "footprint";
-  int size = 128, samples = 1;
-  double bias = 0.01, tolerance = 0.10, threshold = 0.0;
-  bool no_visibility = false, proxy_depth = false;
+  static inline const ibl::fusion::FuseDesc kDefaults{};
+  std::string mapping = ibl::sphere::mapping_name(kDefaults.mapping), blend = ibl::fusion::blend_name(kDefaults.blend);
+  int size = kDefaults.size, samples = kDefaults.samples;
+  double bias = kDefaults.depth_bias, tolerance = kDefaults.depth_tolerance, threshold = kDefaults.angle_threshold;
+  bool no_visibility = !kDefaults.visibility, proxy_depth = false;
 };
 void add_fuse_options(CLI::App& app, FuseOpts& o);
 ibl::fusion::FuseDesc fuse_desc(const FuseOpts& o);

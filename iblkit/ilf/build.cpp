@@ -51,8 +51,10 @@ SHGrid build_shgrid(const Sequence& seq_in, const BuildDesc& desc, const Progres
   auto t_all = Clock::now();
   BuildReport local;
   BuildReport& rep = report ? *report : local;
-  if (desc.bands < 1 || desc.bands > 10) fail(ErrorKind::Value, "--bands {} outside [1, 10]", desc.bands);
-  if (!(desc.project.kernel_cells > 0)) fail(ErrorKind::Value, "--kernel {} must be > 0 cells", desc.project.kernel_cells);
+  if (desc.bands < kMinBuildBands || desc.bands > kMaxBuildBands)
+    fail(ErrorKind::Value, "bands {} outside [{}, {}]", desc.bands, kMinBuildBands, kMaxBuildBands);
+  if (!(desc.project.kernel_cells > 0))
+    fail(ErrorKind::Value, "kernel_cells {} must be > 0 (the kernel's support in grid cells)", desc.project.kernel_cells);
   GridDesc grid{desc.nx, desc.ny, desc.nz, desc.volume ? *desc.volume : seq_in.volume};
   SHGrid out(grid, desc.bands);  // validates resolution, bands and volume
   rep.probes_in = int(seq_in.probes.size());

@@ -15,12 +15,15 @@
 
 namespace ibl::ilf {
 
+// The SH bands a build accepts (BuildDesc::bands).
+inline constexpr int kMinBuildBands = 1, kMaxBuildBands = 10;
+
 struct BuildDesc {
   int nx = 16, ny = 16, nz = 16;      // grid resolution (points per axis)
   std::optional<Box> volume;          // grid volume; default the sequence's volume
-  int bands = 5;                      // SH bands (5 = 25 coefficients)
+  int bands = 5;                      // SH bands (5 = 25 coefficients), in [kMinBuildBands, kMaxBuildBands]
   ProjectDesc project;                // kernel, raster, repair
-  BucketDesc buckets;                 // bucket folder, memory budget, skip-bad; octahedral = −1 for auto
+  BucketDesc buckets{.octahedral = -1};  // bucket folder, memory budget, skip-bad; octahedral −1: auto (below)
   int auto_pixel_buckets = 1 << 20;   // auto: one bucket per pixel when a frame has at most this many pixels
   int auto_octahedral = 256;          // auto: otherwise n×n octahedral buckets with this n
   std::optional<SubsampleDesc> subsample;  // sub-sample first when set
