@@ -219,7 +219,7 @@ BucketStore BucketStore::sort(const Sequence& seq, const BucketDesc& desc, const
       }
       if (!bad.empty()) {
         std::string msg = fmt::format("{}: probe {}: {}", seq.manifest, p, bad);
-        if (!desc.skip_bad) fail(ErrorKind::Value, "{} (use --skip-bad to skip such probes)", msg);
+        if (!desc.skip_bad) fail(ErrorKind::Value, "{} (skip_bad skips such probes)", msg);
         std::fill(rgb.begin(), rgb.end(), 0.0f);
         std::lock_guard lk(mu);
         st.valid_[p] = 0;

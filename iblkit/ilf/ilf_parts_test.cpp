@@ -62,7 +62,7 @@ TEST(IlfSequence, BadManifests) {
   write_text(m, R"({"format":"iblkit.sequence/1","volume":{"min":[0,0,0],"max":[1,1,1]},"probes":[
     {"image":"a.exr","position":[0.5,0.5,0.5]},{"image":"b.exr","position":[2,0.5,0.5]},
     {"image":"c.exr","position":[0.5,0.5,0.5]},{"image":"d.exr","position":[0.2,0.5,0.5]}]})");
-  expect_error([&] { read_sequence(m); }, {"probe 1", "outside the volume", "--skip-bad"});
+  expect_error([&] { read_sequence(m); }, {"probe 1", "outside the volume", "skip_bad"});
   SequenceReadDesc rd;
   rd.skip_bad = true;
   SequenceReport rep;

@@ -21,7 +21,7 @@ Repair parse_repair(const std::string& s) {
   if (s == "none") return Repair::None;
   if (s == "mip") return Repair::Mip;
   if (s == "pullpush" || s == "pull-push") return Repair::PullPush;
-  fail(ErrorKind::Value, "--repair: unknown method \"{}\" (none, mip, pullpush)", s);
+  fail(ErrorKind::Value, "repair: unknown method \"{}\" (none, mip, pullpush)", s);
 }
 
 namespace {

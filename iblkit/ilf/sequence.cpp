@@ -101,7 +101,7 @@ Sequence read_sequence(const std::string& path, const SequenceReadDesc& desc, Se
     }
     if (!problem.empty()) {
       std::string msg = fmt::format("{}: probe {} ({}): {}", path, i, e.image, problem);
-      if (!desc.skip_bad) fail(ErrorKind::Value, "{} (use --skip-bad to drop such probes)", msg);
+      if (!desc.skip_bad) fail(ErrorKind::Value, "{} (skip_bad drops such probes)", msg);
       if (report) { ++report->skipped; report->reasons.push_back(msg); }
       continue;
     }

@@ -64,7 +64,7 @@ void write_vdb(const std::string& path, const SHGrid& g) {
 bool have_vdb() { return false; }
 
 void write_vdb(const std::string& path, const SHGrid&) {
-  fail(ErrorKind::Unsupported, "{}: this build has no OpenVDB (configure with OpenVDB found to enable --vdb)", path);
+  fail(ErrorKind::Unsupported, "{}: this build has no OpenVDB (configure with OpenVDB found to write .vdb grids)", path);
 }
 
 #endif

@@ -46,7 +46,7 @@ int check_pixels(Image& img, const std::string& what, bool sanitize) {
       size_t p = i / nc;
       int x = static_cast<int>(p % img.width()), y = static_cast<int>(p / img.width());
       const char* kind = std::isnan(v) ? "NaN" : (std::isinf(v) ? "Inf" : "negative");
-      fail(ErrorKind::Value, "{}: pixel ({}, {}) channel {} is {} ({}); use --sanitize to replace such values by 0",
+      fail(ErrorKind::Value, "{}: pixel ({}, {}) channel {} is {} ({}); sanitize replaces such values by 0",
            what, x, y, static_cast<int>(i % nc), kind, v);
     }
     d[i] = 0.0f;

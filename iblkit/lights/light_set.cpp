@@ -54,7 +54,7 @@ void validate_probe(const sphere::EnvMap& env, int count) {
     const Row& r = rows[y];
     if (r.bad_x >= 0) {
       float v = img.pixel(r.bad_x, y)[r.bad_c];
-      fail(ErrorKind::Value, "probe pixel ({}, {}) channel {} is {} (use --sanitize)", r.bad_x, y, r.bad_c,
+      fail(ErrorKind::Value, "probe pixel ({}, {}) channel {} is {} (reading it with sanitize replaces such values by 0)", r.bad_x, y, r.bad_c,
            std::isfinite(v) ? fmt::format("negative ({})", v) : fmt::format("{}", v));
     }
     lit += r.lit;

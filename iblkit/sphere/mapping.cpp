@@ -62,7 +62,7 @@ MappingKind detect_mapping(int width, int height, std::string_view file_name) {
   if (width == 6 * height) return MappingKind::CubeStrip;
   fail(ErrorKind::Value,
        "cannot tell the mapping of a {}x{} image{}{}: expected 2:1 (latlong), 1:1 (mirrorball/angular/"
-       "octahedral), 4:3 or 3:4 (cube cross) or 6:1 (cube strip); name it with --mapping",
+       "octahedral), 4:3 or 3:4 (cube cross) or 6:1 (cube strip); name the mapping",
        width, height, name.empty() ? "" : " ", std::string(file_name));
 }
 
