@@ -16,6 +16,7 @@
 #include "iblkit/core/error.h"
 #include "iblkit/core/parallel.h"
 #include "iblkit/fusion/local_lights.h"
+#include "iblkit/geometry/camera.h"
 #include "iblkit/io/draw.h"
 #include "iblkit/io/image_io.h"
 #include "iblkit/io/tonemap.h"
@@ -58,32 +59,33 @@ double image_rmse(const ibl::sphere::EnvMap& est, const ibl::sphere::EnvMap& tru
   return sy > 0 ? std::sqrt(s2 / sw) / (sy / sw) : 0;
 }
 
-struct Camera {
-  Vec3 f, r, u;
-  int w = 320, h = 200;
-  double tan_half = 1.0;  // 90° horizontal field of view
-  Camera(Vec3 forward) {
-    f = ibl::normalize(forward);
-    Vec3 up = std::abs(f.y) > 0.99 ? Vec3{0, 0, 1} : Vec3{0, 1, 0};
-    r = ibl::normalize(ibl::cross(f, up));
-    u = ibl::cross(r, f);
-  }
-  std::vector<Vec3> rays() const {
-    std::vector<Vec3> d;
-    for (int j = 0; j < h; ++j)
-      for (int i = 0; i < w; ++i) {
-        double sx = (2 * (i + 0.5) / w - 1) * tan_half, sy = (1 - 2 * (j + 0.5) / h) * tan_half * h / w;
-        d.push_back(ibl::normalize(f + r * sx + u * sy));
-      }
-    return d;
-  }
-  Image to_image(const std::vector<Vec3>& L) const {
-    Image img(w, h, 3);
-    for (int j = 0; j < h; ++j)
-      for (int i = 0; i < w; ++i) img.set_rgb(i, j, L[static_cast<size_t>(j) * w + i]);
-    return img;
-  }
-};
+// The pinhole of --view: 320×200 pixels with a 90° horizontal field of view, at x looking along `forward`.
+ibl::geometry::Camera view_camera(Vec3 x, Vec3 forward) {
+  ibl::geometry::Camera c;
+  const Vec3 f = ibl::normalize(forward);
+  c.eye = x;
+  c.target = x + f;
+  c.up = std::abs(f.y) > 0.99 ? Vec3{0, 0, 1} : Vec3{0, 1, 0};
+  c.width = 320;
+  c.height = 200;
+  c.fov_y_deg = 2 * std::atan(1.0 * c.height / c.width) * 180 / ibl::kPi;  // tan(45°)·h/w vertically
+  return c;
+}
+
+// Every pixel's direction, row-major.
+std::vector<Vec3> rays(const ibl::geometry::Camera& c) {
+  std::vector<Vec3> d;
+  for (int j = 0; j < c.height; ++j)
+    for (int i = 0; i < c.width; ++i) d.push_back(c.pixel_direction(i, j));
+  return d;
+}
+
+Image to_image(const ibl::geometry::Camera& c, const std::vector<Vec3>& L) {
+  Image img(c.width, c.height, 3);
+  for (int j = 0; j < c.height; ++j)
+    for (int i = 0; i < c.width; ++i) img.set_rgb(i, j, L[static_cast<size_t>(j) * c.width + i]);
+  return img;
+}
 
 // The lab's radiance along each ray (4 random streams per ray, averaged).
 std::vector<Vec3> truth_rays(const ibl::lab::Scene& scene, Vec3 x, const std::vector<Vec3>& dirs, int area_samples) {
@@ -147,18 +149,18 @@ std::vector<EvalRow> evaluate(const fu::ProbeSet& set, const ibl::lab::Scene& sc
     if (pictures) pictures->push_back({"fusion vs truth at " + pname, png});
     if (!view.empty()) {
       // The thesis's Fig. 7.8: the back-projected probes seen from x, angle blend, visibility off/on.
-      Camera cam(parse_vec3(view, "--view"));
-      auto dirs = cam.rays();
+      const auto cam = view_camera(x, parse_vec3(view, "--view"));
+      auto dirs = rays(cam);
       auto t = truth_rays(scene, x, dirs, area_samples);
-      double s = ibl::io::auto_exposure_scale(cam.to_image(t));
-      std::vector<std::pair<std::string, Image>> vs = {{"lab truth", tone(cam.to_image(t), s)}};
+      double s = ibl::io::auto_exposure_scale(to_image(cam, t));
+      std::vector<std::pair<std::string, Image>> vs = {{"lab truth", tone(to_image(cam, t), s)}};
       for (bool vis : {false, true})
         for (const char* bl : {"angle", "footprint"}) {
           FuseOpts o = fo;
           o.blend = bl;
           o.no_visibility = !vis;
           auto L = fu::fuse_rays(set, x, dirs, fuse_desc(o));
-          vs.push_back({fmt::format("{} blend, visibility {}", bl, vis ? "on" : "off (thesis Fig. 7.8)"), tone(cam.to_image(L), s)});
+          vs.push_back({fmt::format("{} blend, visibility {}", bl, vis ? "on" : "off (thesis Fig. 7.8)"), tone(to_image(cam, L), s)});
         }
       std::string vpng = (dir / fmt::format("point{}_view.png", k)).string();
       ibl::io::write_image(vpng, ibl::io::contact_sheet(vs, 3, 320, 200, "view from " + pname + " along " + view));

@@ -207,11 +207,11 @@ void run_render(const RenderOpts& o) {
   if (o.out.empty()) ibl::fail(ibl::ErrorKind::Value, "--out VIEW.png is required");
   auto scene = ibl::lab::load_scene(o.scene);
   nf::SceneView sv(scene);
-  nf::View view;
+  ibl::geometry::Camera view;
   view.eye = iblcli::parse_vec3(o.eye, "--eye");
   view.target = iblcli::parse_vec3(o.target, "--target");
   view.width = view.height = o.size;
-  view.vfov_deg = o.fov;
+  view.fov_y_deg = o.fov;
   const auto pl = placement_of(o.light);
   std::vector<nf::TexturedSpotlight> lights;
   nf::Dataset ds;
@@ -470,10 +470,10 @@ void nearfield_step(iblcli::DemoContext& ctx) {
     if (std::string(name) == "bikelight") {
       auto scene = ibl::lab::load_scene("crypt");
       nf::SceneView sv(scene);
-      nf::View view;
+      ibl::geometry::Camera view;
       view.eye = {0.9, 1.5, 0.9};
       view.target = {-1.1, 0.3, -1.5};
-      view.vfov_deg = 55;
+      view.fov_y_deg = 55;
       view.width = view.height = 160;
       LightOpts lo;
       auto pl = placement_of(lo);

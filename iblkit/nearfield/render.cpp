@@ -88,12 +88,8 @@ SceneView::SceneView(const lab::Scene& scene) : scene_(&scene) {
   tracer_.commit();
 }
 
-bool SceneView::primary(const View& v, int x, int y, Vec3* p, Vec3* n, Vec3* albedo) const {
-  const Vec3 fwd = normalize(v.target - v.eye);
-  const Vec3 right = normalize(cross(fwd, v.up)), up = cross(right, fwd);
-  const double th = std::tan(0.5 * v.vfov_deg * kPi / 180), aspect = static_cast<double>(v.width) / v.height;
-  const double sx = (2 * (x + 0.5) / v.width - 1) * th * aspect, sy = (1 - 2 * (y + 0.5) / v.height) * th;
-  const Vec3 d = normalize(fwd + right * sx + up * sy);
+bool SceneView::primary(const geometry::Camera& v, int x, int y, Vec3* p, Vec3* n, Vec3* albedo) const {
+  const Vec3 d = v.pixel_direction(x, y);
   const auto hit = tracer_.intersect(v.eye, d);
   if (!hit.hit) return false;
   const auto& s = scene_->surfaces[static_cast<size_t>(surface_of_mesh_[hit.mesh])];
@@ -114,13 +110,13 @@ bool SceneView::blocked(Vec3 p, Vec3 q) const { return tracer_.occluded(p, q - p
 
 namespace {
 
-void check_view(const View& v) {
-  if (v.width < 1 || v.height < 1 || v.width > 16384 || v.height > 16384 || !(v.vfov_deg > 0 && v.vfov_deg < 179))
-    fail(ErrorKind::Value, "view: {}x{} pixels, field of view {}°: out of range", v.width, v.height, v.vfov_deg);
+void check_view(const geometry::Camera& v) {
+  if (v.width < 1 || v.height < 1 || v.width > 16384 || v.height > 16384 || !(v.fov_y_deg > 0 && v.fov_y_deg < 179))
+    fail(ErrorKind::Value, "view: {}x{} pixels, field of view {}°: out of range", v.width, v.height, v.fov_y_deg);
 }
 
 template <typename Shade>
-Image render_rows(const SceneView& sv, const View& view, const ProgressFn& progress, Shade shade) {
+Image render_rows(const SceneView& sv, const geometry::Camera& view, const ProgressFn& progress, Shade shade) {
   check_view(view);
   Image out(view.width, view.height, 3);
   std::atomic<int> done{0};
@@ -137,7 +133,7 @@ Image render_rows(const SceneView& sv, const View& view, const ProgressFn& progr
 
 }  // namespace
 
-Image render_spotlights(const SceneView& sv, const std::vector<TexturedSpotlight>& lights, const View& view, bool shadows,
+Image render_spotlights(const SceneView& sv, const std::vector<TexturedSpotlight>& lights, const geometry::Camera& view, bool shadows,
                         const ProgressFn& progress, int srgbe_group) {
   if (srgbe_group < 0) fail(ErrorKind::Value, "sRGBE pass size {} must be ≥ 0", srgbe_group);
   return render_rows(sv, view, progress, [&](Vec3 p, Vec3 n) {
@@ -155,7 +151,7 @@ Image render_spotlights(const SceneView& sv, const std::vector<TexturedSpotlight
   });
 }
 
-Image render_exact(const SceneView& sv, const Luminaire& lum, const Placement& placement, const View& view, bool shadows,
+Image render_exact(const SceneView& sv, const Luminaire& lum, const Placement& placement, const geometry::Camera& view, bool shadows,
                    const ProgressFn& progress) {
   const Frame f = placement.frame();
   std::vector<Vec3> centres;

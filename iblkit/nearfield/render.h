@@ -10,6 +10,7 @@
 
 #include "iblkit/core/image.h"
 #include "iblkit/core/progress.h"
+#include "iblkit/geometry/camera.h"
 #include "iblkit/geometry/raytracer.h"
 #include "iblkit/lab/scene.h"
 #include "iblkit/nearfield/luminaire.h"
@@ -39,20 +40,13 @@ struct ErrorStats {
 };
 ErrorStats compare(const Image& approx, const Image& exact);
 
-// A pinhole camera.
-struct View {
-  Vec3 eye{0, 1.6, 3.5}, target{0, 1, 0}, up{0, 1, 0};
-  double vfov_deg = 60;
-  int width = 400, height = 400;
-};
-
 // The lab scene's diffuse surfaces in a ray tracer of their own (its emitters' geometry is left out).
 class SceneView {
  public:
   explicit SceneView(const lab::Scene& scene);
-  // First diffuse hit of the camera ray through pixel centre (x, y): position, normal (towards the
+  // First diffuse hit of the camera ray through the centre of pixel (x, y): position, normal (towards the
   // eye), albedo; false when the ray leaves the scene.
-  bool primary(const View& view, int x, int y, Vec3* p, Vec3* n, Vec3* albedo) const;
+  bool primary(const geometry::Camera& view, int x, int y, Vec3* p, Vec3* n, Vec3* albedo) const;
   // True when the segment p → q is blocked (p is offset along its normal by the caller).
   bool blocked(Vec3 p, Vec3 q) const;
 
@@ -66,9 +60,9 @@ class SceneView {
 // `srgbe_group` > 0 emulates the paper's 8-bit frame buffer (§4.1–4.2): the spotlights are summed in
 // passes of that many (the paper: 3), and after every pass the running irradiance sum is stored as
 // sRGBE (rgbe.h) and read back, as between the paper's rendering passes.
-Image render_spotlights(const SceneView& sv, const std::vector<TexturedSpotlight>& lights, const View& view,
+Image render_spotlights(const SceneView& sv, const std::vector<TexturedSpotlight>& lights, const geometry::Camera& view,
                         bool shadows, const ProgressFn& progress = {}, int srgbe_group = 0);
-Image render_exact(const SceneView& sv, const Luminaire& lum, const Placement& placement, const View& view,
+Image render_exact(const SceneView& sv, const Luminaire& lum, const Placement& placement, const geometry::Camera& view,
                    bool shadows, const ProgressFn& progress = {});
 
 }  // namespace ibl::nearfield
