@@ -231,7 +231,7 @@ TEST(NearfieldIes, RotationallySymmetricCosineLobe) {
 
 TEST(NearfieldRender, CryptWithShadowsAgainstTheExactLuminaire) {
   auto scene = lab::load_scene("crypt");
-  SceneView sv(scene);
+  SceneView sv(lab::diffuse_surfaces(scene), scene.name);
   geometry::Camera view;
   view.eye = {0.9, 1.5, 0.9};
   view.target = {-1.1, 0.3, -1.5};

@@ -77,14 +77,14 @@ ErrorStats compare(const Image& a, const Image& e) {
   return s;
 }
 
-SceneView::SceneView(const lab::Scene& scene) : scene_(&scene) {
-  for (size_t i = 0; i < scene.surfaces.size(); ++i) {
-    const auto& s = scene.surfaces[i];
-    if (s.role != lab::SurfaceRole::Diffuse || s.mesh.triangle_count() == 0) continue;
+SceneView::SceneView(std::vector<geometry::DiffuseSurface> surfaces, std::string name) : name_(std::move(name)) {
+  for (auto& s : surfaces) {
+    if (s.mesh.triangle_count() == 0) continue;
+    if (!s.albedo) fail(ErrorKind::Value, "scene '{}': surface '{}' has no albedo", name_, s.name);
     tracer_.add(s.mesh);
-    surface_of_mesh_.push_back(static_cast<int>(i));
+    surfaces_.push_back(std::move(s));
   }
-  if (surface_of_mesh_.empty()) fail(ErrorKind::Value, "scene '{}' has no diffuse surfaces to light", scene.name);
+  if (surfaces_.empty()) fail(ErrorKind::Value, "scene '{}' has no diffuse surfaces to light", name_);
   tracer_.commit();
 }
 
@@ -92,7 +92,7 @@ bool SceneView::primary(const geometry::Camera& v, int x, int y, Vec3* p, Vec3* 
   const Vec3 d = v.pixel_direction(x, y);
   const auto hit = tracer_.intersect(v.eye, d);
   if (!hit.hit) return false;
-  const auto& s = scene_->surfaces[static_cast<size_t>(surface_of_mesh_[hit.mesh])];
+  const auto& s = surfaces_[hit.mesh];
   *p = v.eye + d * hit.t;
   Vec3 nn = s.mesh.normal(hit.triangle);
   if (dot(nn, d) > 0) nn = -nn;  // shade the side the camera sees
@@ -102,7 +102,7 @@ bool SceneView::primary(const geometry::Camera& v, int x, int y, Vec3* p, Vec3* 
     const auto& t = s.mesh.triangles[hit.triangle];
     uv = s.mesh.uvs[t[0]] * (1 - hit.b1 - hit.b2) + s.mesh.uvs[t[1]] * hit.b1 + s.mesh.uvs[t[2]] * hit.b2;
   }
-  *albedo = s.albedo.eval(uv);
+  *albedo = s.albedo(uv);
   return true;
 }
 
