@@ -13,6 +13,7 @@
 #include "render_truth.h"
 #include "iblkit/io/draw.h"
 #include "iblkit/core/error.h"
+#include "iblkit/geometry/mesh.h"
 #include "iblkit/geometry/mesh_io.h"
 #include "iblkit/ilf/shgrid.h"
 #include "iblkit/io/envmap_io.h"
@@ -20,7 +21,6 @@
 #include "iblkit/io/tonemap.h"
 #include "iblkit/lights/light_set.h"
 #include "iblkit/render/cpu_renderer.h"
-#include "iblkit/render/mesh.h"
 #include "iblkit/render/prefilter.h"
 #include "iblkit/sh/project.h"
 #ifdef IBLKIT_HAVE_GL
@@ -125,11 +125,13 @@ void setup(CLI::App& app) {
     d.camera.target = iblcli::parse_vec3(o->target, "--target");
     d.camera.fov_y_deg = o->fov;
     Vec3 at = iblcli::parse_vec3(o->at, "--at");
-    Mesh object = iblcli::make_object(o->scene, o->object_size, o->triangles, at);
+    geometry::TriMesh object = iblcli::make_object(o->scene, o->object_size, o->triangles, at), floor;
     Vec3 lo, hi;
     object.bounds(&lo, &hi);
-    Mesh floor = make_floor(o->floor_size, lo.y - 1e-3);  // just under the object's lowest point,
-    floor.transform(1.0, {at.x, 0, at.z});                 // centred under it
+    if (o->floor_size > 0) {
+      floor = geometry::make_floor(o->floor_size, lo.y - 1e-3);  // just under the object's lowest point,
+      floor.transform(1.0, {at.x, 0, at.z});                       // centred under it
+    }
     Material mat{iblcli::parse_vec3(o->albedo, "--albedo"), Vec3{1, 1, 1} * o->gloss, o->exponent, o->lobe == "blinn" ? Lobe::BlinnPhong : Lobe::Phong};
     if (!o->texture.empty()) {
       mat.albedo = {1, 1, 1};
@@ -282,7 +284,7 @@ void demo_step(iblcli::DemoContext& ctx) {
   d.camera.width = 480;
   d.camera.height = 360;
   d.camera.eye = {0, 0.5, 1.6};
-  Mesh object = make_blob(60000, 0.8), floor = make_floor(6, -0.42);
+  geometry::TriMesh object = geometry::make_blob(60000, 0.8), floor = geometry::make_floor(6, -0.42);
   d.objects = {{&object, Material{{0.75, 0.75, 0.75}, {0.15, 0.15, 0.15}, 20}}, {&floor, Material{{0.5, 0.5, 0.5}, {0, 0, 0}, 1}}};
   auto probe = io::read_envmap(ctx.probe);
   d.lighting.environment = sh::project(probe, 5);
@@ -335,10 +337,10 @@ void demo_step(iblcli::DemoContext& ctx) {
     f9.camera.height = 240;
     f9.camera.eye = {0, 1.45, 1.5};
     f9.camera.target = {0, 0.8, 0};
-    Mesh small = iblcli::make_object("blob", 0.35, 30000, {0, 0.85, 0});
+    geometry::TriMesh small = iblcli::make_object("blob", 0.35, 30000, {0, 0.85, 0});
     Vec3 lo, hi;
     small.bounds(&lo, &hi);
-    Mesh table = make_floor(0.8, lo.y - 1e-3);
+    geometry::TriMesh table = geometry::make_floor(0.8, lo.y - 1e-3);
     f9.objects = {{&small, Material{{0.75, 0.75, 0.75}, {0, 0, 0}, 1}}, {&table, Material{{0.5, 0.5, 0.5}, {0, 0, 0}, 1}}};
     iblcli::LabPhotograph photo = iblcli::photograph_frame("low-scene2", f9, 3, 1);  // one bounce more than the capture
     io::ToneMapDesc t9;

@@ -71,9 +71,9 @@ void run(const ViewOpts& o, const ibl::io::EnvReadDesc& rd) {
   for (size_t i = 0; i < o.lights.size(); ++i)
     iblcli::load_lighting(o.lights[i], lopt, &lightings[i], &kinds[i]);
   const Vec3 at = iblcli::parse_vec3(o.at, "--at");
-  const Mesh base = iblcli::make_object(o.scene, o.object_size, o.triangles, {0, 0, 0});
+  const geometry::TriMesh base = iblcli::make_object(o.scene, o.object_size, o.triangles, {0, 0, 0});
   {
-    Mesh placed = base;
+    geometry::TriMesh placed = base;
     placed.transform(1.0, at);
     for (const Lighting& L : lightings)
       if (std::string w = iblcli::grid_bounds_warning(L, placed); !w.empty()) iblcli::info("warning: " + w);
@@ -175,14 +175,17 @@ void run(const ViewOpts& o, const ibl::io::EnvReadDesc& rd) {
     d.camera.target = at + st.offset;
     st.orbit.target = d.camera.target;
     d.camera.eye = st.orbit.eye();
-    Mesh object = base;
+    geometry::TriMesh object = base, floor;
     object.transform(1.0, at + st.offset);
     Vec3 lo, hi;
     object.bounds(&lo, &hi);
-    Mesh floor = make_floor(o.floor_size, lo.y - 1e-3);
-    floor.transform(1.0, {at.x + st.offset.x, 0, at.z + st.offset.z});
     Material mat{{0.75, 0.75, 0.75}, Vec3{1, 1, 1} * (st.glossy ? std::max(o.gloss, 0.15) : 0.0), o.exponent};
-    d.objects = {{&object, mat}, {&floor, Material{{0.5, 0.5, 0.5}, {0, 0, 0}, 1}}};
+    d.objects = {{&object, mat}};
+    if (o.floor_size > 0) {
+      floor = geometry::make_floor(o.floor_size, lo.y - 1e-3);
+      floor.transform(1.0, {at.x + st.offset.x, 0, at.z + st.offset.z});
+      d.objects.push_back({&floor, Material{{0.5, 0.5, 0.5}, {0, 0, 0}, 1}});
+    }
     d.lighting = std::move(lightings[li]);  // lent to the frame, not copied (an SH grid is megabytes)
     gl::GpuTiming t;
     auto t0 = std::chrono::steady_clock::now();

@@ -99,7 +99,7 @@ void load_lighting(const std::string& path, const LightingOptions& o, Lighting* 
   }
 }
 
-std::string grid_bounds_warning(const Lighting& L, const Mesh& object) {
+std::string grid_bounds_warning(const Lighting& L, const geometry::TriMesh& object) {
   if (!L.grid) return {};
   Vec3 lo, hi;
   object.bounds(&lo, &hi);
@@ -114,15 +114,15 @@ std::string grid_bounds_warning(const Lighting& L, const Mesh& object) {
   return {};
 }
 
-Mesh make_object(const std::string& scene, double size, int triangles, Vec3 at) {
-  Mesh object;
+geometry::TriMesh make_object(const std::string& scene, double size, int triangles, Vec3 at) {
+  geometry::TriMesh object;
   if (!(size > 0) && (scene == "blob" || scene == "sphere")) fail(ErrorKind::Value, "--object-size must be > 0 for the {}", scene);
   if (scene == "blob") {
-    object = make_blob(triangles, size);
+    object = geometry::make_blob(triangles, size);
   } else if (scene == "sphere") {
-    object = make_sphere(size / 2, 128, 256);
+    object = geometry::make_sphere({0, 0, 0}, size / 2, 128, 256);
   } else {
-    object = from_trimesh(geometry::read_mesh(scene));
+    object = geometry::with_normals(geometry::read_mesh(scene));
     if (size == 0) return object;  // as the file has it
     // Centre the file's mesh on the origin and scale its largest extent to `size`.
     Vec3 lo, hi;

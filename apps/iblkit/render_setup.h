@@ -6,10 +6,10 @@
 
 #include <CLI/CLI.hpp>
 
+#include "iblkit/geometry/mesh.h"
 #include "iblkit/io/envmap_io.h"
 #include "iblkit/nearfield/spotlight.h"
 #include "iblkit/render/frame.h"
-#include "iblkit/render/mesh.h"
 #include "iblkit/render/shading.h"
 
 namespace iblcli {
@@ -46,12 +46,12 @@ void load_lighting(const std::string& path, const LightingOptions& o, ibl::rende
 
 // A warning when the object reaches outside an SH grid's volume (lookups there clamp to the grid's
 // faces), or an empty string.
-std::string grid_bounds_warning(const ibl::render::Lighting& L, const ibl::render::Mesh& object);
+std::string grid_bounds_warning(const ibl::render::Lighting& L, const ibl::geometry::TriMesh& object);
 
 // "blob" (the procedural bunny stand-in, `triangles`), "sphere", or a mesh file centred and scaled
 // to `size` (its largest extent), then moved to `at`; size 0 keeps a mesh file where and as large
 // as it is (a room such as examples/crypt.obj).
-ibl::render::Mesh make_object(const std::string& scene, double size, int triangles, ibl::Vec3 at);
+ibl::geometry::TriMesh make_object(const std::string& scene, double size, int triangles, ibl::Vec3 at);
 
 }  // namespace iblcli
 #endif

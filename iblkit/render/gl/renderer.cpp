@@ -108,6 +108,7 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing,
   const Camera& cam = d.camera;
   const int W = cam.width, H = cam.height;
   if (W <= 0 || H <= 0 || W > 16384 || H > 16384) fail(ErrorKind::Value, "frame size {}x{} is invalid", W, H);
+  check_objects(d);
   const Lighting& L = d.lighting;
   int bands = L.grid ? L.grid->bands() : (L.environment ? L.environment->bands : 0);
   bool glossy = false;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include "iblkit/core/error.h"
 
@@ -11,21 +12,44 @@ namespace ibl::render::gl {
 
 namespace {
 
-// UVs of a mesh for the GPU: its own, or zeros.
-std::vector<float> gpu_uvs(const Mesh& m) {
-  return m.has_uvs() ? m.uvs : std::vector<float>(2 * m.vertex_count(), 0.0f);
+// A mesh as the GPU takes it: float positions, normals and UVs (zeros where the mesh has none),
+// uint32 indices.
+struct Packed {
+  std::vector<float> positions, normals, uvs;
+  std::vector<uint32_t> indices;
+};
+
+Packed pack(const geometry::TriMesh& m) {
+  Packed p;
+  const size_t n = m.vertex_count();
+  p.positions.resize(3 * n);
+  p.normals.resize(3 * n);
+  p.uvs.assign(2 * n, 0.0f);
+  for (size_t i = 0; i < n; ++i)
+    for (int k = 0; k < 3; ++k) {
+      p.positions[3 * i + k] = static_cast<float>(m.positions[i][k]);
+      p.normals[3 * i + k] = static_cast<float>(m.normals[i][k]);
+    }
+  if (m.has_uvs())
+    for (size_t i = 0; i < n; ++i) {
+      p.uvs[2 * i] = static_cast<float>(m.uvs[i].x);
+      p.uvs[2 * i + 1] = static_cast<float>(m.uvs[i].y);
+    }
+  p.indices.resize(3 * m.triangle_count());
+  for (size_t t = 0; t < m.triangle_count(); ++t)
+    for (int k = 0; k < 3; ++k) p.indices[3 * t + k] = m.triangles[t][k];
+  return p;
 }
 
-MeshBuffers upload(const Mesh& m) {
+MeshBuffers upload(const Packed& m) {
   MeshBuffers b;
   glCreateVertexArrays(1, &b.vao);
   glCreateBuffers(3, b.vbo);
   glCreateBuffers(1, &b.ebo);
-  const std::vector<float> uv = gpu_uvs(m);
-  glNamedBufferStorage(b.vbo[0], static_cast<GLsizeiptr>(m.positions.size() * sizeof(float)), m.positions.data(), 0);
-  glNamedBufferStorage(b.vbo[1], static_cast<GLsizeiptr>(m.normals.size() * sizeof(float)), m.normals.data(), 0);
-  glNamedBufferStorage(b.vbo[2], static_cast<GLsizeiptr>(std::max<size_t>(1, uv.size()) * sizeof(float)), uv.data(), 0);
-  glNamedBufferStorage(b.ebo, static_cast<GLsizeiptr>(m.indices.size() * sizeof(uint32_t)), m.indices.data(), 0);
+  glNamedBufferStorage(b.vbo[0], static_cast<GLsizeiptr>(std::max<size_t>(1, m.positions.size()) * sizeof(float)), m.positions.data(), 0);
+  glNamedBufferStorage(b.vbo[1], static_cast<GLsizeiptr>(std::max<size_t>(1, m.normals.size()) * sizeof(float)), m.normals.data(), 0);
+  glNamedBufferStorage(b.vbo[2], static_cast<GLsizeiptr>(std::max<size_t>(1, m.uvs.size()) * sizeof(float)), m.uvs.data(), 0);
+  glNamedBufferStorage(b.ebo, static_cast<GLsizeiptr>(std::max<size_t>(1, m.indices.size()) * sizeof(uint32_t)), m.indices.data(), 0);
   for (int a = 0; a < 3; ++a) {
     const int n = a == 2 ? 2 : 3;
     glVertexArrayVertexBuffer(b.vao, a, b.vbo[a], 0, n * sizeof(float));
@@ -36,6 +60,12 @@ MeshBuffers upload(const Mesh& m) {
   glVertexArrayElementBuffer(b.vao, b.ebo);
   b.count = static_cast<int>(m.indices.size());
   return b;
+}
+
+// The same values, bit for bit (a moved or changed mesh is uploaded again).
+template <typename T>
+bool same_values(const std::vector<T>& a, const std::vector<T>& b) {
+  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
 }
 
 void release_buffers(MeshBuffers& b) {
@@ -72,15 +102,19 @@ void Uploads::Geometry::release() {
 const Uploads::Geometry& Uploads::geometry(const std::vector<RenderObject>& objects, bool deferred) {
   bool same = geometry_.keys.size() == objects.size();
   for (size_t i = 0; same && i < objects.size(); ++i) {
-    const Mesh& a = *objects[i].mesh;
-    const Mesh& b = geometry_.keys[i];
-    same = a.positions == b.positions && a.normals == b.normals && a.uvs == b.uvs && a.indices == b.indices;
+    const geometry::TriMesh& a = *objects[i].mesh;
+    const geometry::TriMesh& b = geometry_.keys[i];
+    same = same_values(a.positions, b.positions) && same_values(a.normals, b.normals) && same_values(a.uvs, b.uvs) &&
+           same_values(a.triangles, b.triangles);
   }
+  if (same && (!deferred || geometry_.ssbo[0])) return geometry_;
+  std::vector<Packed> packed;
+  for (const auto& o : objects) packed.push_back(pack(*o.mesh));
   if (!same) {
     geometry_.release();
-    for (const auto& o : objects) {
-      geometry_.meshes.push_back(upload(*o.mesh));
-      geometry_.keys.push_back(*o.mesh);
+    for (size_t i = 0; i < objects.size(); ++i) {
+      geometry_.meshes.push_back(upload(packed[i]));
+      geometry_.keys.push_back(*objects[i].mesh);
     }
   }
   if (deferred && !geometry_.ssbo[0]) {
@@ -89,14 +123,13 @@ const Uploads::Geometry& Uploads::geometry(const std::vector<RenderObject>& obje
     std::vector<uint32_t> object_table;
     std::vector<float> pos, nrm, uvs;
     std::vector<uint32_t> idx;
-    for (const auto& o : objects) {
-      if (o.mesh->triangle_count() >= (1u << 24)) fail(ErrorKind::Value, "a mesh of {} triangles is over the deferred path's 2^24", o.mesh->triangle_count());
+    for (const Packed& p : packed) {
+      if (p.indices.size() / 3 >= (1u << 24)) fail(ErrorKind::Value, "a mesh of {} triangles is over the deferred path's 2^24", p.indices.size() / 3);
       object_table.insert(object_table.end(), {static_cast<uint32_t>(pos.size() / 3), static_cast<uint32_t>(idx.size()), 0u, 0u});
-      pos.insert(pos.end(), o.mesh->positions.begin(), o.mesh->positions.end());
-      nrm.insert(nrm.end(), o.mesh->normals.begin(), o.mesh->normals.end());
-      const std::vector<float> uv = gpu_uvs(*o.mesh);
-      uvs.insert(uvs.end(), uv.begin(), uv.end());
-      idx.insert(idx.end(), o.mesh->indices.begin(), o.mesh->indices.end());
+      pos.insert(pos.end(), p.positions.begin(), p.positions.end());
+      nrm.insert(nrm.end(), p.normals.begin(), p.normals.end());
+      uvs.insert(uvs.end(), p.uvs.begin(), p.uvs.end());
+      idx.insert(idx.end(), p.indices.begin(), p.indices.end());
     }
     glCreateBuffers(5, geometry_.ssbo);
     glNamedBufferStorage(geometry_.ssbo[0], static_cast<GLsizeiptr>(std::max<size_t>(4, object_table.size()) * 4), object_table.data(), 0);

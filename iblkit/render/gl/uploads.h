@@ -14,7 +14,8 @@
 
 namespace ibl::render::gl {
 
-// A mesh's vertex array: positions, normals, UVs (zeros where the mesh has none) and indices.
+// A mesh's vertex array: positions, normals, UVs (zeros where the mesh has none) and indices, packed
+// into float and uint32 buffers.
 struct MeshBuffers {
   unsigned vao = 0, vbo[3] = {0, 0, 0}, ebo = 0;
   int count = 0;  // indices
@@ -36,7 +37,7 @@ class Uploads {
   // the compute pass (object table {first vertex, first index, 0, 0}, positions, normals, indices,
   // UVs).
   struct Geometry {
-    std::vector<Mesh> keys;
+    std::vector<geometry::TriMesh> keys;  // copies of the meshes uploaded
     std::vector<MeshBuffers> meshes;
     unsigned ssbo[5] = {0, 0, 0, 0, 0};
     void release();
