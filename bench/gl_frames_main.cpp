@@ -12,10 +12,10 @@
 #include <stdexcept>
 #include <string>
 
+#include "iblkit/geometry/mesh.h"
 #include "iblkit/render/gl/context.h"
 #include "iblkit/render/gl/renderer.h"
 #include "iblkit/nearfield/spotlight.h"
-#include "iblkit/render/mesh.h"
 
 using namespace ibl;
 using namespace ibl::render;
@@ -28,33 +28,31 @@ double median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
-SHGridData make_grid(int n, int bands) {
-  SHGridData g;
-  g.bands = bands;
-  g.nx = g.ny = g.nz = n;
-  g.min = {-0.6, -0.6, -0.6};
-  g.max = {0.6, 0.6, 0.6};
+ilf::SHGrid make_grid(int n, int bands) {
+  ilf::GridDesc gd;
+  gd.nx = gd.ny = gd.nz = n;
+  gd.volume = {{-0.6, -0.6, -0.6}, {0.6, 0.6, 0.6}};
+  ilf::SHGrid g(gd, bands);
   const int K = bands * bands;
-  g.data.resize(static_cast<size_t>(n) * n * n * K * 3);
   for (int z = 0; z < n; ++z)
     for (int y = 0; y < n; ++y)
       for (int x = 0; x < n; ++x)
         for (int k = 0; k < K; ++k)
           for (int c = 0; c < 3; ++c) {
             size_t i = ((((static_cast<size_t>(z) * n + y) * n + x) * K + k) * 3 + c);
-            g.data[i] = static_cast<float>((k == 0 ? 2.0 : 0.3 / (1 + k)) * (1 + 0.3 * std::sin(0.3 * x + 0.2 * y - 0.1 * z + c)));
+            g.data()[i] = static_cast<float>((k == 0 ? 2.0 : 0.3 / (1 + k)) * (1 + 0.3 * std::sin(0.3 * x + 0.2 * y - 0.1 * z + c)));
           }
   return g;
 }
 
 // A box room (inward-facing walls) of w × h × l metres with its floor at y = 0, and four pillars:
 // a stand-in for the crypt (examples/crypt.obj needs assimp, which the lean target leaves out).
-Mesh make_room(double w, double h, double l) {
-  Mesh room;
+geometry::TriMesh make_room(double w, double h, double l) {
+  geometry::TriMesh room;
   auto quad = [&](Vec3 a, Vec3 b, Vec3 c, Vec3 d) {  // counter-clockwise seen from the side it faces
-    Mesh q;
-    for (Vec3 p : {a, b, c, d}) q.positions.insert(q.positions.end(), {float(p.x), float(p.y), float(p.z)});
-    q.indices = {0, 1, 2, 0, 2, 3};
+    geometry::TriMesh q;
+    q.positions = {a, b, c, d};
+    q.triangles = {{0, 1, 2}, {0, 2, 3}};
     q.compute_normals();
     room.append(q);
   };
@@ -72,8 +70,8 @@ Mesh make_room(double w, double h, double l) {
 
 // The crypt of examples/crypt.obj (522 triangles, like Granier et al.'s 500): positions and
 // triangles only, read here because the lean target has no assimp. Empty when the file is missing.
-Mesh read_obj(const std::string& path) {
-  Mesh m;
+geometry::TriMesh read_obj(const std::string& path) {
+  geometry::TriMesh m;
   std::ifstream in(path);
   std::string line;
   while (std::getline(in, line)) {
@@ -83,20 +81,20 @@ Mesh read_obj(const std::string& path) {
     if (tag == "v") {
       float x, y, z;
       ls >> x >> y >> z;
-      m.positions.insert(m.positions.end(), {x, y, z});
+      m.positions.push_back({x, y, z});
     } else if (tag == "f") {
       std::vector<uint32_t> f;
       std::string v;
       while (ls >> v) {
         const long i = std::stol(v.substr(0, v.find('/')));
-        if (i < 1 || static_cast<size_t>(i) > m.positions.size() / 3)
+        if (i < 1 || static_cast<size_t>(i) > m.positions.size())
           throw std::runtime_error(path + ": vertex index " + std::to_string(i) + " is out of range (this reader takes positive indices of vertices listed before the face)");
         f.push_back(static_cast<uint32_t>(i - 1));
       }
-      for (size_t k = 2; k < f.size(); ++k) m.indices.insert(m.indices.end(), {f[0], f[k - 1], f[k]});
+      for (size_t k = 2; k < f.size(); ++k) m.triangles.push_back({f[0], f[k - 1], f[k]});
     }
   }
-  if (!m.indices.empty()) m.compute_normals();
+  if (!m.triangles.empty()) m.compute_normals();
   return m;
 }
 
@@ -144,9 +142,9 @@ int main(int argc, char** argv) {
   const std::string crypt_path = argc > 5 ? argv[5] : "examples/crypt.obj";
   try {
     gl::Context ctx;
-    Mesh blob = make_blob(tris, 0.8);
-    Mesh crypt = read_obj(crypt_path);
-    if (crypt.indices.empty()) std::fprintf(stderr, "iblkit_glbench: no %s, skipping the crypt case\n", crypt_path.c_str());
+    geometry::TriMesh blob = geometry::make_blob(tris, 0.8);
+    geometry::TriMesh crypt = read_obj(crypt_path);
+    if (crypt.triangles.empty()) std::fprintf(stderr, "iblkit_glbench: no %s, skipping the crypt case\n", crypt_path.c_str());
     std::printf("{\"renderer\": \"%s\", \"triangles\": %zu, \"size\": \"%dx%d\", \"frames\": %d", ctx.renderer().c_str(),
                 blob.triangle_count(), width, height, frames);
     for (bool deferred : {false, true}) {
@@ -199,7 +197,7 @@ int main(int argc, char** argv) {
       d.lighting.lights.clear();
       d.spot_shadow_map_size = 512;
       d.objects.clear();
-      if (!crypt.indices.empty()) {
+      if (!crypt.triangles.empty()) {
         d.lighting.spotlights = make_spotlights({-0.55, 0.45, -0.75}, Vec3{-1.3, 0.25, -1.6} - Vec3{-0.55, 0.45, -0.75}, 256);
         d.objects = {{&crypt, Material{{0.62, 0.58, 0.5}, {0, 0, 0}, 1}}};
         d.camera.eye = {1.5, 1.7, 3.2};
@@ -225,8 +223,8 @@ int main(int argc, char** argv) {
         }
       }
       d.lighting.spotlights = make_spotlights({-1.0, 2.2, 2.5}, {0.3, -0.6, -1}, 128);
-      Mesh room = make_room(6, 4, 8);
-      Mesh small = blob;
+      geometry::TriMesh room = make_room(6, 4, 8);
+      geometry::TriMesh small = blob;
       small.transform(0.5, {0, 0.2, 0});
       d.objects = {{&small, Material{{0.7, 0.7, 0.7}, {0.2, 0.2, 0.2}, 20}}, {&room, Material{{0.6, 0.6, 0.6}, {0, 0, 0}, 1}}};
       d.camera.eye = {0.5, 1.6, 3.5};

@@ -13,6 +13,7 @@
 #include "render_truth.h"
 #include "iblkit/io/draw.h"
 #include "iblkit/core/error.h"
+#include "iblkit/geometry/mesh.h"
 #include "iblkit/geometry/mesh_io.h"
 #include "iblkit/ilf/shgrid.h"
 #include "iblkit/io/envmap_io.h"
@@ -20,7 +21,8 @@
 #include "iblkit/io/tonemap.h"
 #include "iblkit/lights/light_set.h"
 #include "iblkit/render/cpu_renderer.h"
-#include "iblkit/render/mesh.h"
+#include "iblkit/render/lighting_io.h"
+#include "iblkit/render/objects.h"
 #include "iblkit/render/prefilter.h"
 #include "iblkit/sh/project.h"
 #ifdef IBLKIT_HAVE_GL
@@ -34,25 +36,25 @@ namespace fs = std::filesystem;
 using namespace ibl;
 using namespace ibl::render;
 
-void setup(CLI::App& app) {
-  struct Opts {
-    std::vector<std::string> lights;
-    std::string scene = "blob", out = "frame.png", backend = "auto", size = "1024x768", eye = "0,0.5,1.6",
-                target = "0,0,0", at = "0,0,0";
-    double object_size = 0.8;
-    int frames = 1, bands = 5, triangles = 100000, shadows = 4, sh_table = 0;
-    iblcli::ShadowMapOptions shadow_maps;
-    double gloss = 0, exponent = 20;
-    std::string glossy = "map";
-    std::string truth;
-    int truth_samples = 4, truth_bounces = 1;
-    double floor_size = 6;
-    std::string luminaire = "0,1,0", luminaire_dir = "0,0,1";
-    std::string texture, lobe = "phong", albedo = "0.75,0.75,0.75";
-    double exposure = 0, fov = 40;
-  };
-  auto* o = new Opts();
-  app.add_option("scene", o->scene,
+struct Opts {
+  std::vector<std::string> lights;
+  render::ObjectDesc object;             // scene, --object-size, --triangles (and --at)
+  render::LightingReadDesc lighting;     // --bands, --shadows (and the probe read options, --luminaire…)
+  std::string out = "frame.png", backend = "auto", size = "1024x768", eye = "0,0.5,1.6", target = "0,0,0", at = "0,0,0";
+  int frames = 1, sh_table = 0;
+  iblcli::ShadowMapOptions shadow_maps;
+  double gloss = 0, exponent = 20;
+  std::string glossy = "map";
+  std::string truth;
+  int truth_samples = 4, truth_bounces = 1;
+  double floor_size = 6;
+  std::string luminaire = "0,1,0", luminaire_dir = "0,0,1";
+  std::string texture, lobe = "phong", albedo = "0.75,0.75,0.75";
+  double exposure = 0, fov = 40;
+};
+
+void add_options(CLI::App& app, Opts* o) {
+  app.add_option("scene", o->object.scene,
                  "the object: blob (a bunny-sized procedural object), sphere, or a mesh file (OBJ, PLY, glTF), "
                  "scaled to --object-size and placed at --at, on a floor")
       ->capture_default_str();
@@ -61,19 +63,19 @@ void setup(CLI::App& app) {
                  "frame each (OUT_<name>.ext)")
       ->required();
   app.add_option("--at", o->at, "place the object's centre here, x,y,z (e.g. inside an SH grid's volume)")->capture_default_str();
-  app.add_option("--object-size", o->object_size, "object size in metres; 0 keeps a mesh file's own size and place (a room)")
+  app.add_option("--object-size", o->object.size, "object size in metres; 0 keeps a mesh file's own size and place (a room)")
       ->check(CLI::Range(0.0, 1000.0))
       ->capture_default_str();
   app.add_option("-o,--out", o->out, "output .png (tone mapped) or .exr (linear)")->capture_default_str();
   app.add_option("--backend", o->backend, "cpu, gl or auto (gl when available)")->check(CLI::IsMember({"cpu", "gl", "auto"}))->capture_default_str();
   app.add_option("--size", o->size, "frame size WxH")->capture_default_str();
   app.add_option("--frames", o->frames, "GL: render this many frames and report the median GPU time")->check(CLI::Range(1, 10000));
-  app.add_option("--shadows", o->shadows, "lights (in the file's priority order) that cast shadows")
+  app.add_option("--shadows", o->lighting.shadows, "lights (in the file's priority order) that cast shadows")
       ->check(CLI::Range(0, 16))
       ->capture_default_str();
   iblcli::add_shadow_map_options(app, &o->shadow_maps);
-  app.add_option("--bands", o->bands, "SH bands when projecting a probe")->check(CLI::Range(1, 9))->capture_default_str();
-  app.add_option("--triangles", o->triangles, "triangles of the blob")->check(CLI::Range(100, 5000000))->capture_default_str();
+  app.add_option("--bands", o->lighting.bands, "SH bands when projecting a probe")->check(CLI::Range(1, 9))->capture_default_str();
+  app.add_option("--triangles", o->object.triangles, "triangles of the blob")->check(CLI::Range(100, 5000000))->capture_default_str();
   app.add_option("--gloss", o->gloss, "weight of the glossy Phong lobe (0..1)")->check(CLI::Range(0.0, 1.0));
   app.add_option("--exponent", o->exponent, "Phong exponent of the glossy lobe")->check(CLI::Range(1.0, 10000.0));
   app.add_option("--lobe", o->lobe, "glossy lobe: phong, or blinn (Blinn-Phong for lights; SH and maps use Phong of exponent/4)")
@@ -109,169 +111,228 @@ void setup(CLI::App& app) {
   app.add_option("--eye", o->eye, "camera position x,y,z")->capture_default_str();
   app.add_option("--fov", o->fov, "vertical field of view, degrees")->check(CLI::Range(1.0, 170.0))->capture_default_str();
   app.add_option("--target", o->target, "camera target x,y,z")->capture_default_str();
-  auto& rd = iblcli::add_probe_read_options(app);
   app.footer("Examples:\n  iblkit render blob --light probe.exr --out blob.png --backend cpu --size 400x300\n"
              "  iblkit render blob --light lights.json --backend gl --frames 100 --out blob.exr\n"
              "  iblkit render blob --light grid.shgrid --at 0.5,0.3,0.5 --object-size 0.3 --eye 0.5,0.6,1.6 --target 0.5,0.3,0.5");
-  app.callback([o, &rd] {
-    int w = 0, h = 0;
-    if (std::sscanf(o->size.c_str(), "%dx%d", &w, &h) != 2 || w < 1 || h < 1 || w > 16384 || h > 16384)
-      fail(ErrorKind::Value, "--size '{}': expected WxH, e.g. 1024x768", o->size);
-    FrameDesc d;
-    d.camera.width = w;
-    d.camera.height = h;
-    o->shadow_maps.apply(&d);
-    d.camera.eye = iblcli::parse_vec3(o->eye, "--eye");
-    d.camera.target = iblcli::parse_vec3(o->target, "--target");
-    d.camera.fov_y_deg = o->fov;
-    Vec3 at = iblcli::parse_vec3(o->at, "--at");
-    Mesh object = iblcli::make_object(o->scene, o->object_size, o->triangles, at);
-    Vec3 lo, hi;
-    object.bounds(&lo, &hi);
-    Mesh floor = make_floor(o->floor_size, lo.y - 1e-3);  // just under the object's lowest point,
-    floor.transform(1.0, {at.x, 0, at.z});                 // centred under it
-    Material mat{iblcli::parse_vec3(o->albedo, "--albedo"), Vec3{1, 1, 1} * o->gloss, o->exponent, o->lobe == "blinn" ? Lobe::BlinnPhong : Lobe::Phong};
-    if (!o->texture.empty()) {
-      mat.albedo = {1, 1, 1};
-      mat.texture = std::make_shared<Image>(io::read_image(o->texture).with_channels(3));
-    }
-    d.objects = {{&object, mat}};
-    if (o->floor_size > 0) d.objects.push_back({&floor, Material{{0.5, 0.5, 0.5}, {0, 0, 0}, 1}});
-    std::string backend = o->backend;
+}
+
+// What the frame shows: the object (and a floor under it) with its material; `d` points at them.
+struct Scene {
+  geometry::TriMesh object, floor;
+  FrameDesc d;
+};
+
+// The frame the options describe (camera, object, floor, material), lighting still empty.
+void make_scene(const Opts& o, Scene* s) {
+  int w = 0, h = 0;
+  if (std::sscanf(o.size.c_str(), "%dx%d", &w, &h) != 2 || w < 1 || h < 1 || w > 16384 || h > 16384)
+    fail(ErrorKind::Value, "--size '{}': expected WxH, e.g. 1024x768", o.size);
+  FrameDesc& d = s->d;
+  d.camera.width = w;
+  d.camera.height = h;
+  o.shadow_maps.apply(&d);
+  d.camera.eye = iblcli::parse_vec3(o.eye, "--eye");
+  d.camera.target = iblcli::parse_vec3(o.target, "--target");
+  d.camera.fov_y_deg = o.fov;
+  render::ObjectDesc od = o.object;
+  od.at = iblcli::parse_vec3(o.at, "--at");
+  if (!(od.size > 0) && (od.scene == "blob" || od.scene == "sphere")) fail(ErrorKind::Value, "--object-size must be > 0 for the {}", od.scene);
+  s->object = render::make_object(od);
+  Vec3 lo, hi;
+  s->object.bounds(&lo, &hi);
+  if (o.floor_size > 0) {
+    s->floor = geometry::make_floor(o.floor_size, lo.y - 1e-3);  // just under the object's lowest point,
+    s->floor.transform(1.0, {od.at.x, 0, od.at.z});              // centred under it
+  }
+  Material mat{iblcli::parse_vec3(o.albedo, "--albedo"), Vec3{1, 1, 1} * o.gloss, o.exponent, o.lobe == "blinn" ? Lobe::BlinnPhong : Lobe::Phong};
+  if (!o.texture.empty()) {
+    mat.albedo = {1, 1, 1};
+    mat.texture = std::make_shared<Image>(io::read_image(o.texture).with_channels(3));
+  }
+  d.objects = {{&s->object, mat}};
+  if (o.floor_size > 0) d.objects.push_back({&s->floor, Material{{0.5, 0.5, 0.5}, {0, 0, 0}, 1}});
+}
+
+// The backend that renders: "cpu", or "gl" with its context (current while this lives).
+struct Backend {
+  std::string name;                // "cpu" or "gl"
+  std::string gl_renderer;         // the GL context's renderer string
+  std::shared_ptr<void> context;   // the GL context
+};
+
+// --backend: cpu, gl, or auto (gl when a context opens, else the CPU).
+Backend open_backend(const std::string& wanted) {
+  Backend b{wanted, "", nullptr};
 #ifdef IBLKIT_HAVE_GL
-    std::unique_ptr<gl::Context> ctx;
-    if (backend != "cpu") {
-      try {
-        ctx = std::make_unique<gl::Context>();
-        backend = "gl";
-      } catch (const Error& e) {
-        if (backend == "gl") fail(ErrorKind::Unsupported, "no OpenGL here ({}); --backend cpu or auto renders on the CPU", e.what());
-        iblcli::info(fmt::format("no OpenGL here ({}); rendering on the CPU", e.what()));
-        backend = "cpu";
-      }
+  if (b.name != "cpu") {
+    try {
+      auto ctx = std::make_shared<gl::Context>();
+      b.gl_renderer = ctx->renderer();
+      b.context = ctx;
+      b.name = "gl";
+    } catch (const Error& e) {
+      if (b.name == "gl") fail(ErrorKind::Unsupported, "no OpenGL here ({}); --backend cpu or auto renders on the CPU", e.what());
+      iblcli::info(fmt::format("no OpenGL here ({}); rendering on the CPU", e.what()));
+      b.name = "cpu";
     }
+  }
 #else
-    if (backend == "gl") fail(ErrorKind::Unsupported, "this build has no OpenGL renderer (libepoxy missing)");
-    backend = "cpu";
+  if (b.name == "gl") fail(ErrorKind::Unsupported, "this build has no OpenGL renderer (libepoxy missing)");
+  b.name = "cpu";
 #endif
-    // The lab photograph, once for every lighting.
-    std::optional<iblcli::LabPhotograph> photo;
-    io::ToneMapDesc td;  // pictures: auto exposure, or with --truth one exposure for all (the truth's)
-    td.exposure_stops = o->exposure;
-    if (!o->truth.empty()) {
-      auto t0 = std::chrono::steady_clock::now();
-      photo = iblcli::photograph_frame(o->truth, d, o->truth_samples, o->truth_bounces, iblcli::progress_bar());
-      iblcli::progress_done();
-      photo->ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-      td.auto_exposure = false;
-      td.exposure_stops = o->exposure + std::log2(photo->median > 0 ? 0.25 / photo->median : 1.0);
-    }
-    const fs::path out_path(o->out), stem = fs::path(o->out).replace_extension();
-    const std::string ext = out_path.extension().string();
-    std::vector<std::pair<std::string, Image>> sheet, errors;
-    iblcli::LightingOptions lopt;
-    lopt.bands = o->bands;
-    lopt.shadows = o->shadows;
-    lopt.glossy_exponent = o->gloss > 0 && o->glossy == "map" ? mat.environment_exponent() : 0.0;
-    lopt.read = rd;
-    lopt.luminaire.position = iblcli::parse_vec3(o->luminaire, "--luminaire");
-    lopt.luminaire.forward = normalize(iblcli::parse_vec3(o->luminaire_dir, "--luminaire-dir"));
-    if (photo) sheet.push_back({"lab photograph (truth)", io::tonemap(photo->radiance, td)});
-    nlohmann::json renders = nlohmann::json::array();
-    for (const std::string& light : o->lights) {
-      d.lighting = Lighting{};
-      std::string kind;
-      iblcli::load_lighting(light, lopt, &d.lighting, &kind);
-      if (std::string w = iblcli::grid_bounds_warning(d.lighting, object); !w.empty()) iblcli::info("warning: " + w);
-      nlohmann::json j = {{"scene", o->scene}, {"light", light}, {"lighting", kind}, {"size", o->size}};
-      RenderResult f;
+  return b;
+}
+
+// One frame on the backend; its timing into j.
+RenderResult render_frame(const Opts& o, const FrameDesc& d, const Backend& backend, nlohmann::json& j) {
+  RenderResult f;
 #ifdef IBLKIT_HAVE_GL
-      if (backend == "gl") {
-        gl::RendererDesc gl_desc;
-        gl_desc.sh_table_size = o->sh_table;
-        gl::Renderer r(gl_desc);
-        gl::GpuTiming t;
-        f = r.render(d, o->frames, &t);
-        std::vector<double> ms = t.frame_ms;
-        std::sort(ms.begin(), ms.end());
-        double med = ms[ms.size() / 2];
-        j["gl_renderer"] = ctx->renderer();
-        j["wall_ms_per_frame"] = t.wall_ms_per_frame;
-        if (ctx->renderer().find("llvmpipe") == std::string::npos) {
-          j["gpu_ms_median"] = med;
-          j["fps_gpu"] = med > 0 ? 1000.0 / med : 0.0;
-        }
-        if (f.unshadowed_lights > 0) {
-          j["unshadowed_lights"] = f.unshadowed_lights;
-          iblcli::info(fmt::format("{} shadow-casting lights got no shadow map (over {}, or point lights inside the object's bounds)",
-                                   f.unshadowed_lights, gl::Renderer::kMaxShadowMaps));
-        }
-      }
+  if (backend.name == "gl") {
+    gl::RendererDesc gl_desc;
+    gl_desc.sh_table_size = o.sh_table;
+    gl::Renderer r(gl_desc);
+    gl::GpuTiming t;
+    f = r.render(d, o.frames, &t);
+    std::vector<double> ms = t.frame_ms;
+    std::sort(ms.begin(), ms.end());
+    double med = ms[ms.size() / 2];
+    j["gl_renderer"] = backend.gl_renderer;
+    j["wall_ms_per_frame"] = t.wall_ms_per_frame;
+    if (backend.gl_renderer.find("llvmpipe") == std::string::npos) {
+      j["gpu_ms_median"] = med;
+      j["fps_gpu"] = med > 0 ? 1000.0 / med : 0.0;
+    }
+    if (f.unshadowed_lights > 0) {
+      j["unshadowed_lights"] = f.unshadowed_lights;
+      iblcli::info(fmt::format("{} shadow-casting lights got no shadow map (over {}, or point lights inside the object's bounds)",
+                               f.unshadowed_lights, gl::Renderer::kMaxShadowMaps));
+    }
+  }
 #endif
-      if (backend == "cpu") {
-        auto t0 = std::chrono::steady_clock::now();
-        f = render_cpu(d, iblcli::progress_bar());
-        iblcli::progress_done();
-        j["cpu_ms"] = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-      }
-      j["backend"] = backend;
-      // One --light writes --out; several write OUT_<light name>.ext each.
-      std::string out = o->lights.size() == 1 ? o->out : stem.string() + "_" + fs::path(light).stem().string() + ext;
-      if (ext == ".png" || ext == ".jpg") io::write_image(out, io::tonemap(f.color, td));
-      else io::write_image(out, f.color);
-      j["output"] = out;
-      if (photo) {
-        iblcli::TruthComparison c = iblcli::compare(*photo, f);
-        sheet.push_back({fmt::format("{}: L1 {:.3f}", fs::path(light).filename().string(), c.rel_l1_first), io::tonemap(f.color, td)});
-        errors.push_back({fmt::format("relative error of {}", fs::path(light).filename().string()), io::false_colour(c.error, 0.5)});
-        j["truth"] = {{"scene", o->truth},
-                      {"rel_l1_object", c.rel_l1_first},
-                      {"rel_l1_object_and_floor", c.rel_l1},
-                      {"median_rel_object", c.median_rel},
-                      {"mean_luminance_render", c.mean_render},
-                      {"mean_luminance_truth", c.mean_truth},
-                      {"object_pixels", c.first_pixels},
-                      {"photograph_ms", photo->ms}};
-      }
-      renders.push_back(j);
-    }
-    nlohmann::json result = renders.size() == 1 ? renders[0] : nlohmann::json{{"renders", renders}};
-    if (photo) {
-      io::write_image(stem.string() + "_truth.exr", photo->radiance);
-      io::write_image(stem.string() + "_truth.png", sheet[0].second);
-      // Row 1: the truth and each render; row 2: a key, then each render's error map.
-      const int cols = 1 + static_cast<int>(o->lights.size());
-      if (o->lights.size() == 1) io::write_image(stem.string() + "_error.png", errors[0].second);
-      Image key(64, 8, 1);
-      for (int y = 0; y < 8; ++y)
-        for (int x = 0; x < 64; ++x) key.at(x, y, 0) = static_cast<float>(0.5 * x / 63.0);
-      sheet.push_back({"relative error 0 .. 0.5 (grey: not compared)", io::false_colour(key, 0.5)});
-      for (auto& e : errors) sheet.push_back(std::move(e));
-      std::string pictures = stem.string() + "_compare.png";
-      io::write_image(pictures, io::contact_sheet(sheet, cols, std::min(480, w), std::min(480, w) * h / w));
-      result["truth_pictures"] = pictures;
-    }
-    iblcli::emit(result, [&] {
-      for (const auto& j : renders) {
-        fmt::print("rendered {} ({}, {} backend) lit by {}\n", j["output"].get<std::string>(), o->size, backend,
-                   j["lighting"].get<std::string>());
-        if (j.contains("gpu_ms_median"))
-          fmt::print("GPU time {:.3f} ms/frame median of {} ({:.0f} fps) on {}\n", j["gpu_ms_median"].get<double>(), o->frames,
-                     j["fps_gpu"].get<double>(), j["gl_renderer"].get<std::string>());
-        else if (j.contains("gl_renderer"))
-          fmt::print("{:.1f} ms/frame wall clock over {} frames on {} (a software renderer: its GPU timer queries mean nothing)\n",
-                     j["wall_ms_per_frame"].get<double>(), o->frames, j["gl_renderer"].get<std::string>());
-        if (j.contains("cpu_ms")) fmt::print("CPU time {:.0f} ms\n", j["cpu_ms"].get<double>());
-        if (j.contains("truth"))
-          fmt::print("against the lab photograph in {}: object relative L1 {:.3f} (median pixel {:.3f}; mean luminance {:.4g} vs "
-                     "{:.4g}), object and floor {:.3f}\n",
-                     o->truth, j["truth"]["rel_l1_object"].get<double>(), j["truth"]["median_rel_object"].get<double>(),
-                     j["truth"]["mean_luminance_render"].get<double>(), j["truth"]["mean_luminance_truth"].get<double>(),
-                     j["truth"]["rel_l1_object_and_floor"].get<double>());
-      }
-      if (result.contains("truth_pictures")) fmt::print("pictures: {}\n", result["truth_pictures"].get<std::string>());
-    });
-  });
+  if (backend.name == "cpu") {
+    auto t0 = std::chrono::steady_clock::now();
+    f = render_cpu(d, iblcli::progress_bar());
+    iblcli::progress_done();
+    j["cpu_ms"] = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  }
+  j["backend"] = backend.name;
+  return f;
+}
+
+// The lab photograph and what each rendered frame is compared with.
+struct Truth {
+  std::optional<iblcli::LabPhotograph> photo;
+  io::ToneMapDesc td;  // pictures: auto exposure, or with --truth one exposure for all (the truth's)
+  std::vector<std::pair<std::string, Image>> sheet, errors;
+};
+
+// Photographs the frame in the --truth scene, once for every lighting.
+void photograph(const Opts& o, const FrameDesc& d, Truth* t) {
+  t->td.exposure_stops = o.exposure;
+  if (o.truth.empty()) return;
+  auto t0 = std::chrono::steady_clock::now();
+  t->photo = iblcli::photograph_frame(o.truth, d, o.truth_samples, o.truth_bounces, iblcli::progress_bar());
+  iblcli::progress_done();
+  t->photo->ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  t->td.auto_exposure = false;
+  t->td.exposure_stops = o.exposure + std::log2(t->photo->median > 0 ? 0.25 / t->photo->median : 1.0);
+  t->sheet.push_back({"lab photograph (truth)", io::tonemap(t->photo->radiance, t->td)});
+}
+
+// The frame against the photograph: into j, the contact sheet and the error maps.
+void compare_with_truth(const Opts& o, const std::string& light, const RenderResult& f, Truth* t, nlohmann::json& j) {
+  iblcli::TruthComparison c = iblcli::compare(*t->photo, f);
+  const std::string name = fs::path(light).filename().string();
+  t->sheet.push_back({fmt::format("{}: L1 {:.3f}", name, c.rel_l1_first), io::tonemap(f.color, t->td)});
+  t->errors.push_back({fmt::format("relative error of {}", name), io::false_colour(c.error, 0.5)});
+  j["truth"] = {{"scene", o.truth},
+                {"rel_l1_object", c.rel_l1_first},
+                {"rel_l1_object_and_floor", c.rel_l1},
+                {"median_rel_object", c.median_rel},
+                {"mean_luminance_render", c.mean_render},
+                {"mean_luminance_truth", c.mean_truth},
+                {"object_pixels", c.first_pixels},
+                {"photograph_ms", t->photo->ms}};
+}
+
+// STEM_truth.exr/.png, STEM_error.png (one --light) and STEM_compare.png: row 1 the truth and each
+// render, row 2 a key, then each render's error map. Returns the contact sheet's path.
+std::string write_truth_pictures(const Opts& o, const fs::path& stem, int w, int h, Truth* t) {
+  io::write_image(stem.string() + "_truth.exr", t->photo->radiance);
+  io::write_image(stem.string() + "_truth.png", t->sheet[0].second);
+  const int cols = 1 + static_cast<int>(o.lights.size());
+  if (o.lights.size() == 1) io::write_image(stem.string() + "_error.png", t->errors[0].second);
+  Image key(64, 8, 1);
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 64; ++x) key.at(x, y, 0) = static_cast<float>(0.5 * x / 63.0);
+  t->sheet.push_back({"relative error 0 .. 0.5 (grey: not compared)", io::false_colour(key, 0.5)});
+  for (auto& e : t->errors) t->sheet.push_back(std::move(e));
+  std::string pictures = stem.string() + "_compare.png";
+  io::write_image(pictures, io::contact_sheet(t->sheet, cols, std::min(480, w), std::min(480, w) * h / w));
+  return pictures;
+}
+
+void print_renders(const Opts& o, const nlohmann::json& renders, const nlohmann::json& result, const std::string& backend) {
+  for (const auto& j : renders) {
+    fmt::print("rendered {} ({}, {} backend) lit by {}\n", j["output"].get<std::string>(), o.size, backend, j["lighting"].get<std::string>());
+    if (j.contains("gpu_ms_median"))
+      fmt::print("GPU time {:.3f} ms/frame median of {} ({:.0f} fps) on {}\n", j["gpu_ms_median"].get<double>(), o.frames,
+                 j["fps_gpu"].get<double>(), j["gl_renderer"].get<std::string>());
+    else if (j.contains("gl_renderer"))
+      fmt::print("{:.1f} ms/frame wall clock over {} frames on {} (a software renderer: its GPU timer queries mean nothing)\n",
+                 j["wall_ms_per_frame"].get<double>(), o.frames, j["gl_renderer"].get<std::string>());
+    if (j.contains("cpu_ms")) fmt::print("CPU time {:.0f} ms\n", j["cpu_ms"].get<double>());
+    if (j.contains("truth"))
+      fmt::print("against the lab photograph in {}: object relative L1 {:.3f} (median pixel {:.3f}; mean luminance {:.4g} vs "
+                 "{:.4g}), object and floor {:.3f}\n",
+                 o.truth, j["truth"]["rel_l1_object"].get<double>(), j["truth"]["median_rel_object"].get<double>(),
+                 j["truth"]["mean_luminance_render"].get<double>(), j["truth"]["mean_luminance_truth"].get<double>(),
+                 j["truth"]["rel_l1_object_and_floor"].get<double>());
+  }
+  if (result.contains("truth_pictures")) fmt::print("pictures: {}\n", result["truth_pictures"].get<std::string>());
+}
+
+// The frame lit by each --light in turn, written to --out (OUT_<light name>.ext for several).
+void run(const Opts& o, const io::EnvReadDesc& rd) {
+  Scene s;
+  make_scene(o, &s);
+  FrameDesc& d = s.d;
+  render::LightingReadDesc lopt = o.lighting;
+  lopt.glossy_exponent = o.gloss > 0 && o.glossy == "map" ? d.objects[0].material.environment_exponent() : 0.0;
+  lopt.read = rd;
+  lopt.luminaire.position = iblcli::parse_vec3(o.luminaire, "--luminaire");
+  lopt.luminaire.forward = normalize(iblcli::parse_vec3(o.luminaire_dir, "--luminaire-dir"));
+  const Backend backend = open_backend(o.backend);
+  Truth truth;
+  photograph(o, d, &truth);
+  const fs::path stem = fs::path(o.out).replace_extension();
+  const std::string ext = fs::path(o.out).extension().string();
+  nlohmann::json renders = nlohmann::json::array();
+  for (const std::string& light : o.lights) {
+    d.lighting = Lighting{};
+    std::string kind;
+    render::read_lighting(light, lopt, &d.lighting, &kind);
+    if (std::string w = iblcli::grid_bounds_warning(d.lighting, s.object); !w.empty()) iblcli::info("warning: " + w);
+    nlohmann::json j = {{"scene", o.object.scene}, {"light", light}, {"lighting", kind}, {"size", o.size}};
+    RenderResult f = render_frame(o, d, backend, j);
+    // One --light writes --out; several write OUT_<light name>.ext each.
+    std::string out = o.lights.size() == 1 ? o.out : stem.string() + "_" + fs::path(light).stem().string() + ext;
+    if (ext == ".png" || ext == ".jpg") io::write_image(out, io::tonemap(f.color, truth.td));
+    else io::write_image(out, f.color);
+    j["output"] = out;
+    if (truth.photo) compare_with_truth(o, light, f, &truth, j);
+    renders.push_back(j);
+  }
+  nlohmann::json result = renders.size() == 1 ? renders[0] : nlohmann::json{{"renders", renders}};
+  if (truth.photo) result["truth_pictures"] = write_truth_pictures(o, stem, d.camera.width, d.camera.height, &truth);
+  iblcli::emit(result, [&] { print_renders(o, renders, result, backend.name); });
+}
+
+void setup(CLI::App& app) {
+  auto* o = new Opts();
+  add_options(app, o);
+  auto& rd = iblcli::add_probe_read_options(app);
+  app.callback([o, &rd] { run(*o, rd); });
 }
 
 // Demo step: the blob lit by the demo probe's 5-band SH, on the CPU and (where GL exists) on GL,
@@ -282,7 +343,7 @@ void demo_step(iblcli::DemoContext& ctx) {
   d.camera.width = 480;
   d.camera.height = 360;
   d.camera.eye = {0, 0.5, 1.6};
-  Mesh object = make_blob(60000, 0.8), floor = make_floor(6, -0.42);
+  geometry::TriMesh object = geometry::make_blob(60000, 0.8), floor = geometry::make_floor(6, -0.42);
   d.objects = {{&object, Material{{0.75, 0.75, 0.75}, {0.15, 0.15, 0.15}, 20}}, {&floor, Material{{0.5, 0.5, 0.5}, {0, 0, 0}, 1}}};
   auto probe = io::read_envmap(ctx.probe);
   d.lighting.environment = sh::project(probe, 5);
@@ -335,10 +396,10 @@ void demo_step(iblcli::DemoContext& ctx) {
     f9.camera.height = 240;
     f9.camera.eye = {0, 1.45, 1.5};
     f9.camera.target = {0, 0.8, 0};
-    Mesh small = iblcli::make_object("blob", 0.35, 30000, {0, 0.85, 0});
+    geometry::TriMesh small = render::make_object({.scene = "blob", .size = 0.35, .triangles = 30000, .at = {0, 0.85, 0}});
     Vec3 lo, hi;
     small.bounds(&lo, &hi);
-    Mesh table = make_floor(0.8, lo.y - 1e-3);
+    geometry::TriMesh table = geometry::make_floor(0.8, lo.y - 1e-3);
     f9.objects = {{&small, Material{{0.75, 0.75, 0.75}, {0, 0, 0}, 1}}, {&table, Material{{0.5, 0.5, 0.5}, {0, 0, 0}, 1}}};
     iblcli::LabPhotograph photo = iblcli::photograph_frame("low-scene2", f9, 3, 1);  // one bounce more than the capture
     io::ToneMapDesc t9;
@@ -347,9 +408,7 @@ void demo_step(iblcli::DemoContext& ctx) {
     std::vector<std::pair<std::string, Image>> sheet = {{"lab photograph", io::tonemap(photo.radiance, t9)}};
     nlohmann::json errs = nlohmann::json::object();
     for (const std::string& g : grids) {
-      iblcli::LightingOptions lo9;
-      std::string kind;
-      iblcli::load_lighting(g, lo9, &f9.lighting, &kind);
+      render::read_lighting(g, {}, &f9.lighting);
       RenderResult r = render_cpu(f9);
       iblcli::TruthComparison c = iblcli::compare(photo, r);
       std::string name = fs::path(g).stem().string();

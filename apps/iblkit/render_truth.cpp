@@ -11,24 +11,13 @@ namespace iblcli {
 
 using namespace ibl;
 
-namespace {
-
-geometry::TriMesh to_trimesh(const render::Mesh& m) {
-  geometry::TriMesh t;
-  for (size_t i = 0; i < m.vertex_count(); ++i) t.positions.push_back(m.position(i));
-  for (size_t i = 0; i < m.triangle_count(); ++i) t.triangles.push_back({m.indices[3 * i], m.indices[3 * i + 1], m.indices[3 * i + 2]});
-  return t;
-}
-
-}  // namespace
-
 LabPhotograph photograph_frame(const std::string& scene_path, const render::FrameDesc& d, int samples, int bounces,
                                const ProgressFn& progress) {
   lab::Scene scene = lab::load_scene(scene_path, false);
   LabPhotograph p;
   for (size_t i = 0; i < d.objects.size(); ++i)
     p.objects.push_back(
-        lab::add_object(scene, "object " + std::to_string(i), to_trimesh(*d.objects[i].mesh), d.objects[i].material.albedo));
+        lab::add_object(scene, "object " + std::to_string(i), *d.objects[i].mesh, d.objects[i].material.albedo));
   scene.build();
   lab::ViewDesc vd;
   vd.width = d.camera.width;

@@ -59,6 +59,66 @@ TEST(GeometryMesh, PrimitivesHaveTheirAreasAndOrientation) {
   EXPECT_NEAR(q.normal(0).z, 1, 1e-12);
 }
 
+// A unit cube of 8 shared corners: within a 40° crease every face keeps its own normal (each corner
+// splits into 3 vertices, 24 in all); with 100° all faces meet smoothly and the corners stay shared,
+// their normals pointing outwards along the corner's diagonal.
+TEST(GeometryMesh, WithNormalsSplitsCornersAtCreases) {
+  TriMesh cube;
+  for (int i = 0; i < 8; ++i) cube.positions.push_back({i & 1 ? 1.0 : -1.0, i & 2 ? 1.0 : -1.0, i & 4 ? 1.0 : -1.0});
+  const int faces[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};  // outward
+  for (const auto& f : faces) {
+    cube.triangles.push_back({static_cast<uint32_t>(f[0]), static_cast<uint32_t>(f[1]), static_cast<uint32_t>(f[2])});
+    cube.triangles.push_back({static_cast<uint32_t>(f[0]), static_cast<uint32_t>(f[2]), static_cast<uint32_t>(f[3])});
+  }
+  TriMesh hard = with_normals(cube, 40);
+  ASSERT_TRUE(hard.has_normals());
+  EXPECT_EQ(hard.vertex_count(), 24u);
+  EXPECT_EQ(hard.triangle_count(), 12u);
+  for (size_t t = 0; t < hard.triangle_count(); ++t)
+    for (uint32_t v : hard.triangles[t]) EXPECT_NEAR(length(hard.normals[v] - hard.normal(t)), 0, 1e-12) << "triangle " << t;
+  TriMesh smooth = with_normals(cube, 100);
+  EXPECT_EQ(smooth.vertex_count(), 8u);
+  for (size_t v = 0; v < 8; ++v) {
+    EXPECT_NEAR(length(smooth.normals[v]), 1, 1e-12);
+    EXPECT_GT(dot(smooth.normals[v], normalize(smooth.positions[v])), 0.8) << "corner " << v;
+  }
+}
+
+// The renderers' objects: a sphere's normals are its radii, the blob is closed and faces outwards
+// with unit smooth normals, the floor faces +Y with u along +X and v along −Z; normals follow flip,
+// transform and append.
+TEST(GeometryMesh, RenderObjectsCarryTheirNormals) {
+  TriMesh sph = make_sphere({1, 0, 0}, 0.5, 16, 32);
+  ASSERT_TRUE(sph.has_normals());
+  for (size_t i = 0; i < sph.vertex_count(); ++i) ASSERT_NEAR(length(sph.normals[i] - (sph.positions[i] - Vec3{1, 0, 0}) * 2.0), 0, 1e-12);
+  EXPECT_THROW(make_sphere({0, 0, 0}, 1, 1, 8), Error);
+  TriMesh blob = make_blob(4000, 0.8);
+  ASSERT_TRUE(blob.has_normals());
+  EXPECT_NEAR(blob.triangle_count(), 4000, 400);
+  int outward = 0;
+  for (size_t t = 0; t < blob.triangle_count(); ++t) outward += dot(blob.normal(t), blob.positions[blob.triangles[t][0]]) > 0;
+  EXPECT_GT(outward, 0.99 * blob.triangle_count());
+  for (const auto& t : blob.triangles)  // (one vertex at each pole belongs to no triangle)
+    for (uint32_t v : t) ASSERT_NEAR(length(blob.normals[v]), 1, 1e-12);
+  TriMesh floor = make_floor(2, -0.5);
+  ASSERT_TRUE(floor.has_normals() && floor.has_uvs());
+  EXPECT_NEAR(floor.total_area(), 4, kAreaTol);
+  for (size_t i = 0; i < floor.vertex_count(); ++i) {
+    EXPECT_EQ(floor.normals[i].y, 1.0);
+    EXPECT_EQ(floor.positions[i].y, -0.5);
+    EXPECT_NEAR(floor.uvs[i].x, (floor.positions[i].x + 1) / 2, 1e-12);
+    EXPECT_NEAR(floor.uvs[i].y, (1 - floor.positions[i].z) / 2, 1e-12);
+  }
+  for (size_t t = 0; t < floor.triangle_count(); ++t) EXPECT_NEAR(floor.normal(t).y, 1, 1e-12);
+  floor.flip();
+  EXPECT_EQ(floor.normals[0].y, -1.0);
+  floor.transform(Mat3::rotation({1, 0, 0}, kPi / 2), 1.0, {0, 0, 0});  // −Y turns to −Z
+  EXPECT_NEAR(floor.normals[0].z, -1, 1e-12);
+  floor.append(make_quad({0, 0, 0}, {0, 0, 1}, {0, 1, 0}, 1, 1));  // no normals: the result has none
+  EXPECT_FALSE(floor.has_normals());
+  EXPECT_TRUE(floor.has_uvs());
+}
+
 TEST(GeometryRayTracer, DistancesInsideABoxAreAnalytic) {
   Vec3 lo{-1, 0, -2}, hi{2, 3, 1}, o{0.3, 1.1, -0.4};
   RayTracer rt;

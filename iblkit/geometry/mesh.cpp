@@ -37,24 +37,45 @@ void TriMesh::bounds(Vec3* lo, Vec3* hi) const {
 
 void TriMesh::append(const TriMesh& o) {
   bool keep_uv = (positions.empty() || !uvs.empty()) && !o.uvs.empty();
+  bool keep_normals = (positions.empty() || !normals.empty()) && !o.normals.empty();
   auto base = static_cast<uint32_t>(positions.size());
   if (!keep_uv) uvs.clear();
+  if (!keep_normals) normals.clear();
   positions.insert(positions.end(), o.positions.begin(), o.positions.end());
   if (keep_uv) uvs.insert(uvs.end(), o.uvs.begin(), o.uvs.end());
+  if (keep_normals) normals.insert(normals.end(), o.normals.begin(), o.normals.end());
   for (auto t : o.triangles) triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
 }
 
 void TriMesh::transform(const Mat3& rotation, double scale, Vec3 translation) {
   for (Vec3& p : positions) p = rotation * (p * scale) + translation;
+  for (Vec3& n : normals) n = normalize(rotation * n);
+}
+
+void TriMesh::transform(double scale, Vec3 translation) {
+  for (Vec3& p : positions) p = p * scale + translation;
 }
 
 void TriMesh::flip() {
   for (auto& t : triangles) std::swap(t[1], t[2]);
+  for (Vec3& n : normals) n = -n;
+}
+
+void TriMesh::compute_normals() {
+  std::vector<Vec3> acc(positions.size());
+  for (const auto& t : triangles) {
+    Vec3 n = cross(positions[t[1]] - positions[t[0]], positions[t[2]] - positions[t[0]]);  // length = 2 × area
+    for (uint32_t v : t) acc[v] += n;
+  }
+  normals.resize(positions.size());
+  for (size_t i = 0; i < acc.size(); ++i) normals[i] = normalize(acc[i]);
 }
 
 void TriMesh::validate(const std::string& what) const {
   if (!uvs.empty() && uvs.size() != positions.size())
     fail(ErrorKind::Format, "{}: {} UVs for {} vertices", what, uvs.size(), positions.size());
+  if (!normals.empty() && normals.size() != positions.size())
+    fail(ErrorKind::Format, "{}: {} normals for {} vertices", what, normals.size(), positions.size());
   for (size_t i = 0; i < positions.size(); ++i)
     for (int k = 0; k < 3; ++k)
       if (!std::isfinite(positions[i][k])) fail(ErrorKind::Value, "{}: vertex {} is not finite", what, i);
@@ -62,6 +83,50 @@ void TriMesh::validate(const std::string& what) const {
     for (uint32_t v : triangles[i])
       if (v >= positions.size())
         fail(ErrorKind::Format, "{}: triangle {} names vertex {} of {}", what, i, v, positions.size());
+}
+
+TriMesh with_normals(const TriMesh& m, double crease_deg) {
+  // Smooth normals within smooth regions, hard edges at creases: each triangle corner averages the
+  // (area-weighted) normals of the triangles around its vertex that lie within crease_deg of its
+  // own face, and corners of one vertex that end up with different normals become separate vertices.
+  const size_t T = m.triangles.size();
+  std::vector<Vec3> face(T);  // area-weighted (length = 2 × area)
+  std::vector<std::vector<uint32_t>> around(m.positions.size());
+  for (size_t t = 0; t < T; ++t) {
+    const auto& tri = m.triangles[t];
+    face[t] = cross(m.positions[tri[1]] - m.positions[tri[0]], m.positions[tri[2]] - m.positions[tri[0]]);
+    for (uint32_t v : tri) around[v].push_back(static_cast<uint32_t>(t));
+  }
+  const double cos_crease = std::cos(crease_deg * kPi / 180);
+  const bool has_uv = m.uvs.size() == m.positions.size();
+  TriMesh out;
+  out.triangles.reserve(T);
+  // Corners of vertex v with identical normals share one output vertex.
+  std::vector<std::vector<std::pair<Vec3, uint32_t>>> made(m.positions.size());
+  for (size_t t = 0; t < T; ++t) {
+    const Vec3 nt = normalize(face[t]);
+    std::array<uint32_t, 3> corners{};
+    for (int c = 0; c < 3; ++c) {
+      const uint32_t v = m.triangles[t][c];
+      Vec3 acc;
+      for (uint32_t u : around[v])
+        if (dot(normalize(face[u]), nt) >= cos_crease) acc += face[u];
+      Vec3 n = length(acc) > 0 ? normalize(acc) : nt;
+      uint32_t id = UINT32_MAX;
+      for (const auto& [nn, k] : made[v])
+        if (length(nn - n) < 1e-9) id = k;
+      if (id == UINT32_MAX) {
+        id = static_cast<uint32_t>(out.vertex_count());
+        out.positions.push_back(m.positions[v]);
+        out.normals.push_back(n);
+        if (has_uv) out.uvs.push_back(m.uvs[v]);
+        made[v].push_back({n, id});
+      }
+      corners[c] = id;
+    }
+    out.triangles.push_back(corners);
+  }
+  return out;
 }
 
 namespace {
@@ -122,6 +187,7 @@ TriMesh make_disc(Vec3 center, Vec3 normal, double radius, int segments) {
 
 TriMesh make_sphere(Vec3 center, double radius, int rings, int segments, bool inward) {
   check_positive(radius, "sphere radius");
+  if (rings < 2 || segments < 3) fail(ErrorKind::Value, "sphere needs ≥ 2 rings and ≥ 3 segments ({} and {} given)", rings, segments);
   TriMesh m;
   for (int r = 0; r <= rings; ++r) {
     double th = kPi * r / rings;
@@ -129,6 +195,7 @@ TriMesh make_sphere(Vec3 center, double radius, int rings, int segments, bool in
       double ph = kTwoPi * s / segments;
       Vec3 d{std::sin(th) * std::cos(ph), std::cos(th), -std::sin(th) * std::sin(ph)};
       m.positions.push_back(center + d * radius);
+      m.normals.push_back(inward ? -d : d);
       m.uvs.push_back({static_cast<double>(s) / segments, 1.0 - static_cast<double>(r) / rings});
     }
   }
@@ -146,6 +213,31 @@ TriMesh make_sphere(Vec3 center, double radius, int rings, int segments, bool in
     bool out = dot(nn, p0 - center) > 0;
     if (out == inward) std::swap(t[1], t[2]);
   }
+  return m;
+}
+
+TriMesh make_blob(int triangles, double size) {
+  // rings × segments × 2 ≈ triangles with segments = 2 rings.
+  int rings = std::max(4, static_cast<int>(std::sqrt(triangles / 4.0)));
+  int segments = 2 * rings;
+  auto r = [&](Vec3 d) {
+    double body = 1.0 + 0.18 * d.y * d.y * (d.y < 0 ? 0.5 : -0.4) + 0.12 * d.x * d.z;  // pear-like body
+    double bumps = 0.04 * std::sin(5 * d.x + 1.3) * std::sin(4 * d.z + 0.7) * std::cos(3 * d.y);
+    // Two ears: narrow lobes up and slightly back.
+    auto lobe = [](Vec3 d, Vec3 axis, double sharp) { return std::pow(std::max(0.0, dot(d, normalize(axis))), sharp); };
+    double ears = 0.55 * lobe(d, {0.25, 1.0, 0.35}, 60) + 0.55 * lobe(d, {-0.25, 1.0, 0.35}, 60);
+    double snout = 0.25 * lobe(d, {0, 0.2, -1}, 12);
+    return 0.5 * size * (body + bumps + ears + snout);
+  };
+  TriMesh m = make_sphere({0, 0, 0}, 1.0, rings, segments);
+  for (Vec3& p : m.positions) p = p * r(p);  // p is the unit direction d on the sphere
+  m.compute_normals();
+  return m;
+}
+
+TriMesh make_floor(double size, double height) {
+  TriMesh m = make_quad({0, height, 0}, {0, 1, 0}, {0, 0, -1}, size, size);
+  m.normals.assign(m.positions.size(), Vec3{0, 1, 0});
   return m;
 }
 

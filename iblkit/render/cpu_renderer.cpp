@@ -15,6 +15,11 @@ namespace ibl::render {
 
 namespace {
 
+// A vertex attribute at float precision, as the GPU reads it (render/frame.h): both renderers draw
+// the same triangles with the same normals.
+Vec3 f32(Vec3 v) { return {static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z)}; }
+Vec2 f32(Vec2 v) { return {static_cast<float>(v.x), static_cast<float>(v.y)}; }
+
 // Embree scene of every object, for shadow rays.
 class ShadowScene {
  public:
@@ -23,14 +28,16 @@ class ShadowScene {
     if (!device_) fail(ErrorKind::Internal, "Embree device creation failed");
     scene_ = rtcNewScene(device_);
     for (const auto& o : d.objects) {
-      const Mesh& m = *o.mesh;
+      const geometry::TriMesh& m = *o.mesh;
       RTCGeometry g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
       auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
                                                             3 * sizeof(float), m.vertex_count()));
-      std::copy(m.positions.begin(), m.positions.end(), v);
+      for (size_t i = 0; i < m.vertex_count(); ++i)
+        for (int k = 0; k < 3; ++k) v[3 * i + k] = static_cast<float>(m.positions[i][k]);
       auto* idx = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
                                                                  3 * sizeof(uint32_t), m.triangle_count()));
-      std::copy(m.indices.begin(), m.indices.end(), idx);
+      for (size_t t = 0; t < m.triangle_count(); ++t)
+        for (int k = 0; k < 3; ++k) idx[3 * t + k] = m.triangles[t][k];
       rtcCommitGeometry(g);
       rtcAttachGeometry(scene_, g);
       rtcReleaseGeometry(g);
@@ -133,6 +140,7 @@ RenderResult render_cpu(const FrameDesc& d, const ProgressFn& progress) {
   const geometry::Camera& cam = d.camera;
   const int W = cam.width, H = cam.height;
   if (W <= 0 || H <= 0) fail(ErrorKind::Value, "frame size {}x{} is invalid", W, H);
+  check_objects(d);
   geometry::Mat4f vp = geometry::mul(cam.projection(), cam.view());
   std::vector<Hit> hits(static_cast<size_t>(W) * H);
   // Rasterise in horizontal bands, one task each: every band tests every triangle's bounds.
@@ -141,13 +149,13 @@ RenderResult render_cpu(const FrameDesc& d, const ProgressFn& progress) {
   parallel_for(0, bands, [&](int64_t band) {
     int y_lo = static_cast<int>(band) * kBand, y_hi = std::min(H, y_lo + kBand);
     for (size_t oi = 0; oi < d.objects.size(); ++oi) {
-      const Mesh& m = *d.objects[oi].mesh;
+      const geometry::TriMesh& m = *d.objects[oi].mesh;
       for (size_t t = 0; t < m.triangle_count(); ++t) {
         // Clip space, then clip against GL's near plane z ≥ −w, carrying each vertex's barycentric
         // coordinates in the original triangle.
         ClipVertex tri[3];
         for (int k = 0; k < 3; ++k) {
-          Vec3 p = m.position(m.indices[3 * t + k]);
+          Vec3 p = f32(m.positions[m.triangles[t][k]]);
           for (int r = 0; r < 4; ++r) tri[k].c[r] = vp[r] * p.x + vp[4 + r] * p.y + vp[8 + r] * p.z + vp[12 + r];
           tri[k].b = {k == 0 ? 1.0 : 0.0, k == 1 ? 1.0 : 0.0, k == 2 ? 1.0 : 0.0};
         }
@@ -176,17 +184,17 @@ RenderResult render_cpu(const FrameDesc& d, const ProgressFn& progress) {
         continue;
       }
       const RenderObject& o = d.objects[h.object];
-      const Mesh& m = *o.mesh;
-      uint32_t i0 = m.indices[3 * h.tri], i1 = m.indices[3 * h.tri + 1], i2 = m.indices[3 * h.tri + 2];
+      const geometry::TriMesh& m = *o.mesh;
+      const auto [i0, i1, i2] = m.triangles[h.tri];
       double b0 = 1.0 - h.b1 - h.b2;
-      Vec3 p = m.position(i0) * b0 + m.position(i1) * h.b1 + m.position(i2) * h.b2;
-      Vec3 n = normalize(m.normal(i0) * b0 + m.normal(i1) * h.b1 + m.normal(i2) * h.b2);
+      Vec3 p = f32(m.positions[i0]) * b0 + f32(m.positions[i1]) * h.b1 + f32(m.positions[i2]) * h.b2;
+      Vec3 n = normalize(f32(m.normals[i0]) * b0 + f32(m.normals[i1]) * h.b1 + f32(m.normals[i2]) * h.b2);
       Vec3 v = normalize(cam.eye - p);
       VisibilityFn vis;
       if (shadows)
         vis = [&](Vec3 q, Vec3 l, double dist) { return !shadows->occluded(q + n * d.shadow_bias, l, dist); };
       if (o.material.texture) {
-        Vec2 uv = m.has_uvs() ? m.uv(i0) * b0 + m.uv(i1) * h.b1 + m.uv(i2) * h.b2 : Vec2{0, 0};
+        Vec2 uv = m.has_uvs() ? f32(m.uvs[i0]) * b0 + f32(m.uvs[i1]) * h.b1 + f32(m.uvs[i2]) * h.b2 : Vec2{0, 0};
         Material tm = o.material;
         tm.albedo = tm.albedo * texture_albedo(*o.material.texture, uv);
         f.color.set_rgb(x, y, shade(d.lighting, tm, p, n, v, vis));

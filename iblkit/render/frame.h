@@ -1,14 +1,16 @@
 // What both renderers draw: a mesh with a material, seen by a camera, under a lighting.
 #pragma once
 #include "iblkit/core/image.h"
+#include "iblkit/geometry/mesh.h"
 #include "iblkit/geometry/camera.h"
-#include "iblkit/render/mesh.h"
 #include "iblkit/render/shading.h"
 
 namespace ibl::render {
 
 struct RenderObject {
-  const Mesh* mesh = nullptr;
+  const geometry::TriMesh* mesh = nullptr;  // with vertex normals (geometry::with_normals); both
+                                            // renderers read its positions, normals and UVs at float
+                                            // precision (the GPU's)
   Material material;
 };
 
@@ -25,6 +27,10 @@ struct FrameDesc {
                                  // from the group's mean position (0: a map each)
   double shadow_bias = 2e-3;   // offset along the normal before shadow tests, metres
 };
+
+// Throws ibl::Error unless every object has a mesh with one normal per vertex (both renderers call
+// it; a mesh without UVs, or with too few, reads its texture at (0,0)).
+void check_objects(const FrameDesc& d);
 
 // Per-pixel result: RGB radiance (linear HDR) and coverage.
 struct RenderResult {

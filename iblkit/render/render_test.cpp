@@ -11,7 +11,7 @@
 #include "iblkit/io/image_io.h"
 #include "iblkit/io/tonemap.h"
 #include "iblkit/render/cpu_renderer.h"
-#include "iblkit/render/mesh.h"
+#include "iblkit/geometry/mesh.h"
 #include "iblkit/sh/basis.h"
 #ifdef IBLKIT_HAVE_GL
 #include <epoxy/gl.h>
@@ -26,7 +26,7 @@
 namespace ibl::render {
 namespace {
 
-FrameDesc sphere_scene(const Mesh* mesh, int w = 96, int h = 72) {
+FrameDesc sphere_scene(const geometry::TriMesh* mesh, int w = 96, int h = 72) {
   FrameDesc d;
   d.camera.eye = {0, 0.2, 1.5};
   d.camera.target = {0, 0, 0};
@@ -38,7 +38,7 @@ FrameDesc sphere_scene(const Mesh* mesh, int w = 96, int h = 72) {
 
 // The 128×96 view of a blob (slightly glossy) on a floor that the light-kind tests share; a test that
 // wants other objects replaces d.objects.
-FrameDesc blob_scene(const Mesh* blob, const Mesh* floor) {
+FrameDesc blob_scene(const geometry::TriMesh* blob, const geometry::TriMesh* floor) {
   FrameDesc d;
   d.objects = {{blob, Material{{0.7, 0.6, 0.5}, {0.1, 0.1, 0.1}, 20}}, {floor, Material{}}};
   d.camera.eye = {0.3, 0.9, 1.4};
@@ -69,7 +69,7 @@ void expect_sphere_shading(const FrameDesc& d, const RenderResult& f, double tol
 // then reflects exactly ρ everywhere (E = π); SH carries the constant exactly.
 TEST(RenderCpu, WhiteFurnaceGivesAlbedo) {
   constexpr double kFurnaceTol = 1e-5;  // float interpolation of normals; the answer is exact
-  Mesh m = make_blob(4000, 0.8);
+  geometry::TriMesh m = geometry::make_blob(4000, 0.8);
   FrameDesc d = sphere_scene(&m);
   d.objects[0].material.albedo = {0.3, 0.5, 0.7};
   sh::Coeffs env;
@@ -95,7 +95,7 @@ TEST(RenderCpu, WhiteFurnaceGivesAlbedo) {
 // every pixel (ray–sphere intersection).
 TEST(RenderCpu, DirectionalLightOnSphereMatchesClosedForm) {
   constexpr double kFacetTol = 0.02;  // interpolated normals of a 64×128 UV sphere vs the true sphere
-  Mesh m = make_sphere(0.4, 64, 128);
+  geometry::TriMesh m = geometry::make_sphere({0, 0, 0}, 0.4, 64, 128);
   FrameDesc d = sphere_scene(&m);
   d.objects[0].material.albedo = {0.5, 0.5, 0.5};
   Vec3 l = normalize(Vec3{0.4, 0.8, 0.5});
@@ -106,7 +106,7 @@ TEST(RenderCpu, DirectionalLightOnSphereMatchesClosedForm) {
 // A point light near a sphere: L_o = ρ/π · I · max(0, n·l)/d² with l and d from the exact hit point.
 TEST(RenderCpu, PointLightOnSphereMatchesClosedForm) {
   constexpr double kFacetTol = 0.02;  // interpolated normals and facet positions of the UV sphere
-  Mesh m = make_sphere(0.4, 64, 128);
+  geometry::TriMesh m = geometry::make_sphere({0, 0, 0}, 0.4, 64, 128);
   FrameDesc d = sphere_scene(&m);
   d.objects[0].material.albedo = {0.5, 0.5, 0.5};
   const Vec3 q{0.5, 0.9, 0.7};
@@ -119,7 +119,7 @@ TEST(RenderCpu, PointLightOnSphereMatchesClosedForm) {
 
 // A floor under a blob and a light from above: the floor below the blob is in shadow.
 TEST(RenderCpu, ShadowsFromShadowRays) {
-  Mesh blob = make_blob(2000, 0.4), floor = make_floor(4, -0.3);
+  geometry::TriMesh blob = geometry::make_blob(2000, 0.4), floor = geometry::make_floor(4, -0.3);
   FrameDesc d;
   d.camera.eye = {0, 2.5, 0.01};
   d.camera.target = {0, 0, 0};
@@ -184,16 +184,13 @@ Agreement compare(const RenderResult& a, const RenderResult& b) {
 }
 
 // An SH grid of nx × ny × nz points over the box ±0.5, its values zero.
-SHGridData unit_box_grid(int bands, int nx, int ny, int nz) {
-  SHGridData g;
-  g.bands = bands;
-  g.nx = nx;
-  g.ny = ny;
-  g.nz = nz;
-  g.min = {-0.5, -0.5, -0.5};
-  g.max = {0.5, 0.5, 0.5};
-  g.data.assign(static_cast<size_t>(nx) * ny * nz * bands * bands * 3, 0.0f);
-  return g;
+ilf::SHGrid unit_box_grid(int bands, int nx, int ny, int nz) {
+  ilf::GridDesc gd;
+  gd.nx = nx;
+  gd.ny = ny;
+  gd.nz = nz;
+  gd.volume = {{-0.5, -0.5, -0.5}, {0.5, 0.5, 0.5}};
+  return ilf::SHGrid(gd, bands);
 }
 
 // A textured spotlight at `at` shining along `forward`, its texture over ±half on a plane 0.5 m
@@ -325,7 +322,7 @@ TEST_F(RenderGl, GlslShTableMatchesCpp) {
 
 TEST_F(RenderGl, ShEnvironmentAgreesWithCpu) {
   gl::Context ctx;
-  Mesh m = make_sphere(0.4, 48, 96);
+  geometry::TriMesh m = geometry::make_sphere({0, 0, 0}, 0.4, 48, 96);
   FrameDesc d = sphere_scene(&m, 80, 60);
   sh::Coeffs env;
   env.bands = 5;
@@ -345,10 +342,10 @@ TEST_F(RenderGl, ShEnvironmentAgreesWithCpu) {
 // table (64² faces).
 TEST_F(RenderGl, ShGridAgreesWithCpu) {
   gl::Context ctx;
-  Mesh m = make_blob(6000, 0.5);
+  geometry::TriMesh m = geometry::make_blob(6000, 0.5);
   FrameDesc d = sphere_scene(&m, 96, 72);
-  SHGridData g = unit_box_grid(5, 4, 5, 3);
-  for (size_t i = 0; i < g.data.size(); ++i) g.data[i] = static_cast<float>((i % 75 < 3 ? 2.0 : 0.1) * (1 + 0.5 * std::sin(0.37 * i)));
+  ilf::SHGrid g = unit_box_grid(5, 4, 5, 3);
+  for (size_t i = 0; i < g.data().size(); ++i) g.data()[i] = static_cast<float>((i % 75 < 3 ? 2.0 : 0.1) * (1 + 0.5 * std::sin(0.37 * i)));
   d.lighting.grid = g;
   d.objects[0].material.specular = {0.3, 0.3, 0.3};
   d.objects[0].material.exponent = 30;
@@ -364,7 +361,7 @@ TEST_F(RenderGl, ShGridAgreesWithCpu) {
 
 TEST_F(RenderGl, DirectionalLightsWithShadowsAgreeWithCpu) {
   gl::Context ctx;
-  Mesh blob = make_blob(6000, 0.5), floor = make_floor(3, -0.25);
+  geometry::TriMesh blob = geometry::make_blob(6000, 0.5), floor = geometry::make_floor(3, -0.25);
   FrameDesc d = blob_scene(&blob, &floor);
   d.lighting.lights = {{normalize(Vec3{0.5, 1, 0.3}), {2, 2, 2}, true}, {normalize(Vec3{-0.6, 0.7, -0.2}), {0.5, 0.4, 0.3}, true},
                        {normalize(Vec3{0, 1, 0}), {0.2, 0.2, 0.3}, false}};
@@ -379,7 +376,7 @@ TEST_F(RenderGl, DirectionalLightsWithShadowsAgreeWithCpu) {
 
 TEST_F(RenderGl, PointLightsWithShadowsAgreeWithCpu) {
   gl::Context ctx;
-  Mesh blob = make_blob(6000, 0.5), floor = make_floor(1.6, -0.25);
+  geometry::TriMesh blob = geometry::make_blob(6000, 0.5), floor = geometry::make_floor(1.6, -0.25);
   FrameDesc d = blob_scene(&blob, &floor);
   d.lighting.point_lights = {{{1.2, 1.5, 0.6}, {4, 4, 4}, true}, {{-1.0, 0.8, -0.9}, {1.0, 0.8, 0.6}, true},
                              {{0, 2, 0}, {0.3, 0.3, 0.4}, false}};
@@ -405,7 +402,7 @@ TEST_F(RenderGl, PointLightsWithShadowsAgreeWithCpu) {
 // against the CPU reference with shadow rays: same texels, same mip selection, same formulas.
 TEST_F(RenderGl, TexturedSpotlightsWithShadowsAgreeWithCpu) {
   gl::Context ctx;
-  Mesh blob = make_blob(6000, 0.5), floor = make_floor(3, -0.25);
+  geometry::TriMesh blob = geometry::make_blob(6000, 0.5), floor = geometry::make_floor(3, -0.25);
   FrameDesc d = blob_scene(&blob, &floor);
   d.spot_shadow_map_size = 512;
   Image tex(32, 24, 3);
@@ -449,7 +446,7 @@ TEST_F(RenderGl, LayeredShadowPassEqualsPassPerLight) {
   gl::Context ctx;
   if (!epoxy_has_gl_extension("GL_ARB_shader_viewport_layer_array"))
     GTEST_SKIP() << "this GL has no GL_ARB_shader_viewport_layer_array: the renderer uses one pass per light";
-  Mesh blob = make_blob(6000, 0.5), floor = make_floor(1.6, -0.25);
+  geometry::TriMesh blob = geometry::make_blob(6000, 0.5), floor = geometry::make_floor(1.6, -0.25);
   FrameDesc d = blob_scene(&blob, &floor);
   d.lighting.lights = {{normalize(Vec3{0.5, 1, 0.3}), {1, 1, 1}, true}, {normalize(Vec3{-0.6, 0.7, -0.2}), {0.5, 0.4, 0.3}, true}};
   d.lighting.point_lights = {{{0.45, 0.35, 0.3}, {1, 1, 1}, true}};  // inside the bounds: a cube of six layers
@@ -497,11 +494,11 @@ TEST_F(RenderGl, LayeredShadowPassEqualsPassPerLight) {
 // on a fresh renderer, and a frame left on the GPU is the frame that would have been read back.
 TEST_F(RenderGl, KeptUploadsFollowChangedLighting) {
   gl::Context ctx;
-  Mesh blob = make_blob(3000, 0.5);
+  geometry::TriMesh blob = geometry::make_blob(3000, 0.5);
   FrameDesc d = sphere_scene(&blob, 64, 48);
-  SHGridData g = unit_box_grid(3, 3, 3, 3);
-  std::fill(g.data.begin(), g.data.end(), 0.1f);
-  for (size_t p = 0; p < 27; ++p) g.data[p * 27] = g.data[p * 27 + 1] = g.data[p * 27 + 2] = 1.0f;
+  ilf::SHGrid g = unit_box_grid(3, 3, 3, 3);
+  std::fill(g.data().begin(), g.data().end(), 0.1f);
+  for (size_t p = 0; p < 27; ++p) g.data()[p * 27] = g.data()[p * 27 + 1] = g.data()[p * 27 + 2] = 1.0f;
   d.lighting.grid = g;
   gl::Renderer kept;
   auto same = [](const RenderResult& a, const RenderResult& b) {
@@ -511,7 +508,7 @@ TEST_F(RenderGl, KeptUploadsFollowChangedLighting) {
     return worst;
   };
   RenderResult first = kept.render(d);
-  d.lighting.grid->data[((2 * 3 + 1) * 3 + 1) * 27] = 3.0f;  // the same grid object: point (1,1,2)'s red DC term
+  d.lighting.grid->data()[((2 * 3 + 1) * 3 + 1) * 27] = 3.0f;  // the same grid object: point (1,1,2)'s red DC term
   RenderResult changed = kept.render(d);
   EXPECT_GT(same(first, changed), 1e-3);
   EXPECT_EQ(same(changed, gl::Renderer().render(d)), 0.0);
@@ -566,7 +563,7 @@ TEST_F(RenderGl, KeptUploadsFollowChangedLighting) {
 // for each tone curve, with the frame never leaving the GPU.
 TEST_F(RenderGl, PresentMatchesCpuToneMapping) {
   gl::Context ctx;
-  Mesh m = make_sphere(0.4, 32, 64);
+  geometry::TriMesh m = geometry::make_sphere({0, 0, 0}, 0.4, 32, 64);
   FrameDesc d = sphere_scene(&m, 80, 60);
   d.lighting.lights = {{normalize(Vec3{0.3, 1, 0.5}), {6, 5, 4}, false}};
   d.objects[0].material.specular = {0.4, 0.4, 0.4};
@@ -612,7 +609,7 @@ TEST_F(RenderGl, PresentMatchesCpuToneMapping) {
 // Phong lobe of s/4), on both renderers.
 TEST_F(RenderGl, TexturedBlinnPhongAgreesWithCpu) {
   gl::Context ctx;
-  Mesh blob = make_blob(6000, 0.5), floor = make_floor(3, -0.25);
+  geometry::TriMesh blob = geometry::make_blob(6000, 0.5), floor = geometry::make_floor(3, -0.25);
   ASSERT_TRUE(blob.has_uvs());
   ASSERT_TRUE(floor.has_uvs());
   auto tex = std::make_shared<Image>(64, 32, 3);
@@ -645,7 +642,7 @@ TEST_F(RenderGl, TexturedBlinnPhongAgreesWithCpu) {
 // read the same texels with the same bilinear filter.
 TEST_F(RenderGl, GlossyMapAgreesWithCpu) {
   gl::Context ctx;
-  Mesh m = make_sphere(0.4, 48, 96);
+  geometry::TriMesh m = geometry::make_sphere({0, 0, 0}, 0.4, 48, 96);
   FrameDesc d = sphere_scene(&m, 80, 60);
   sphere::EnvMap probe(Image(64, 32, 3), sphere::Mapping(sphere::MappingKind::LatLong, 64, 32));
   for (int y = 0; y < 32; ++y)

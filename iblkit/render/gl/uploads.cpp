@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include "iblkit/core/error.h"
 
@@ -11,21 +12,44 @@ namespace ibl::render::gl {
 
 namespace {
 
-// UVs of a mesh for the GPU: its own, or zeros.
-std::vector<float> gpu_uvs(const Mesh& m) {
-  return m.has_uvs() ? m.uvs : std::vector<float>(2 * m.vertex_count(), 0.0f);
+// A mesh as the GPU takes it: float positions, normals and UVs (zeros where the mesh has none),
+// uint32 indices.
+struct Packed {
+  std::vector<float> positions, normals, uvs;
+  std::vector<uint32_t> indices;
+};
+
+Packed pack(const geometry::TriMesh& m) {
+  Packed p;
+  const size_t n = m.vertex_count();
+  p.positions.resize(3 * n);
+  p.normals.resize(3 * n);
+  p.uvs.assign(2 * n, 0.0f);
+  for (size_t i = 0; i < n; ++i)
+    for (int k = 0; k < 3; ++k) {
+      p.positions[3 * i + k] = static_cast<float>(m.positions[i][k]);
+      p.normals[3 * i + k] = static_cast<float>(m.normals[i][k]);
+    }
+  if (m.has_uvs())
+    for (size_t i = 0; i < n; ++i) {
+      p.uvs[2 * i] = static_cast<float>(m.uvs[i].x);
+      p.uvs[2 * i + 1] = static_cast<float>(m.uvs[i].y);
+    }
+  p.indices.resize(3 * m.triangle_count());
+  for (size_t t = 0; t < m.triangle_count(); ++t)
+    for (int k = 0; k < 3; ++k) p.indices[3 * t + k] = m.triangles[t][k];
+  return p;
 }
 
-MeshBuffers upload(const Mesh& m) {
+MeshBuffers upload(const Packed& m) {
   MeshBuffers b;
   glCreateVertexArrays(1, &b.vao);
   glCreateBuffers(3, b.vbo);
   glCreateBuffers(1, &b.ebo);
-  const std::vector<float> uv = gpu_uvs(m);
-  glNamedBufferStorage(b.vbo[0], static_cast<GLsizeiptr>(m.positions.size() * sizeof(float)), m.positions.data(), 0);
-  glNamedBufferStorage(b.vbo[1], static_cast<GLsizeiptr>(m.normals.size() * sizeof(float)), m.normals.data(), 0);
-  glNamedBufferStorage(b.vbo[2], static_cast<GLsizeiptr>(std::max<size_t>(1, uv.size()) * sizeof(float)), uv.data(), 0);
-  glNamedBufferStorage(b.ebo, static_cast<GLsizeiptr>(m.indices.size() * sizeof(uint32_t)), m.indices.data(), 0);
+  glNamedBufferStorage(b.vbo[0], static_cast<GLsizeiptr>(std::max<size_t>(1, m.positions.size()) * sizeof(float)), m.positions.data(), 0);
+  glNamedBufferStorage(b.vbo[1], static_cast<GLsizeiptr>(std::max<size_t>(1, m.normals.size()) * sizeof(float)), m.normals.data(), 0);
+  glNamedBufferStorage(b.vbo[2], static_cast<GLsizeiptr>(std::max<size_t>(1, m.uvs.size()) * sizeof(float)), m.uvs.data(), 0);
+  glNamedBufferStorage(b.ebo, static_cast<GLsizeiptr>(std::max<size_t>(1, m.indices.size()) * sizeof(uint32_t)), m.indices.data(), 0);
   for (int a = 0; a < 3; ++a) {
     const int n = a == 2 ? 2 : 3;
     glVertexArrayVertexBuffer(b.vao, a, b.vbo[a], 0, n * sizeof(float));
@@ -36,6 +60,12 @@ MeshBuffers upload(const Mesh& m) {
   glVertexArrayElementBuffer(b.vao, b.ebo);
   b.count = static_cast<int>(m.indices.size());
   return b;
+}
+
+// The same values, bit for bit (a moved or changed mesh is uploaded again).
+template <typename T>
+bool same_values(const std::vector<T>& a, const std::vector<T>& b) {
+  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
 }
 
 void release_buffers(MeshBuffers& b) {
@@ -72,15 +102,19 @@ void Uploads::Geometry::release() {
 const Uploads::Geometry& Uploads::geometry(const std::vector<RenderObject>& objects, bool deferred) {
   bool same = geometry_.keys.size() == objects.size();
   for (size_t i = 0; same && i < objects.size(); ++i) {
-    const Mesh& a = *objects[i].mesh;
-    const Mesh& b = geometry_.keys[i];
-    same = a.positions == b.positions && a.normals == b.normals && a.uvs == b.uvs && a.indices == b.indices;
+    const geometry::TriMesh& a = *objects[i].mesh;
+    const geometry::TriMesh& b = geometry_.keys[i];
+    same = same_values(a.positions, b.positions) && same_values(a.normals, b.normals) && same_values(a.uvs, b.uvs) &&
+           same_values(a.triangles, b.triangles);
   }
+  if (same && (!deferred || geometry_.ssbo[0])) return geometry_;
+  std::vector<Packed> packed;
+  for (const auto& o : objects) packed.push_back(pack(*o.mesh));
   if (!same) {
     geometry_.release();
-    for (const auto& o : objects) {
-      geometry_.meshes.push_back(upload(*o.mesh));
-      geometry_.keys.push_back(*o.mesh);
+    for (size_t i = 0; i < objects.size(); ++i) {
+      geometry_.meshes.push_back(upload(packed[i]));
+      geometry_.keys.push_back(*objects[i].mesh);
     }
   }
   if (deferred && !geometry_.ssbo[0]) {
@@ -89,14 +123,13 @@ const Uploads::Geometry& Uploads::geometry(const std::vector<RenderObject>& obje
     std::vector<uint32_t> object_table;
     std::vector<float> pos, nrm, uvs;
     std::vector<uint32_t> idx;
-    for (const auto& o : objects) {
-      if (o.mesh->triangle_count() >= (1u << 24)) fail(ErrorKind::Value, "a mesh of {} triangles is over the deferred path's 2^24", o.mesh->triangle_count());
+    for (const Packed& p : packed) {
+      if (p.indices.size() / 3 >= (1u << 24)) fail(ErrorKind::Value, "a mesh of {} triangles is over the deferred path's 2^24", p.indices.size() / 3);
       object_table.insert(object_table.end(), {static_cast<uint32_t>(pos.size() / 3), static_cast<uint32_t>(idx.size()), 0u, 0u});
-      pos.insert(pos.end(), o.mesh->positions.begin(), o.mesh->positions.end());
-      nrm.insert(nrm.end(), o.mesh->normals.begin(), o.mesh->normals.end());
-      const std::vector<float> uv = gpu_uvs(*o.mesh);
-      uvs.insert(uvs.end(), uv.begin(), uv.end());
-      idx.insert(idx.end(), o.mesh->indices.begin(), o.mesh->indices.end());
+      pos.insert(pos.end(), p.positions.begin(), p.positions.end());
+      nrm.insert(nrm.end(), p.normals.begin(), p.normals.end());
+      uvs.insert(uvs.end(), p.uvs.begin(), p.uvs.end());
+      idx.insert(idx.end(), p.indices.begin(), p.indices.end());
     }
     glCreateBuffers(5, geometry_.ssbo);
     glNamedBufferStorage(geometry_.ssbo[0], static_cast<GLsizeiptr>(std::max<size_t>(4, object_table.size()) * 4), object_table.data(), 0);
@@ -109,22 +142,23 @@ const Uploads::Geometry& Uploads::geometry(const std::vector<RenderObject>& obje
 }
 
 // (Compared in full: a memcmp costs a tenth of packing and uploading the values again.)
-unsigned Uploads::grid_texture(const SHGridData& g) {
-  if (grid_tex_ && g.nx == grid_key_.nx && g.ny == grid_key_.ny && g.nz == grid_key_.nz && g.bands == grid_key_.bands &&
-      g.data == grid_key_.data)
+unsigned Uploads::grid_texture(const ilf::SHGrid& g) {
+  const ilf::GridDesc &gd = g.grid(), &key = grid_key_.grid();
+  if (grid_tex_ && gd.nx == key.nx && gd.ny == key.ny && gd.nz == key.nz && g.bands() == grid_key_.bands() &&
+      g.data() == grid_key_.data())
     return grid_tex_;
   if (grid_tex_) glDeleteTextures(1, &grid_tex_);
   grid_tex_ = 0;  // (nothing stale is left if what follows throws)
   grid_key_ = {};
-  const int K = g.bands * g.bands;
-  const size_t points = static_cast<size_t>(g.nx) * g.ny * g.nz;
+  const int K = g.coeff_count();
+  const size_t points = static_cast<size_t>(gd.count());
   std::vector<float> packed(points * K * 4, 0.0f);
   for (int k = 0; k < K; ++k)
     for (size_t p = 0; p < points; ++p)
-      for (int c = 0; c < 3; ++c) packed[(static_cast<size_t>(k) * points + p) * 4 + c] = g.data[(p * K + k) * 3 + c];
+      for (int c = 0; c < 3; ++c) packed[(static_cast<size_t>(k) * points + p) * 4 + c] = g.data()[(p * K + k) * 3 + c];
   glCreateTextures(GL_TEXTURE_3D, 1, &grid_tex_);
-  glTextureStorage3D(grid_tex_, 1, GL_RGBA16F, g.nx, g.ny, g.nz * K);
-  glTextureSubImage3D(grid_tex_, 0, 0, 0, 0, g.nx, g.ny, g.nz * K, GL_RGBA, GL_FLOAT, packed.data());
+  glTextureStorage3D(grid_tex_, 1, GL_RGBA16F, gd.nx, gd.ny, gd.nz * K);
+  glTextureSubImage3D(grid_tex_, 0, 0, 0, 0, gd.nx, gd.ny, gd.nz * K, GL_RGBA, GL_FLOAT, packed.data());
   glTextureParameteri(grid_tex_, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
   glTextureParameteri(grid_tex_, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
   for (GLenum w : {GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T, GL_TEXTURE_WRAP_R}) glTextureParameteri(grid_tex_, w, GL_CLAMP_TO_EDGE);

@@ -8,12 +8,14 @@
 #include <vector>
 
 #include "iblkit/core/image.h"
+#include "iblkit/ilf/shgrid.h"
 #include "iblkit/nearfield/spotlight.h"
 #include "iblkit/render/frame.h"
 
 namespace ibl::render::gl {
 
-// A mesh's vertex array: positions, normals, UVs (zeros where the mesh has none) and indices.
+// A mesh's vertex array: positions, normals, UVs (zeros where the mesh has none) and indices, packed
+// into float and uint32 buffers.
 struct MeshBuffers {
   unsigned vao = 0, vbo[3] = {0, 0, 0}, ebo = 0;
   int count = 0;  // indices
@@ -35,7 +37,7 @@ class Uploads {
   // the compute pass (object table {first vertex, first index, 0, 0}, positions, normals, indices,
   // UVs).
   struct Geometry {
-    std::vector<Mesh> keys;
+    std::vector<geometry::TriMesh> keys;  // copies of the meshes uploaded
     std::vector<MeshBuffers> meshes;
     unsigned ssbo[5] = {0, 0, 0, 0, 0};
     void release();
@@ -43,7 +45,7 @@ class Uploads {
   const Geometry& geometry(const std::vector<RenderObject>& objects, bool deferred);
 
   // The SH grid in one RGBA16F 3D texture, coefficient k in slices [k·nz, (k+1)·nz).
-  unsigned grid_texture(const SHGridData& grid);
+  unsigned grid_texture(const ilf::SHGrid& grid);
 
   // The spotlights' textures in one mip-mapped RGBA16F 2D array, a layer per spotlight, each
   // divided by its largest |texel| (`scale`: half floats stop at 65504).
@@ -60,7 +62,7 @@ class Uploads {
   int color_w_ = 0, color_h_ = 0;
   Geometry geometry_;
   unsigned grid_tex_ = 0;
-  SHGridData grid_key_;
+  ilf::SHGrid grid_key_;
   SpotTextures spots_;
 };
 

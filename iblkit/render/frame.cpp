@@ -1,0 +1,17 @@
+#include "iblkit/render/frame.h"
+
+#include "iblkit/core/error.h"
+
+namespace ibl::render {
+
+void check_objects(const FrameDesc& d) {
+  for (size_t i = 0; i < d.objects.size(); ++i) {
+    const geometry::TriMesh* m = d.objects[i].mesh;
+    if (!m) fail(ErrorKind::Value, "object {} has no mesh", i);
+    if (!m->has_normals() && m->vertex_count() > 0)
+      fail(ErrorKind::Value, "object {}: its mesh has {} normals for {} vertices (geometry::with_normals gives a mesh its shading normals)",
+           i, m->normals.size(), m->vertex_count());
+  }
+}
+
+}  // namespace ibl::render
