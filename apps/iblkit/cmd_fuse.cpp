@@ -51,7 +51,7 @@ void add_fuse_options(CLI::App& c, FuseOpts& o) {
 
 ibl::fusion::FuseDesc fuse_desc(const FuseOpts& o) {
   fu::FuseDesc d;
-  d.mapping = mapping_from_name(o.mapping);
+  d.mapping = ibl::sphere::parse_mapping(o.mapping);
   d.size = o.size;
   d.blend = fu::parse_blend(o.blend);
   d.visibility = !o.no_visibility;

@@ -69,7 +69,7 @@ void run_capture(const CaptureOpts& o) {
   if (o.env_samples > 0) d.capture.render.env_samples = o.env_samples;
   if (o.seed > 0) d.capture.render.seed = o.seed;
   if (o.random > 0) pos = ibl::lab::random_positions(lo, hi, o.random, d.capture.render.seed);
-  d.capture.mapping = iblcli::mapping_from_name(o.mapping);
+  d.capture.mapping = ibl::sphere::parse_mapping(o.mapping);
   d.capture.size = o.size;
   d.capture.samples = o.samples;
   d.capture.dead_angle_deg = o.dead_angle;

@@ -36,7 +36,7 @@ Sequence read_sequence(const std::string& path, const SequenceReadDesc& desc, Se
   Sequence seq;
   seq.manifest = path;
   std::string mapping = j.value("mapping", "mirrorball");
-  auto kind = sphere::parse_mapping_kind(mapping);
+  auto kind = sphere::find_mapping(mapping);
   if (!kind) fail(ErrorKind::Format, "{}: field \"mapping\": unknown mapping \"{}\"", path, mapping);
   seq.mapping = *kind;
   if (j.contains("dead_angle_deg")) {
