@@ -13,6 +13,7 @@
 #include "fuse_cli.h"
 #include "fusion_pictures.h"
 #include "iblkit/core/error.h"
+#include "iblkit/core/json_file.h"
 #include "iblkit/fusion/local_lights.h"
 #include "iblkit/io/draw.h"
 #include "iblkit/io/image_io.h"
@@ -170,7 +171,7 @@ void run_path(const FuseOpts& o, const std::string& probes, const std::string& p
     auto lj = ibl::lights::to_json(filt);
     for (size_t i = 0; i < filt.lights.size(); ++i) lj["lights"][i]["id"] = filt_tr.ids()[i];
     lj["time"] = path[k].time;
-    std::ofstream(dir / "lights" / (name + ".json")) << lj.dump(1) << "\n";
+    ibl::write_json_file((dir / "lights" / (name + ".json")).string(), lj);
     if (k % every == 0 && pics.size() < 8) {
       filt.regions = raw.regions;  // outlines of this frame's cut; markers at the filtered lights
       pics.push_back({fmt::format("frame {} at ({:.2f}, {:.2f}, {:.2f})", k, path[k].position.x, path[k].position.y,
@@ -199,7 +200,7 @@ void run_path(const FuseOpts& o, const std::string& probes, const std::string& p
                       {"shadow_light_jitter_deg", {{"unfiltered", jit_raw * 180 / ibl::kPi}, {"filtered", jit_filt * 180 / ibl::kPi}}},
                       {"lights_vs_map", {{"unfiltered", err_raw}, {"filtered", err_filt}}},
                       {"out", out}};
-  std::ofstream(dir / "path_summary.json") << j.dump(1) << "\n";
+  ibl::write_json_file((dir / "path_summary.json").string(), j);
   std::string png = (dir / "path.png").string();
   ibl::io::write_image(png, ibl::io::contact_sheet(pics, 2, 512, 256,
                                                    fmt::format("{} frames, {} tracked lights (filter time constant {})", path.size(), nlights, tau)));

@@ -10,6 +10,7 @@
 
 #include "cli.h"
 #include "iblkit/core/error.h"
+#include "iblkit/core/json_file.h"
 #include "iblkit/io/image_io.h"
 #include "iblkit/io/tonemap.h"
 #include "iblkit/lab/capture.h"
@@ -143,7 +144,7 @@ void run_truth(const TruthOpts& o) {
     ibl::io::write_image((out / "radiance.png").string(), ibl::io::tonemap(t.radiance.image));
     if (d.bands > 0) ibl::sh::write_coeffs((out / "sh.json").string(), t.sh);
     if (!t.sh_visible.c.empty()) ibl::sh::write_coeffs((out / "sh_visible.json").string(), t.sh_visible);
-    std::ofstream(out / "truth.json") << j.dump(1) << "\n";
+    ibl::write_json_file((out / "truth.json").string(), j);
     j["out"] = o.out;
   }
   iblcli::emit(j, [&] {

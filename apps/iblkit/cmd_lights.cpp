@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 
 #include "cli.h"
+#include "iblkit/core/atomic_file.h"
 #include "iblkit/core/error.h"
 #include "iblkit/io/image_io.h"
 #include "iblkit/lights/cut.h"
@@ -254,8 +255,7 @@ std::vector<iblcli::ErrorCurve> curves_of(const EvalResult& r) {
 }
 
 void write_csv(const std::string& path, const EvalResult& r) {
-  std::ofstream f(path);
-  if (!f) ibl::fail(ibl::ErrorKind::Io, "cannot write {}", path);
+  std::ostringstream f;
   f << "method,count,mean_rel,max_rel,rms_rel,rms_abs,mean_irradiance_Y,seconds,iterations,final_iterations,converged,initial_cost,final_cost\n";
   for (const auto& row : r.rows)
     f << fmt::format("{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.4f},{},{},{},{},{}\n", row.method, row.count,
@@ -269,6 +269,7 @@ void write_csv(const std::string& path, const EvalResult& r) {
   if (r.have_sh)
     f << fmt::format("sh-3band,9,{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},,,,,,\n", r.sh.mean_rel, r.sh.max_rel, r.sh.rms_rel,
                      r.sh.rms_abs, ibl::luminance(r.sh.mean_est));
+  ibl::write_file_atomically(path, f.str());
 }
 
 std::vector<std::string> split_list(const std::string& s) {

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "iblkit/core/error.h"
+#include "iblkit/core/json_file.h"
 #include "iblkit/core/parallel.h"
 #include "iblkit/io/image_io.h"
 
@@ -250,8 +251,7 @@ BucketStore BucketStore::sort(const Sequence& seq, const BucketDesc& desc, const
   if (rep.skipped == st.probe_count_) fail(ErrorKind::Value, "{}: every probe was skipped", seq.manifest);
   json j = {{"key", key}, {"chunk", st.chunk_}, {"valid", st.valid_}, {"skipped", rep.skipped}, {"reasons", rep.reasons},
             {"width", w}, {"height", h}, {"buckets", t.buckets()}, {"blocks", t.blocks()}};
-  std::ofstream out(index);
-  out << j.dump() << "\n";
+  write_json_file(index.string(), j, -1);
   ibl::report(progress, "sort", 1.0);
   return st;
 }

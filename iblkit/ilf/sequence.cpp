@@ -142,10 +142,7 @@ void write_sequence(const std::string& path, const Sequence& seq) {
             {"volume", {{"min", {seq.volume.min.x, seq.volume.min.y, seq.volume.min.z}},
                         {"max", {seq.volume.max.x, seq.volume.max.y, seq.volume.max.z}}}},
             {"probes", probes}};
-  std::ofstream out(path);
-  if (!out) fail(ErrorKind::Io, "{}: cannot write the sequence manifest", path);
-  out << j.dump(1) << "\n";
-  if (!out) fail(ErrorKind::Io, "{}: write failed", path);
+  write_json_file(path, j);
 }
 
 }  // namespace ibl::ilf

@@ -169,10 +169,7 @@ void write_dataset(const std::string& path, const Dataset& ds) {
             {"m_basis", basis_name(ds.m_basis)},
             {"filter_gain", ds.filter_gain},
             {"measurements", ms}};
-  std::ofstream out(path);
-  if (!out) fail(ErrorKind::Io, "{}: cannot write", path);
-  out << j.dump(1) << "\n";
-  if (!out) fail(ErrorKind::Io, "{}: write failed", path);
+  write_json_file(path, j);
 }
 
 }  // namespace ibl::nearfield
