@@ -130,21 +130,13 @@ std::vector<int> parse_int_list(const std::string& s, const std::string& what) {
   return out;
 }
 
-ibl::sphere::MappingKind mapping_from_name(const std::string& name) {
-  auto k = ibl::sphere::parse_mapping_kind(name);
-  if (!k)
-    ibl::fail(ibl::ErrorKind::Value,
-              "unknown mapping '{}': use latlong, mirrorball, angular, hcross, vcross, cubestrip or octahedral", name);
-  return *k;
-}
-
 ibl::io::EnvReadDesc& add_probe_read_options(CLI::App& app) {
   auto* desc = new ibl::io::EnvReadDesc();  // lives as long as the app (the process)
   auto* mapping = new std::string();
   app.add_option("--in-mapping", *mapping,
                  "mapping of the input (latlong, mirrorball, angular, hcross, vcross, cubestrip, octahedral); "
                  "default: detected from the image shape and name")
-      ->each([desc](const std::string& s) { desc->mapping = mapping_from_name(s); });
+      ->each([desc](const std::string& s) { desc->mapping = ibl::sphere::parse_mapping(s); });
   app.add_option("--dead-angle", desc->dead_angle_deg, "mirror ball: unusable cone behind the ball, degrees")
       ->check(CLI::Range(0.0, 89.0));
   app.add_flag("--sanitize", desc->sanitize, "replace NaN/Inf/negative pixels by 0 (and say how many) instead of failing");

@@ -68,8 +68,6 @@ ibl::Vec3 parse_vec3(const std::string& s, const std::string& what);  // "x,y,z"
 std::vector<int> parse_int_list(const std::string& s, const std::string& what);  // "1,2,4"
 // Adds --mapping, --dead-angle, --sanitize to an app and returns the read settings they fill.
 ibl::io::EnvReadDesc& add_probe_read_options(CLI::App& app);
-// Validates a --mapping string and returns the kind (throws ibl::Error on an unknown name).
-ibl::sphere::MappingKind mapping_from_name(const std::string& name);
 
 // Path of a real probe to use when none is given: blender-data's, else shared/probes.
 std::string default_probe();

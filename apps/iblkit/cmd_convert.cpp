@@ -48,7 +48,7 @@ void setup(CLI::App& app) {
     ibl::io::ReadReport rep;
     auto src = ibl::io::read_envmap(o->in, rd, &rep);
     if (rep.sanitized) iblcli::info(fmt::format("sanitized {} NaN/Inf/negative values", rep.sanitized));
-    MappingKind k = iblcli::mapping_from_name(o->mapping);
+    MappingKind k = ibl::sphere::parse_mapping(o->mapping);
     int size = o->size;
     if (size == 0) {
       double pixels = static_cast<double>(src.image.width()) * src.image.height();

@@ -9,6 +9,7 @@
 
 #include "cli.h"
 #include "iblkit/core/error.h"
+#include "iblkit/core/json_file.h"
 #include "iblkit/io/draw.h"
 #include "iblkit/io/envmap_io.h"
 #include "iblkit/io/image_io.h"
@@ -97,7 +98,7 @@ void setup(CLI::App& app) {
     std::string sheet = (fs::path(ctx.out_dir) / "contact_sheet.png").string();
     if (!pics.empty())
       ibl::io::write_image(sheet, ibl::io::contact_sheet(pics, 4, 300, 170, "iblkit demo: " + fs::path(ctx.probe).filename().string()));
-    std::ofstream(fs::path(ctx.out_dir) / "summary.json") << ctx.summary.dump(2) << "\n";
+    ibl::write_json_file((fs::path(ctx.out_dir) / "summary.json").string(), ctx.summary, 2);
     iblcli::emit(ctx.summary, [&] {
       fmt::print("demo wrote {} pictures into {}/\n", ctx.pictures.size(), ctx.out_dir);
       fmt::print("  contact sheet: {}\n  numbers:       {}/summary.json\n", sheet, ctx.out_dir);

@@ -13,6 +13,7 @@
 #include "fuse_cli.h"
 #include "fusion_pictures.h"
 #include "iblkit/core/error.h"
+#include "iblkit/core/json_file.h"
 #include "iblkit/fusion/local_lights.h"
 #include "iblkit/fusion/path.h"
 #include "iblkit/io/draw.h"
@@ -52,7 +53,7 @@ void add_fuse_options(CLI::App& c, FuseOpts& o) {
 
 ibl::fusion::FuseDesc fuse_desc(const FuseOpts& o) {
   fu::FuseDesc d;
-  d.mapping = mapping_from_name(o.mapping);
+  d.mapping = ibl::sphere::parse_mapping(o.mapping);
   d.size = o.size;
   d.blend = fu::parse_blend(o.blend);
   d.visibility = !o.no_visibility;
@@ -159,7 +160,7 @@ void run_path(const FuseOpts& o, const std::string& probes, const std::string& p
     auto lj = ibl::lights::to_json(f.filtered);
     for (size_t i = 0; i < f.filtered.lights.size(); ++i) lj["lights"][i]["id"] = f.filtered_ids[i];
     lj["time"] = f.point.time;
-    std::ofstream(dir / "lights" / (name + ".json")) << lj.dump(1) << "\n";
+    ibl::write_json_file((dir / "lights" / (name + ".json")).string(), lj);
     if (f.index % every == 0 && pics.size() < 8) {
       ibl::lights::LightSet filt = f.filtered;
       filt.regions = f.cut.regions;  // outlines of this frame's cut; markers at the filtered lights
@@ -183,7 +184,7 @@ void run_path(const FuseOpts& o, const std::string& probes, const std::string& p
                       {"shadow_light_jitter_deg", {{"unfiltered", r.raw_jitter * 180 / ibl::kPi}, {"filtered", r.filtered_jitter * 180 / ibl::kPi}}},
                       {"lights_vs_map", {{"unfiltered", r.raw_vs_maps}, {"filtered", r.filtered_vs_maps}}},
                       {"out", out}};
-  std::ofstream(dir / "path_summary.json") << j.dump(1) << "\n";
+  ibl::write_json_file((dir / "path_summary.json").string(), j);
   std::string png = (dir / "path.png").string();
   ibl::io::write_image(png, ibl::io::contact_sheet(pics, 2, 512, 256,
                                                    fmt::format("{} frames, {} tracked lights (filter time constant {})", path.size(), pd.lights, tau)));

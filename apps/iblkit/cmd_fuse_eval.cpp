@@ -15,6 +15,8 @@
 #include "fusion_pictures.h"
 #include "iblkit/core/error.h"
 #include "iblkit/fusion/evaluate.h"
+#include "iblkit/core/json_file.h"
+#include "iblkit/core/parallel.h"
 #include "iblkit/fusion/local_lights.h"
 #include "iblkit/io/draw.h"
 #include "iblkit/io/image_io.h"
@@ -134,7 +136,7 @@ void run_eval(const EvalOpts& o) {
   double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   nlohmann::json j = {{"scene", scene.name}, {"probes", o.probes}, {"size", o.f.size}, {"samples", o.f.samples},
                       {"rows", rows_json(rows)}, {"seconds", secs}};
-  std::ofstream(fs::path(o.out) / "eval.json") << j.dump(1) << "\n";
+  ibl::write_json_file((fs::path(o.out) / "eval.json").string(), j);
   emit(j, [&] {
     fmt::print("{} fused with {} probes, {}×{} lat-long, {}×{} rays per pixel; truth {}×{} samples ({:.1f} s)\n", scene.name,
                set.probes.size(), 2 * o.f.size, o.f.size, o.f.samples, o.f.samples, o.truth_samples, o.truth_samples, secs);

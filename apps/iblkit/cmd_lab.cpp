@@ -10,6 +10,7 @@
 
 #include "cli.h"
 #include "iblkit/core/error.h"
+#include "iblkit/core/json_file.h"
 #include "iblkit/io/image_io.h"
 #include "iblkit/io/tonemap.h"
 #include "iblkit/lab/capture.h"
@@ -69,7 +70,7 @@ void run_capture(const CaptureOpts& o) {
   if (o.env_samples > 0) d.capture.render.env_samples = o.env_samples;
   if (o.seed > 0) d.capture.render.seed = o.seed;
   if (o.random > 0) pos = ibl::lab::random_positions(lo, hi, o.random, d.capture.render.seed);
-  d.capture.mapping = iblcli::mapping_from_name(o.mapping);
+  d.capture.mapping = ibl::sphere::parse_mapping(o.mapping);
   d.capture.size = o.size;
   d.capture.samples = o.samples;
   d.capture.dead_angle_deg = o.dead_angle;
@@ -143,7 +144,7 @@ void run_truth(const TruthOpts& o) {
     ibl::io::write_image((out / "radiance.png").string(), ibl::io::tonemap(t.radiance.image));
     if (d.bands > 0) ibl::sh::write_coeffs((out / "sh.json").string(), t.sh);
     if (!t.sh_visible.c.empty()) ibl::sh::write_coeffs((out / "sh_visible.json").string(), t.sh_visible);
-    std::ofstream(out / "truth.json") << j.dump(1) << "\n";
+    ibl::write_json_file((out / "truth.json").string(), j);
     j["out"] = o.out;
   }
   iblcli::emit(j, [&] {

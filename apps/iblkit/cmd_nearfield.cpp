@@ -104,7 +104,7 @@ void run_simulate(const SimOpts& o) {
   auto lum = nf::make_luminaire(o.luminaire);
   nf::SimulateDesc d;
   std::tie(d.nx, d.ny) = parse_grid(o.grid);
-  d.basis = nf::basis_from_name(o.basis, "--basis");
+  d.basis = nf::parse_basis(o.basis, "--basis");
   d.spacing = o.spacing;
   d.distance = o.distance;
   d.resolution = o.resolution;

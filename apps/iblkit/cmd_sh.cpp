@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "cli.h"
+#include "iblkit/core/atomic_file.h"
 #include "iblkit/core/error.h"
 #include "iblkit/io/envmap_io.h"
 #include "iblkit/io/image_io.h"
@@ -21,13 +22,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using namespace ibl;
-
-void write_text(const std::string& path, const std::string& text) {
-  std::ofstream f(path);
-  if (!f) fail(ErrorKind::Io, "{}: cannot open for writing", path);
-  f << text;
-  if (!f) fail(ErrorKind::Io, "{}: write failed", path);
-}
 
 // Irradiance E(n) of radiance coefficients as a 2H×H lat-long image.
 Image irradiance_image(const sh::Coeffs& radiance, int height) {
@@ -80,7 +74,7 @@ void setup(CLI::App& app) {
     c = sh::apply_window(c, wd, &wr);
 
     std::string text = sh::export_text(c, format);
-    if (!o->out.empty()) write_text(o->out, text);
+    if (!o->out.empty()) write_file_atomically(o->out, text);
     if (!o->irradiance_map.empty()) io::write_image(o->irradiance_map, irradiance_image(c, o->irradiance_size));
 
     nlohmann::json j = {{"probe", o->probe},
@@ -127,9 +121,9 @@ void demo_step(iblcli::DemoContext& ctx) {
   sh::Coeffs c3 = sh::project(env, 3);
   sh::write_coeffs((dir / "sh.json").string(), c5);
   sh::write_coeffs((dir / "sh3.json").string(), c3);
-  write_text((dir / "sh_threejs.json").string(), sh::export_text(c3, sh::ExportFormat::ThreeJs));
-  write_text((dir / "sh.txt").string(), sh::export_text(c3, sh::ExportFormat::Filament));
-  write_text((dir / "sh_gltf.json").string(), sh::export_text(c3, sh::ExportFormat::Gltf));
+  write_file_atomically((dir / "sh_threejs.json").string(), sh::export_text(c3, sh::ExportFormat::ThreeJs));
+  write_file_atomically((dir / "sh.txt").string(), sh::export_text(c3, sh::ExportFormat::Filament));
+  write_file_atomically((dir / "sh_gltf.json").string(), sh::export_text(c3, sh::ExportFormat::Gltf));
 
   // Pictures share the probe's exposure; irradiance is shown as the radiance of a white Lambertian
   // surface, E/π.

@@ -6,9 +6,11 @@
 #include <CLI/CLI.hpp>
 
 #include "cli.h"
+#include "iblkit/core/atomic_file.h"
 #include "iblkit/core/error.h"
 
 int main(int argc, char** argv) {
+  ibl::remove_temp_files_on_signals();  // Ctrl-C or a kill mid-write leaves no temporary file behind
   CLI::App app{
       "iblkit: image-based lighting from captured light.\n"
       "Turns HDR light probes into spherical harmonics, directional lights and other representations,\n"

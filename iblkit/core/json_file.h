@@ -1,5 +1,6 @@
-// Reading iblkit's JSON files (manifests, light sets, scenes, paths): one place for the errors a
-// user sees when a file is missing, is not JSON, or is another kind of iblkit file.
+// Reading and writing iblkit's JSON files (manifests, light sets, scenes, paths): one place for the
+// errors a user sees when a file is missing, is not JSON, or is another kind of iblkit file, and one
+// writer that reports failure and replaces the file whole (core/atomic_file.h).
 #pragma once
 #include <filesystem>
 #include <fstream>
@@ -7,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "iblkit/core/atomic_file.h"
 #include "iblkit/core/error.h"
 
 namespace ibl {
@@ -29,6 +31,12 @@ inline nlohmann::json read_json_file(const std::string& path) {
 inline void require_format(const nlohmann::json& j, const std::string& path, const std::string& format) {
   if (!j.is_object() || j.value("format", "") != format)
     fail(ErrorKind::Format, "{}: not an {} file (\"format\" is missing or different)", path, format);
+}
+
+// Writes j.dump(indent) and a newline to path through a temporary file renamed into place;
+// ErrorKind::Io "PATH: cannot write (reason)" on failure, the previous file at path then intact.
+inline void write_json_file(const std::string& path, const nlohmann::json& j, int indent = 1) {
+  write_file_atomically(path, j.dump(indent) + "\n");
 }
 
 }  // namespace ibl

@@ -3,27 +3,19 @@
 #include <atomic>
 #include <cmath>
 
+#include "iblkit/core/enum_names.h"
 #include "iblkit/core/error.h"
 #include "iblkit/core/fastmath.h"
 #include "iblkit/core/parallel.h"
 
 namespace ibl::fusion {
 
-std::string blend_name(Blend b) {
-  switch (b) {
-    case Blend::Nearest: return "nearest";
-    case Blend::Angle: return "angle";
-    case Blend::Footprint: return "footprint";
-  }
-  return "?";
-}
+namespace {
+constexpr EnumName<Blend> kBlendNames[] = {{Blend::Nearest, "nearest"}, {Blend::Angle, "angle"}, {Blend::Footprint, "footprint"}};
+}  // namespace
 
-Blend parse_blend(const std::string& s) {
-  if (s == "nearest") return Blend::Nearest;
-  if (s == "angle") return Blend::Angle;
-  if (s == "footprint") return Blend::Footprint;
-  fail(ErrorKind::Value, "unknown blend \"{}\" (expected nearest, angle or footprint)", s);
-}
+std::string blend_name(Blend b) { return name_of(kBlendNames, b); }
+Blend parse_blend(const std::string& s) { return parse_enum(kBlendNames, s, "blend"); }
 
 sphere::Mapping output_mapping(sphere::MappingKind k, int size) {
   if (size < 1 || size > 8192) fail(ErrorKind::Value, "output size {} is out of range [1, 8192]", size);

@@ -203,7 +203,7 @@ ProbeSet load_probe_set(const std::string& manifest, const LoadDesc& desc) {
   io::EnvReadDesc rd;
   if (j.contains("mapping")) {
     if (!j["mapping"].is_string()) fail(ErrorKind::Format, "{}: field \"mapping\" must be a string", manifest);
-    auto k = sphere::parse_mapping_kind(j["mapping"].get<std::string>());
+    auto k = sphere::find_mapping(j["mapping"].get<std::string>());
     if (!k) fail(ErrorKind::Format, "{}: unknown mapping \"{}\"", manifest, j["mapping"].get<std::string>());
     rd.mapping = *k;
   }

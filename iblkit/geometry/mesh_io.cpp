@@ -9,6 +9,7 @@
 #include <memory>
 
 #include "iblkit/core/error.h"
+#include "iblkit/core/atomic_file.h"
 
 namespace ibl::geometry {
 
@@ -52,7 +53,8 @@ TriMesh read_mesh(const std::string& path) {
 }
 
 void write_obj(const std::string& path, const TriMesh& mesh, const std::string& comment) {
-  std::unique_ptr<FILE, int (*)(FILE*)> f(std::fopen(path.c_str(), "w"), &std::fclose);
+  AtomicFile file(path);
+  std::unique_ptr<FILE, int (*)(FILE*)> f(std::fopen(file.temp_path().c_str(), "w"), &std::fclose);
   if (!f) fail(ErrorKind::Io, "{}: cannot write", path);
   if (!comment.empty()) std::fprintf(f.get(), "# %s\n", comment.c_str());
   for (const Vec3& p : mesh.positions) std::fprintf(f.get(), "v %.6g %.6g %.6g\n", p.x, p.y, p.z);
@@ -64,7 +66,10 @@ void write_obj(const std::string& path, const TriMesh& mesh, const std::string& 
     else
       std::fprintf(f.get(), "f %u %u %u\n", t[0] + 1, t[1] + 1, t[2] + 1);
   }
-  if (std::ferror(f.get())) fail(ErrorKind::Io, "{}: write failed", path);
+  bool ok = !std::ferror(f.get());
+  ok = std::fclose(f.release()) == 0 && ok;
+  if (!ok) fail(ErrorKind::Io, "{}: write failed", path);
+  file.commit();
 }
 
 }  // namespace ibl::geometry

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "iblkit/core/error.h"
+#include "iblkit/core/json_file.h"
 #include "iblkit/core/parallel.h"
 #include "iblkit/io/image_io.h"
 
@@ -139,13 +140,13 @@ BucketStore BucketStore::sort(const Sequence& seq, const BucketDesc& desc, const
   if (ec) fail(ErrorKind::Io, "{}: cannot create the bucket folder ({})", desc.dir, ec.message());
   BucketReport local;
   BucketReport& rep = report ? *report : local;
-  // The first readable frame fixes the size.
+  // The first frame with a readable header fixes the size (its pixels are checked with the others').
   int w = 0, h = 0;
   for (size_t i = 0; i < seq.probes.size() && w == 0; ++i) {
     try {
-      Image img = io::read_image(seq.probes[i].image, {desc.sanitize, 3});
-      w = img.width();
-      h = img.height();
+      auto spec = io::read_image_spec(seq.probes[i].image);
+      w = spec.width;
+      h = spec.height;
     } catch (const Error& e) {
       if (!desc.skip_bad) fail(e.kind(), "probe {}: field \"image\": {}", i, e.what());
     }
@@ -250,8 +251,7 @@ BucketStore BucketStore::sort(const Sequence& seq, const BucketDesc& desc, const
   if (rep.skipped == st.probe_count_) fail(ErrorKind::Value, "{}: every probe was skipped", seq.manifest);
   json j = {{"key", key}, {"chunk", st.chunk_}, {"valid", st.valid_}, {"skipped", rep.skipped}, {"reasons", rep.reasons},
             {"width", w}, {"height", h}, {"buckets", t.buckets()}, {"blocks", t.blocks()}};
-  std::ofstream out(index);
-  out << j.dump() << "\n";
+  write_json_file(index.string(), j, -1);
   ibl::report(progress, "sort", 1.0);
   return st;
 }

@@ -77,8 +77,8 @@ SHGrid build_shgrid(const Sequence& seq_in, const BuildDesc& desc, const Progres
     int64_t pixels = 0;
     for (const auto& p : seq.probes) {
       try {
-        Image img = io::read_image(p.image, {bd.sanitize, 3});
-        pixels = int64_t(img.width()) * img.height();
+        auto spec = io::read_image_spec(p.image);
+        pixels = int64_t(spec.width) * spec.height;
         break;
       } catch (const Error&) {
         if (!bd.skip_bad) throw;

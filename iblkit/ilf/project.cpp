@@ -4,25 +4,18 @@
 #include <cmath>
 #include <string>
 
+#include "iblkit/core/enum_names.h"
 #include "iblkit/core/error.h"
 
 namespace ibl::ilf {
 
-const char* repair_name(Repair r) {
-  switch (r) {
-    case Repair::None: return "none";
-    case Repair::Mip: return "mip";
-    case Repair::PullPush: return "pullpush";
-  }
-  return "?";
-}
+namespace {
+constexpr EnumName<Repair> kRepairNames[] = {
+    {Repair::None, "none"}, {Repair::Mip, "mip"}, {Repair::PullPush, "pullpush"}, {Repair::PullPush, "pull-push"}};
+}  // namespace
 
-Repair parse_repair(const std::string& s) {
-  if (s == "none") return Repair::None;
-  if (s == "mip") return Repair::Mip;
-  if (s == "pullpush" || s == "pull-push") return Repair::PullPush;
-  fail(ErrorKind::Value, "repair: unknown method \"{}\" (none, mip, pullpush)", s);
-}
+const char* repair_name(Repair r) { return name_of(kRepairNames, r); }
+Repair parse_repair(const std::string& s) { return parse_enum(kRepairNames, s, "repair method"); }
 
 namespace {
 

@@ -15,7 +15,7 @@ enum class Repair {
   PullPush, // normalised-convolution pull–push on the 2D plane of the rays (Gortler et al. 1996)
 };
 const char* repair_name(Repair r);
-Repair parse_repair(const std::string& s);
+Repair parse_repair(const std::string& s);  // none, mip, pullpush (or pull-push); throws ibl::Error otherwise
 
 struct ProjectDesc {
   double kernel_cells = 3.0;  // Gaussian kernel support diameter in grid cells ([1] §5.2 uses 3)

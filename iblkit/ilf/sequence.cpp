@@ -36,7 +36,7 @@ Sequence read_sequence(const std::string& path, const SequenceReadDesc& desc, Se
   Sequence seq;
   seq.manifest = path;
   std::string mapping = j.value("mapping", "mirrorball");
-  auto kind = sphere::parse_mapping_kind(mapping);
+  auto kind = sphere::find_mapping(mapping);
   if (!kind) fail(ErrorKind::Format, "{}: field \"mapping\": unknown mapping \"{}\"", path, mapping);
   seq.mapping = *kind;
   if (j.contains("scene") && j["scene"].is_string()) seq.scene = j["scene"].get<std::string>();
@@ -152,10 +152,7 @@ void write_sequence(const std::string& path, const Sequence& seq) {
                         {"max", {seq.volume.max.x, seq.volume.max.y, seq.volume.max.z}}}},
             {"probes", probes}};
   if (!seq.scene.empty()) j["scene"] = seq.scene;
-  std::ofstream out(path);
-  if (!out) fail(ErrorKind::Io, "{}: cannot write the sequence manifest", path);
-  out << j.dump(1) << "\n";
-  if (!out) fail(ErrorKind::Io, "{}: write failed", path);
+  write_json_file(path, j);
 }
 
 }  // namespace ibl::ilf

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "iblkit/core/error.h"
+#include "iblkit/core/atomic_file.h"
 #include "iblkit/sh/basis.h"
 #include "iblkit/sh/convolve.h"
 
@@ -84,12 +85,15 @@ void write_shgrid(const std::string& path, const SHGrid& g) {
   size_t total = ((head.size() + 1 + 63) / 64) * 64;
   head.append(total - head.size() - 1, ' ');
   head.push_back('\n');
-  std::ofstream out(path, std::ios::binary);
+  AtomicFile file(path);
+  std::ofstream out(file.temp_path(), std::ios::binary);
   if (!out) fail(ErrorKind::Io, "{}: cannot write", path);
   out.write(head.data(), std::streamsize(head.size()));
   static_assert(sizeof(float) == 4);
   out.write(reinterpret_cast<const char*>(g.data().data()), std::streamsize(g.data().size() * 4));  // x86: little-endian
+  out.close();
   if (!out) fail(ErrorKind::Io, "{}: write failed", path);
+  file.commit();
 }
 
 SHGrid read_shgrid(const std::string& path) {

@@ -1,6 +1,7 @@
 // OpenVDB export of an SH grid (`ilf build --vdb`), for Houdini and Blender users: one Vec3f grid per
 // coefficient, voxel (i, j, k) = grid point (i, j, k), a scale+translate transform to world metres.
 #include "iblkit/core/error.h"
+#include "iblkit/core/atomic_file.h"
 #include "iblkit/ilf/shgrid.h"
 
 #ifdef IBLKIT_HAVE_OPENVDB
@@ -50,13 +51,15 @@ void write_vdb(const std::string& path, const SHGrid& g) {
   meta.insertMeta("iblkit_max", openvdb::Vec3DMetadata(openvdb::Vec3d(gd.volume.max.x, gd.volume.max.y, gd.volume.max.z)));
   meta.insertMeta("iblkit_resolution", openvdb::Vec3IMetadata(openvdb::Vec3i(gd.nx, gd.ny, gd.nz)));
   meta.insertMeta("iblkit_sh_convention", openvdb::StringMetadata("real orthonormal, no Condon-Shortley phase, k = l(l+1)+m"));
+  AtomicFile out(path);
   try {
-    openvdb::io::File file(path);
+    openvdb::io::File file(out.temp_path());
     file.write(grids, meta);
     file.close();
   } catch (const openvdb::Exception& e) {
     fail(ErrorKind::Io, "{}: cannot write OpenVDB file ({})", path, e.what());
   }
+  out.commit();
 }
 
 #else

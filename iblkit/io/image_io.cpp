@@ -8,6 +8,7 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include "iblkit/core/atomic_file.h"
 #include "iblkit/core/error.h"
 
 namespace ibl::io {
@@ -100,9 +101,10 @@ Image read_image(const std::string& path, const ReadDesc& desc, ReadReport* repo
 namespace {
 // Portable float map: Debian's OpenImageIO 2.4 reads PFM but has no writer for it. Little-endian
 // (scale −1), rows bottom to top, 1 or 3 channels.
-void write_pfm(const std::string& path, const Image& img) {
+// Writes to `file` (a temporary name); errors name `path`.
+void write_pfm(const std::string& file, const std::string& path, const Image& img) {
   int nc = img.channels() >= 3 ? 3 : 1;
-  std::FILE* f = std::fopen(path.c_str(), "wb");
+  std::FILE* f = std::fopen(file.c_str(), "wb");
   if (!f) fail(ErrorKind::Io, "{}: cannot write", path);
   std::fprintf(f, "%s\n%d %d\n-1.0\n", nc == 3 ? "PF" : "Pf", img.width(), img.height());
   std::vector<float> row(static_cast<size_t>(img.width()) * nc);
@@ -121,8 +123,12 @@ void write_image(const std::string& path, const Image& img, const WriteDesc& des
   if (img.empty()) fail(ErrorKind::Value, "{}: refusing to write an empty image", path);
   std::string ext = fs::path(path).extension().string();
   for (auto& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
-  if (ext == ".pfm") return write_pfm(path, img);
-  auto out = OIIO::ImageOutput::create(path);
+  AtomicFile file(path);  // OIIO writes to file.temp_path(), which keeps the extension
+  if (ext == ".pfm") {
+    write_pfm(file.temp_path(), path, img);
+    return file.commit();
+  }
+  auto out = OIIO::ImageOutput::create(file.temp_path());
   if (!out) fail(ErrorKind::Format, "{}: no image writer for extension '{}' ({})", path, ext, OIIO::geterror());
   bool ldr = ext == ".png" || ext == ".jpg" || ext == ".jpeg";
   int nc = img.channels();
@@ -140,9 +146,11 @@ void write_image(const std::string& path, const Image& img, const WriteDesc& des
         v = c < color ? linear_to_srgb(v) : std::clamp(v, 0.0f, 1.0f);
       }
   }
-  if (!out->open(path, spec)) fail(ErrorKind::Io, "{}: cannot write ({})", path, out->geterror());
+  if (!out->open(file.temp_path(), spec)) fail(ErrorKind::Io, "{}: cannot write ({})", path, out->geterror());
   if (!out->write_image(OIIO::TypeDesc::FLOAT, src.data())) fail(ErrorKind::Io, "{}: write failed ({})", path, out->geterror());
   if (!out->close()) fail(ErrorKind::Io, "{}: close failed ({})", path, out->geterror());
+  out.reset();
+  file.commit();
 }
 
 }  // namespace ibl::io

@@ -23,6 +23,14 @@ struct ReadReport {
 
 Image read_image(const std::string& path, const ReadDesc& desc = {}, ReadReport* report = nullptr);
 
+struct ImageSpec {
+  int width = 0, height = 0, channels = 0;
+};
+// The size and channel count from the file's header, the pixels left undecoded (image_spec.cpp);
+// the errors of read_image for a missing, unreadable or non-image file. The pixels may still be
+// bad: read_image is what checks them.
+ImageSpec read_image_spec(const std::string& path);
+
 // Checks for NaN/Inf/negative values; throws ibl::Error with the first bad pixel's position,
 // or with `sanitize` replaces them by 0 and returns how many were replaced. Negative values
 // within 5% of the mean |value| are compression noise and become 0 without complaint.

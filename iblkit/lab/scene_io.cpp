@@ -218,7 +218,7 @@ Emitter emitter(const json& j, const Ctx& c) {
     if (j.contains("image")) {
       io::EnvReadDesc rd;
       if (j.contains("mapping")) {
-        rd.mapping = sphere::parse_mapping_kind(j["mapping"].get<std::string>());
+        rd.mapping = sphere::find_mapping(j["mapping"].get<std::string>());
         if (!rd.mapping) c.bad("mapping", "unknown mapping");
       }
       e.env = std::make_shared<sphere::EnvMap>(io::read_envmap(c.rel(j["image"].get<std::string>()), rd));

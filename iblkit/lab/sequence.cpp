@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "iblkit/core/error.h"
+#include "iblkit/core/json_file.h"
 #include "iblkit/geometry/mesh_io.h"
 #include "iblkit/ilf/sequence.h"
 #include "iblkit/io/draw.h"
@@ -176,7 +177,7 @@ SequenceResult write_probe_set(const Scene& scene, const std::vector<Vec3>& posi
             {"scene", scene.name}, {"probes", probes}};
   SequenceResult r;
   r.manifest = (out / "probes.json").string();
-  std::ofstream(r.manifest) << m.dump(1) << "\n";
+  write_json_file(r.manifest, m);
   r.contact_sheet = write_sheet(pics, out, describe(scene, d));
   r.probes = positions.size();
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

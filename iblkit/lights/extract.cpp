@@ -1,10 +1,11 @@
 #include "iblkit/lights/extract.h"
 
 #include <chrono>
-#include <fstream>
+#include <sstream>
 
 #include <fmt/format.h>
 
+#include "iblkit/core/atomic_file.h"
 #include "iblkit/core/error.h"
 #include "iblkit/lights/cut.h"
 #include "iblkit/sh/convolve.h"
@@ -145,8 +146,7 @@ EvalResult evaluate_methods(const sphere::EnvMap& env, const MethodsEvalDesc& de
 }
 
 void write_eval_csv(const std::string& path, const EvalResult& r) {
-  std::ofstream f(path);
-  if (!f) fail(ErrorKind::Io, "cannot write {}", path);
+  std::ostringstream f;
   f << "method,count,mean_rel,max_rel,rms_rel,rms_abs,mean_irradiance_Y,seconds,iterations,final_iterations,converged,initial_cost,final_cost\n";
   for (const auto& row : r.rows) {
     const auto& o = row.optimizer;
@@ -163,6 +163,7 @@ void write_eval_csv(const std::string& path, const EvalResult& r) {
     f << fmt::format("{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},,,,,,\n", sh_reference_name(r.sh_bands),
                      r.sh_bands * r.sh_bands, r.sh.mean_rel, r.sh.max_rel, r.sh.rms_rel, r.sh.rms_abs,
                      luminance(r.sh.mean_est));
+  write_file_atomically(path, f.str());
 }
 
 }  // namespace ibl::lights

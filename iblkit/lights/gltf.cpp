@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "iblkit/core/error.h"
+#include "iblkit/core/json_file.h"
 
 namespace ibl::lights {
 
@@ -60,11 +61,7 @@ nlohmann::json to_gltf(const LightSet& set, const GltfDesc& desc) {
 }
 
 void write_gltf(const std::string& path, const LightSet& set, const GltfDesc& desc) {
-  auto j = to_gltf(set, desc);
-  std::ofstream f(path);
-  if (!f) fail(ErrorKind::Io, "cannot write {}", path);
-  f << j.dump(2) << "\n";
-  if (!f) fail(ErrorKind::Io, "error writing {}", path);
+  write_json_file(path, to_gltf(set, desc), 2);
 }
 
 }  // namespace ibl::lights

@@ -230,10 +230,7 @@ LightSet from_json(const nlohmann::json& j, const std::string& what) {
 }
 
 void write_lights(const std::string& path, const LightSet& set) {
-  std::ofstream f(path);
-  if (!f) fail(ErrorKind::Io, "cannot write {}", path);
-  f << to_json(set).dump(2) << "\n";
-  if (!f) fail(ErrorKind::Io, "error writing {}", path);
+  write_json_file(path, to_json(set), 2);
 }
 
 LightSet read_lights(const std::string& path) {

@@ -6,6 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "iblkit/core/enum_names.h"
 #include "iblkit/core/error.h"
 #include "iblkit/core/json_file.h"
 #include "iblkit/io/image_io.h"
@@ -16,13 +17,12 @@ namespace ibl::nearfield {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-const char* basis_name(Basis b) { return b == Basis::Bilinear ? "bilinear" : "biquadratic"; }
+namespace {
+constexpr EnumName<Basis> kBasisNames[] = {{Basis::Bilinear, "bilinear"}, {Basis::Biquadratic, "biquadratic"}};
+}  // namespace
 
-Basis basis_from_name(const std::string& name, const std::string& what) {
-  if (name == "bilinear") return Basis::Bilinear;
-  if (name == "biquadratic") return Basis::Biquadratic;
-  fail(ErrorKind::Value, "{}: unknown basis '{}' (bilinear or biquadratic)", what, name);
-}
+const char* basis_name(Basis b) { return name_of(kBasisNames, b); }
+Basis parse_basis(const std::string& name, const std::string& what) { return parse_enum(kBasisNames, name, "basis", what); }
 
 Image Dataset::measurement(int i, int j) const {
   const size_t k = static_cast<size_t>(j * nx + i);
@@ -91,7 +91,7 @@ Dataset read_dataset(const std::string& path) {
   Dataset ds;
   ds.name = j.value("name", fs::path(path).stem().string());
   ds.luminaire = j.value("luminaire", "");
-  ds.basis = basis_from_name(j.value("basis", ""), path + ": basis");
+  ds.basis = parse_basis(j.value("basis", ""), path + ": basis");
   ds.spacing = number(j, "spacing", path);
   ds.filter_width = number(j, "filter_width", path);
   ds.distance = number(j, "distance", path);
@@ -104,7 +104,7 @@ Dataset read_dataset(const std::string& path) {
   if (!j.contains("m_extent") || !j["m_extent"].is_object()) fail(ErrorKind::Format, "{}: 'm_extent' {{min, max}} missing", path);
   ds.m_min = vec2(j["m_extent"].value("min", json()), path + ": m_extent.min");
   ds.m_max = vec2(j["m_extent"].value("max", json()), path + ": m_extent.max");
-  ds.m_basis = basis_from_name(j.value("m_basis", "bilinear"), path + ": m_basis");
+  ds.m_basis = parse_basis(j.value("m_basis", "bilinear"), path + ": m_basis");
   ds.filter_gain = j.value("filter_gain", 1.0);
   if (!j.contains("measurements") || !j["measurements"].is_array()) fail(ErrorKind::Format, "{}: 'measurements' array missing", path);
   const size_t n = static_cast<size_t>(ds.count());
@@ -169,10 +169,7 @@ void write_dataset(const std::string& path, const Dataset& ds) {
             {"m_basis", basis_name(ds.m_basis)},
             {"filter_gain", ds.filter_gain},
             {"measurements", ms}};
-  std::ofstream out(path);
-  if (!out) fail(ErrorKind::Io, "{}: cannot write", path);
-  out << j.dump(1) << "\n";
-  if (!out) fail(ErrorKind::Io, "{}: write failed", path);
+  write_json_file(path, j);
 }
 
 }  // namespace ibl::nearfield

@@ -32,7 +32,7 @@ enum class Basis {
   Biquadratic,  // Φ: quadratic B-spline of support 3h; dual filter support 4h (the paper's 5 mm -> 20 mm)
 };
 const char* basis_name(Basis b);
-Basis basis_from_name(const std::string& name, const std::string& what);  // throws ibl::Error
+Basis parse_basis(const std::string& name, const std::string& what);  // throws ibl::Error naming `what`
 
 struct Dataset {
   std::string name;              // e.g. "flashlight-7x7"

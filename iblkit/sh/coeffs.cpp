@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "iblkit/core/error.h"
+#include "iblkit/core/atomic_file.h"
 #include "iblkit/core/json_file.h"
 #include "iblkit/sh/basis.h"
 
@@ -80,10 +81,7 @@ Coeffs coeffs_from_json(const nlohmann::json& j, const std::string& what) {
 
 void write_coeffs(const std::string& path, const Coeffs& c) {
   c.validate(path);
-  std::ofstream f(path);
-  if (!f) fail(ErrorKind::Io, "{}: cannot open for writing", path);
-  f << to_json_text(c);
-  if (!f) fail(ErrorKind::Io, "{}: write failed", path);
+  write_file_atomically(path, to_json_text(c));
 }
 
 Coeffs read_coeffs(const std::string& path) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "iblkit/core/enum_names.h"
 #include "iblkit/core/error.h"
 #include "iblkit/sh/basis.h"
 
@@ -68,21 +69,13 @@ Vec3 irradiance_at(const Coeffs& radiance, Vec3 n) {
   return e;
 }
 
-std::string window_name(Window w) {
-  switch (w) {
-    case Window::None: return "none";
-    case Window::Hanning: return "hanning";
-    case Window::Lanczos: return "lanczos";
-    case Window::Deringing: return "deringing";
-  }
-  return "none";
-}
+namespace {
+constexpr EnumName<Window> kWindowNames[] = {
+    {Window::None, "none"}, {Window::Hanning, "hanning"}, {Window::Lanczos, "lanczos"}, {Window::Deringing, "deringing"}};
+}  // namespace
 
-Window parse_window(const std::string& name) {
-  for (Window w : {Window::None, Window::Hanning, Window::Lanczos, Window::Deringing})
-    if (window_name(w) == name) return w;
-  fail(ErrorKind::Value, "unknown SH window '{}' (use none, hanning, lanczos or deringing)", name);
-}
+std::string window_name(Window w) { return name_of(kWindowNames, w); }
+Window parse_window(const std::string& name) { return parse_enum(kWindowNames, name, "SH window"); }
 
 std::vector<double> window_weights(Window w, int bands, double width) {
   check_bands(bands);

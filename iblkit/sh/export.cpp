@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include "iblkit/core/enum_names.h"
 #include "iblkit/core/error.h"
 #include "iblkit/sh/basis.h"
 #include "iblkit/sh/convolve.h"
@@ -31,21 +32,13 @@ int order_of(int i) { return i - band_of(i) * (band_of(i) + 1); }
 
 }  // namespace
 
-std::string export_format_name(ExportFormat f) {
-  switch (f) {
-    case ExportFormat::Iblkit: return "iblkit";
-    case ExportFormat::ThreeJs: return "threejs";
-    case ExportFormat::Filament: return "filament";
-    case ExportFormat::Gltf: return "gltf";
-  }
-  return "iblkit";
-}
+namespace {
+constexpr EnumName<ExportFormat> kExportFormatNames[] = {
+    {ExportFormat::Iblkit, "iblkit"}, {ExportFormat::ThreeJs, "threejs"}, {ExportFormat::Filament, "filament"}, {ExportFormat::Gltf, "gltf"}};
+}  // namespace
 
-ExportFormat parse_export_format(const std::string& name) {
-  for (ExportFormat f : {ExportFormat::Iblkit, ExportFormat::ThreeJs, ExportFormat::Filament, ExportFormat::Gltf})
-    if (export_format_name(f) == name) return f;
-  fail(ErrorKind::Value, "unknown SH export format '{}' (use iblkit, threejs, filament or gltf)", name);
-}
+std::string export_format_name(ExportFormat f) { return name_of(kExportFormatNames, f); }
+ExportFormat parse_export_format(const std::string& name) { return parse_enum(kExportFormatNames, name, "SH export format"); }
 
 Coeffs to_threejs(const Coeffs& radiance) { return radiance.resized(3); }
 

@@ -6,34 +6,34 @@
 #include <cmath>
 #include <vector>
 
+#include "iblkit/core/enum_names.h"
 #include "iblkit/core/error.h"
 
 namespace ibl::sphere {
 
-std::string mapping_name(MappingKind k) {
-  switch (k) {
-    case MappingKind::LatLong: return "latlong";
-    case MappingKind::MirrorBall: return "mirrorball";
-    case MappingKind::Angular: return "angular";
-    case MappingKind::CubeHCross: return "hcross";
-    case MappingKind::CubeVCross: return "vcross";
-    case MappingKind::CubeStrip: return "cubestrip";
-    case MappingKind::Octahedral: return "octahedral";
-  }
-  return "?";
-}
+namespace {
+// Names first (in enum order), then aliases.
+constexpr EnumName<MappingKind> kMappingNames[] = {
+    {MappingKind::LatLong, "latlong"},       {MappingKind::MirrorBall, "mirrorball"}, {MappingKind::Angular, "angular"},
+    {MappingKind::CubeHCross, "hcross"},     {MappingKind::CubeVCross, "vcross"},     {MappingKind::CubeStrip, "cubestrip"},
+    {MappingKind::Octahedral, "octahedral"}, {MappingKind::LatLong, "equirect"},      {MappingKind::LatLong, "equirectangular"},
+    {MappingKind::MirrorBall, "ball"},       {MappingKind::MirrorBall, "chrome"},     {MappingKind::Angular, "probe"},
+    {MappingKind::Angular, "angularmap"},    {MappingKind::CubeHCross, "cubecross"},  {MappingKind::CubeHCross, "cube"},
+    {MappingKind::CubeHCross, "horizontal-cross"}, {MappingKind::CubeVCross, "vertical-cross"},
+    {MappingKind::CubeStrip, "strip"},       {MappingKind::Octahedral, "oct"}};
 
-std::optional<MappingKind> parse_mapping_kind(std::string_view name) {
-  std::string n(name);
+std::string lower(std::string_view s) {
+  std::string n(s);
   for (auto& ch : n) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
-  if (n == "latlong" || n == "equirect" || n == "equirectangular") return MappingKind::LatLong;
-  if (n == "mirrorball" || n == "ball" || n == "chrome") return MappingKind::MirrorBall;
-  if (n == "angular" || n == "probe" || n == "angularmap") return MappingKind::Angular;
-  if (n == "hcross" || n == "cubecross" || n == "cube" || n == "horizontal-cross") return MappingKind::CubeHCross;
-  if (n == "vcross" || n == "vertical-cross") return MappingKind::CubeVCross;
-  if (n == "cubestrip" || n == "strip") return MappingKind::CubeStrip;
-  if (n == "octahedral" || n == "oct") return MappingKind::Octahedral;
-  return std::nullopt;
+  return n;
+}
+}  // namespace
+
+std::string mapping_name(MappingKind k) { return name_of(kMappingNames, k); }
+std::optional<MappingKind> find_mapping(std::string_view name) { return find_enum(kMappingNames, lower(name)); }
+MappingKind parse_mapping(std::string_view name, std::string_view what) {
+  if (auto k = find_mapping(name)) return *k;
+  return parse_enum(kMappingNames, name, "mapping", what);  // fails, listing the names
 }
 
 double Mapping::aspect(MappingKind k) {

@@ -23,10 +23,12 @@ namespace ibl::sphere {
 enum class MappingKind { LatLong, MirrorBall, Angular, CubeHCross, CubeVCross, CubeStrip, Octahedral };
 
 // Name used in files and on the command line: latlong, mirrorball, angular, hcross, vcross,
-// cubestrip, octahedral. parse_mapping_kind also accepts "cubecross" (returns nullopt-free HCross;
-// use detect_mapping to choose h/v by aspect) and a few aliases (equirect, ball, probe, cube).
+// cubestrip, octahedral. Parsing ignores case and also accepts "cubecross" (HCross; use
+// detect_mapping to choose h/v by aspect) and a few aliases (equirect, ball, probe, cube).
 std::string mapping_name(MappingKind k);
-std::optional<MappingKind> parse_mapping_kind(std::string_view name);
+std::optional<MappingKind> find_mapping(std::string_view name);  // nullopt for an unknown name
+// Throws ibl::Error "[what: ]unknown mapping 'x' (use latlong, …)" for an unknown name.
+MappingKind parse_mapping(std::string_view name, std::string_view what = {});
 
 // Cube faces in the DESIGN.md order.
 enum class CubeFace { PX = 0, NX, PY, NY, PZ, NZ };

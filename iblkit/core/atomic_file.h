@@ -1,0 +1,52 @@
+// Output files written whole or not at all (DESIGN.md, "Errors"): every writer puts its bytes into a
+// temporary file beside the output and renames it into place once it is complete and closed, so a
+// failed or killed command never leaves a half-written file at its output path, and the file that
+// was there before stays intact until the new one replaces it in one step. (Protection against
+// crashes of the process, not of the machine: nothing is fsync'ed.)
+//
+//   AtomicFile f(path);                     // nothing created yet
+//   write_somehow(f.temp_path());           // e.g. "out/probe.tmp-4711-3.exr"; throws on failure
+//   f.commit();                             // rename into place; without it the destructor removes the temp
+#pragma once
+#include <string>
+#include <string_view>
+
+namespace ibl {
+
+class AtomicFile {
+ public:
+  // Chooses temp_path() beside `path` as "<stem>.tmp-<pid>-<n><extension>": unique in the process
+  // and across processes, and with the output's extension so a writer that picks its format by
+  // extension still can. Where `path` is a symbolic link, its target is replaced, not the link.
+  // Where `path` is there and is not a regular file (/dev/null, a FIFO), temp_path() is `path`
+  // itself and commit() does nothing.
+  explicit AtomicFile(const std::string& path);
+  ~AtomicFile();  // removes temp_path() unless committed
+  AtomicFile(const AtomicFile&) = delete;
+  AtomicFile& operator=(const AtomicFile&) = delete;
+
+  const std::string& path() const { return path_; }
+  const std::string& temp_path() const { return temp_; }
+  // Renames temp_path() onto path(); on failure removes temp_path() and throws ErrorKind::Io
+  // "PATH: cannot write (reason)".
+  void commit();
+
+ private:
+  std::string path_, target_, temp_;
+  int slot_ = -1;  // in the registry of live temporary files (remove_live_temp_files), or -1
+  bool direct_ = false, committed_ = false;
+};
+
+// Writes `bytes` to `path` through an AtomicFile; ErrorKind::Io "PATH: cannot write (reason)".
+void write_file_atomically(const std::string& path, std::string_view bytes);
+
+// Removes the temporary file of every AtomicFile alive in this process. Async-signal-safe: for a
+// signal handler.
+void remove_live_temp_files() noexcept;
+
+// For programs (the CLI calls it first thing; the library never does): on SIGINT, SIGTERM and
+// SIGHUP, remove_live_temp_files() and then die of the signal as without the handler. A signal the
+// process ignores (nohup, a shell's background job) stays ignored.
+void remove_temp_files_on_signals();
+
+}  // namespace ibl
