@@ -14,18 +14,14 @@
 #include "fuse_cli.h"
 #include "fusion_pictures.h"
 #include "iblkit/core/error.h"
-#include "iblkit/core/parallel.h"
+#include "iblkit/fusion/evaluate.h"
 #include "iblkit/fusion/local_lights.h"
 #include "iblkit/io/draw.h"
 #include "iblkit/io/image_io.h"
 #include "iblkit/io/tonemap.h"
-#include "iblkit/lab/radiance.h"
-#include "iblkit/lab/rng.h"
 #include "iblkit/lab/scene_io.h"
 #include "iblkit/lab/sequence.h"
 #include "iblkit/lab/truth.h"
-#include "iblkit/lights/evaluate.h"
-#include "iblkit/sphere/pointset.h"
 
 namespace iblcli {
 
@@ -43,123 +39,63 @@ struct EvalOpts {
   int truth_samples = 4, area_samples = 32;
 };
 
-// Solid-angle weighted RMS of the luminance difference over the mean luminance of the truth.
-double image_rmse(const ibl::sphere::EnvMap& est, const ibl::sphere::EnvMap& truth) {
-  const auto& m = truth.mapping;
-  double s2 = 0, sy = 0, sw = 0;
-  for (int y = 0; y < m.height(); ++y)
-    for (int x = 0; x < m.width(); ++x) {
-      double w = m.solid_angle_estimate(x, y);
-      double yt = ibl::luminance(truth.image.rgb(x, y)), ye = ibl::luminance(est.image.rgb(x, y));
-      s2 += w * (ye - yt) * (ye - yt);
-      sy += w * yt;
-      sw += w;
-    }
-  return sy > 0 ? std::sqrt(s2 / sw) / (sy / sw) : 0;
-}
-
-struct Camera {
-  Vec3 f, r, u;
-  int w = 320, h = 200;
-  double tan_half = 1.0;  // 90° horizontal field of view
-  Camera(Vec3 forward) {
-    f = ibl::normalize(forward);
-    Vec3 up = std::abs(f.y) > 0.99 ? Vec3{0, 0, 1} : Vec3{0, 1, 0};
-    r = ibl::normalize(ibl::cross(f, up));
-    u = ibl::cross(r, f);
-  }
-  std::vector<Vec3> rays() const {
-    std::vector<Vec3> d;
-    for (int j = 0; j < h; ++j)
-      for (int i = 0; i < w; ++i) {
-        double sx = (2 * (i + 0.5) / w - 1) * tan_half, sy = (1 - 2 * (j + 0.5) / h) * tan_half * h / w;
-        d.push_back(ibl::normalize(f + r * sx + u * sy));
-      }
-    return d;
-  }
-  Image to_image(const std::vector<Vec3>& L) const {
-    Image img(w, h, 3);
-    for (int j = 0; j < h; ++j)
-      for (int i = 0; i < w; ++i) img.set_rgb(i, j, L[static_cast<size_t>(j) * w + i]);
-    return img;
-  }
-};
-
-// The lab's radiance along each ray (4 random streams per ray, averaged).
-std::vector<Vec3> truth_rays(const ibl::lab::Scene& scene, Vec3 x, const std::vector<Vec3>& dirs, int area_samples) {
-  ibl::lab::RenderDesc rd = scene.render;
-  rd.area_samples = area_samples;
-  std::vector<Vec3> out(dirs.size());
-  ibl::parallel_for(0, static_cast<int64_t>(dirs.size()), [&](int64_t i) {
-    Vec3 s;
-    for (int k = 0; k < 4; ++k) {
-      ibl::lab::Rng rng(ibl::lab::stream_key(rd.seed, 7, static_cast<uint64_t>(i), k));
-      s += ibl::lab::radiance(scene, x, dirs[i], rng, rd);
-    }
-    out[i] = s / 4;
-  }, 64);
-  return out;
-}
-
-struct EvalRow {
-  std::string point, blend;
-  bool visibility;
-  double rmse, irr_mean, irr_max, fused, unseen, left;
-};
-
-// Evaluates every blend × visibility at each point; returns the rows and writes pictures into dir.
-std::vector<EvalRow> evaluate(const fu::ProbeSet& set, const ibl::lab::Scene& scene, const std::vector<Vec3>& points,
-                              const FuseOpts& fo, int truth_samples, int area_samples, const fs::path& dir,
-                              std::vector<std::pair<std::string, std::string>>* pictures, const std::string& view) {
-  fs::create_directories(dir);
-  static const std::vector<Vec3> normals = ibl::sphere::icosphere_face_centres(5);  // 20480 (Madsen & Laursen)
-  std::vector<EvalRow> rows;
-  for (size_t k = 0; k < points.size(); ++k) {
-    Vec3 x = points[k];
-    std::string pname = fmt::format("({:g}, {:g}, {:g})", x.x, x.y, x.z);
+// The lab's exact answers as the evaluation's reference: the local radiance map (truth_samples² sub-pixel
+// samples, area_samples shadow rays per area light) and the radiance along view rays.
+fu::Reference lab_reference(const ibl::lab::Scene& scene, int truth_samples, int area_samples) {
+  fu::Reference ref;
+  ref.radiance_map = [&scene, truth_samples, area_samples](Vec3 x, int size) {
     ibl::lab::TruthDesc td;
-    td.size = fo.size;
+    td.size = size;
     td.samples = truth_samples;
     td.area_samples = area_samples;
     td.bands = 0;
-    auto truth = ibl::lab::ground_truth(scene, x, td);
-    auto e_truth = ibl::lights::irradiance_ground_truth(truth.radiance, normals);
-    double scale = ibl::io::auto_exposure_scale(truth.radiance.image);
-    std::vector<std::pair<std::string, Image>> sheet = {{"lab truth " + pname, tone(truth.radiance.image, scale)}};
-    for (fu::Blend b : {fu::Blend::Nearest, fu::Blend::Angle, fu::Blend::Footprint})
-      for (bool vis : {false, true}) {
-        FuseOpts o = fo;
-        o.mapping = "latlong";
-        o.blend = fu::blend_name(b);
-        o.no_visibility = !vis;
-        fu::LocalMap m = fu::fuse(set, x, fuse_desc(o));
-        auto e = ibl::lights::irradiance_ground_truth(m.radiance, normals);
-        auto st = ibl::lights::compare_irradiance(e, e_truth);
-        rows.push_back({pname, o.blend, vis, image_rmse(m.radiance, truth.radiance), st.mean_rel, st.max_rel, m.stats.fused,
-                        m.stats.unseen, m.stats.left_proxy});
-        sheet.push_back({fmt::format("{}{}: RMSE {:.3f}, E err {:.1f}%", o.blend, vis ? "" : " no visibility", rows.back().rmse,
-                                     100 * st.mean_rel),
-                         tone(m.radiance.image, scale)});
-        if (b == fu::Blend::Footprint && vis) sheet.push_back({"coverage (footprint, visibility)", coverage_picture(m, static_cast<int>(set.probes.size()))});
-      }
+    return ibl::lab::ground_truth(scene, x, td).radiance;
+  };
+  ref.radiance_along = [&scene, area_samples](Vec3 x, const std::vector<Vec3>& dirs) {
+    ibl::lab::RenderDesc rd = scene.render;
+    rd.area_samples = area_samples;
+    return ibl::lab::radiance_along(scene, x, dirs, rd);
+  };
+  return ref;
+}
+
+std::string point_name(Vec3 x) { return fmt::format("({:g}, {:g}, {:g})", x.x, x.y, x.z); }
+
+// Evaluates every blend × visibility at each point (fusion/evaluate.h); returns the rows and writes
+// pictures into dir.
+std::vector<fu::EvalRow> evaluate(const fu::ProbeSet& set, const ibl::lab::Scene& scene, const std::vector<Vec3>& points,
+                                  const FuseOpts& fo, int truth_samples, int area_samples, const fs::path& dir,
+                                  std::vector<std::pair<std::string, std::string>>* pictures, const std::string& view) {
+  fs::create_directories(dir);
+  const fu::Reference ref = lab_reference(scene, truth_samples, area_samples);
+  fu::EvalDesc ed;
+  ed.fuse = fuse_desc(fo);
+  if (!view.empty()) ed.view = parse_vec3(view, "--view");
+  std::vector<fu::EvalRow> rows;
+  for (size_t k = 0; k < points.size(); ++k) {
+    const std::string pname = point_name(points[k]);
+    const fu::PointEval pe = fu::evaluate_point(set, points[k], ref, ed);
+    double scale = ibl::io::auto_exposure_scale(pe.truth.image);
+    std::vector<std::pair<std::string, Image>> sheet = {{"lab truth " + pname, tone(pe.truth.image, scale)}};
+    for (size_t i = 0; i < pe.rows.size(); ++i) {
+      const auto& r = pe.rows[i];
+      sheet.push_back({fmt::format("{}{}: RMSE {:.3f}, E err {:.1f}%", fu::blend_name(r.blend), r.visibility ? "" : " no visibility",
+                                   r.image_rmse, 100 * r.irradiance_mean_rel),
+                       tone(pe.maps[i].radiance.image, scale)});
+      if (r.blend == fu::Blend::Footprint && r.visibility)
+        sheet.push_back({"coverage (footprint, visibility)", coverage_picture(pe.maps[i], static_cast<int>(set.probes.size()))});
+      rows.push_back(r);
+    }
     std::string png = (dir / fmt::format("point{}.png", k)).string();
     ibl::io::write_image(png, ibl::io::contact_sheet(sheet, 2, 512, 256, "fused vs lab truth at " + pname + " (same exposure)"));
     if (pictures) pictures->push_back({"fusion vs truth at " + pname, png});
-    if (!view.empty()) {
+    if (ed.view) {
       // The thesis's Fig. 7.8: the back-projected probes seen from x, angle blend, visibility off/on.
-      Camera cam(parse_vec3(view, "--view"));
-      auto dirs = cam.rays();
-      auto t = truth_rays(scene, x, dirs, area_samples);
-      double s = ibl::io::auto_exposure_scale(cam.to_image(t));
-      std::vector<std::pair<std::string, Image>> vs = {{"lab truth", tone(cam.to_image(t), s)}};
-      for (bool vis : {false, true})
-        for (const char* bl : {"angle", "footprint"}) {
-          FuseOpts o = fo;
-          o.blend = bl;
-          o.no_visibility = !vis;
-          auto L = fu::fuse_rays(set, x, dirs, fuse_desc(o));
-          vs.push_back({fmt::format("{} blend, visibility {}", bl, vis ? "on" : "off (thesis Fig. 7.8)"), tone(cam.to_image(L), s)});
-        }
+      double s = ibl::io::auto_exposure_scale(pe.view_truth);
+      std::vector<std::pair<std::string, Image>> vs = {{"lab truth", tone(pe.view_truth, s)}};
+      for (const auto& v : pe.views)
+        vs.push_back({fmt::format("{} blend, visibility {}", fu::blend_name(v.blend), v.visibility ? "on" : "off (thesis Fig. 7.8)"),
+                      tone(v.image, s)});
       std::string vpng = (dir / fmt::format("point{}_view.png", k)).string();
       ibl::io::write_image(vpng, ibl::io::contact_sheet(vs, 3, 320, 200, "view from " + pname + " along " + view));
       if (pictures) pictures->push_back({"fusion view from " + pname, vpng});
@@ -168,22 +104,23 @@ std::vector<EvalRow> evaluate(const fu::ProbeSet& set, const ibl::lab::Scene& sc
   return rows;
 }
 
-nlohmann::json rows_json(const std::vector<EvalRow>& rows) {
+nlohmann::json rows_json(const std::vector<fu::EvalRow>& rows) {
   nlohmann::json a = nlohmann::json::array();
   for (const auto& r : rows)
-    a.push_back({{"point", r.point}, {"blend", r.blend}, {"visibility", r.visibility}, {"image_rmse", r.rmse},
-                 {"irradiance_mean_rel", r.irr_mean}, {"irradiance_max_rel", r.irr_max}, {"fused", r.fused},
-                 {"unseen", r.unseen}, {"left_proxy", r.left}});
+    a.push_back({{"point", point_name(r.point)}, {"blend", fu::blend_name(r.blend)}, {"visibility", r.visibility},
+                 {"image_rmse", r.image_rmse}, {"irradiance_mean_rel", r.irradiance_mean_rel},
+                 {"irradiance_max_rel", r.irradiance_max_rel}, {"fused", r.coverage.fused}, {"unseen", r.coverage.unseen},
+                 {"left_proxy", r.coverage.left_proxy}});
   return a;
 }
 
-void print_rows(const std::vector<EvalRow>& rows) {
+void print_rows(const std::vector<fu::EvalRow>& rows) {
   fmt::print("| point | blend | visibility | image RMSE (rel.) | irradiance error mean / max | fused / unseen / left |\n");
   fmt::print("| --- | --- | --- | --- | --- | --- |\n");
   for (const auto& r : rows)
-    fmt::print("| {} | {} | {} | {:.3f} | {:.1f}% / {:.1f}% | {:.1f}% / {:.1f}% / {:.1f}% |\n", r.point, r.blend,
-               r.visibility ? "on" : "off", r.rmse, 100 * r.irr_mean, 100 * r.irr_max, 100 * r.fused, 100 * r.unseen,
-               100 * r.left);
+    fmt::print("| {} | {} | {} | {:.3f} | {:.1f}% / {:.1f}% | {:.1f}% / {:.1f}% / {:.1f}% |\n", point_name(r.point),
+               fu::blend_name(r.blend), r.visibility ? "on" : "off", r.image_rmse, 100 * r.irradiance_mean_rel,
+               100 * r.irradiance_max_rel, 100 * r.coverage.fused, 100 * r.coverage.unseen, 100 * r.coverage.left_proxy);
 }
 
 void run_eval(const EvalOpts& o) {

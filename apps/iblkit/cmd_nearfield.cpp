@@ -14,10 +14,10 @@
 #include "iblkit/io/tonemap.h"
 #include "iblkit/lab/scene_io.h"
 #include "iblkit/nearfield/basis.h"
-#include "iblkit/nearfield/ies.h"
 #include "iblkit/nearfield/luminaire.h"
 #include "iblkit/nearfield/reconstruct.h"
 #include "iblkit/nearfield/render.h"
+#include "iblkit/nearfield/scene_render.h"
 
 namespace {
 
@@ -187,14 +187,6 @@ nf::Placement placement_of(const LightOpts& o) {
   return p;
 }
 
-// The dataset's luminaire for comparisons, or none.
-std::optional<nf::Luminaire> comparison(const nf::Dataset& ds, const std::string& exact) {
-  if (exact.empty() || exact == "none") return std::nullopt;
-  std::string name = exact == "auto" ? ds.luminaire : exact;
-  if (name.empty()) ibl::fail(ibl::ErrorKind::Value, "--exact auto: the dataset names no lab luminaire (a measured dataset)");
-  return nf::make_luminaire(name);
-}
-
 struct RenderOpts {
   std::string dataset, scene = "crypt", out, eye = "0.9,1.5,0.9", target = "-1.1,0.3,-1.5", ies;
   int size = 400;
@@ -206,57 +198,40 @@ struct RenderOpts {
 void run_render(const RenderOpts& o) {
   if (o.out.empty()) ibl::fail(ibl::ErrorKind::Value, "--out VIEW.png is required");
   auto scene = ibl::lab::load_scene(o.scene);
-  nf::SceneView sv(scene);
-  nf::View view;
-  view.eye = iblcli::parse_vec3(o.eye, "--eye");
-  view.target = iblcli::parse_vec3(o.target, "--target");
-  view.width = view.height = o.size;
-  view.vfov_deg = o.fov;
-  const auto pl = placement_of(o.light);
-  std::vector<nf::TexturedSpotlight> lights;
-  nf::Dataset ds;
-  std::string label;
-  auto t0 = std::chrono::steady_clock::now();
-  if (!o.ies.empty()) {
-    lights.push_back(nf::ies_spotlight(nf::read_ies(o.ies), pl, 80, 256, o.ies_scale));
-    label = o.ies;
-  } else {
-    ds = nf::read_dataset(o.dataset);
-    lights = nf::spotlights(ds, pl, !o.no_shadows);
-    label = ds.name;
-  }
-  const double t_setup = seconds_since(t0);
-  t0 = std::chrono::steady_clock::now();
-  Image img = nf::render_spotlights(sv, lights, view, !o.no_shadows, iblcli::progress_bar());
+  nf::SceneView sv(ibl::lab::diffuse_surfaces(scene), scene.name);
+  nf::SceneRenderDesc d;
+  d.dataset = o.dataset;
+  d.ies = o.ies;
+  d.ies_scale = o.ies_scale;
+  d.exact = o.light.exact;
+  d.far_field = !o.light.no_far;
+  d.camera.eye = iblcli::parse_vec3(o.eye, "--eye");
+  d.camera.target = iblcli::parse_vec3(o.target, "--target");
+  d.camera.width = d.camera.height = o.size;
+  d.camera.fov_y_deg = o.fov;
+  d.placement = placement_of(o.light);
+  d.shadows = !o.no_shadows;
+  d.srgbe = o.srgbe;
+  const nf::SceneRender r = nf::render_scene(sv, d, iblcli::progress_bar());
   iblcli::progress_done();
-  const double t_render = seconds_since(t0);
-  json j = {{"dataset", label}, {"scene", scene.name}, {"out", o.out}, {"size", o.size}, {"spotlights", lights.size()},
-            {"shadows", !o.no_shadows}, {"setup_seconds", t_setup}, {"render_seconds", t_render}};
-  std::vector<Image> imgs{img};
-  std::vector<std::string> names{"near-field (Eq. 14)"};
-  if (o.srgbe) {
-    // The paper's 8-bit sRGBE frame buffer between passes of 3 spotlights, against the float sum.
-    Image q = nf::render_spotlights(sv, lights, view, !o.no_shadows, {}, 3);
-    auto st = nf::compare(q, img);
-    j["srgbe_passes"] = {{"passes", (lights.size() + 2) / 3}, {"error_vs_float", stats_json(st)},
+  const std::string& label = r.label;
+  json j = {{"dataset", label}, {"scene", scene.name}, {"out", o.out}, {"size", o.size}, {"spotlights", r.spotlights},
+            {"shadows", !o.no_shadows}, {"setup_seconds", r.setup_seconds}, {"render_seconds", r.render_seconds}};
+  if (r.srgbe_error)
+    j["srgbe_passes"] = {{"passes", r.srgbe_passes}, {"error_vs_float", stats_json(*r.srgbe_error)},
                          {"frame_buffer_bytes_float", 12 * o.size * o.size}, {"frame_buffer_bytes_srgbe", 4 * o.size * o.size}};
-  }
-  auto lum = o.ies.empty() ? comparison(ds, o.light.exact) : std::nullopt;
-  if (lum) {
-    t0 = std::chrono::steady_clock::now();
-    Image ex = nf::render_exact(sv, *lum, pl, view, !o.no_shadows);
-    j["exact_seconds"] = seconds_since(t0);
-    j["near_field_error"] = stats_json(nf::compare(img, ex));
-    imgs.insert(imgs.begin(), ex);
+  std::vector<Image> imgs{r.near_field};
+  std::vector<std::string> names{"near-field (Eq. 14)"};
+  if (r.exact) {
+    j["exact_seconds"] = r.exact_seconds;
+    j["near_field_error"] = stats_json(*r.near_field_error);
+    imgs.insert(imgs.begin(), *r.exact);
     names.insert(names.begin(), "exact (virtual luminaire)");
-    if (!o.light.no_far) {
-      auto ff = nf::far_field_spotlight([&](Vec3 w) { return lum->intensity(w); }, ds.distance, ds.m_max.x,
-                                        ds.positive[0].width(), pl, !o.no_shadows);
-      Image fi = nf::render_spotlights(sv, {ff}, view, !o.no_shadows);
-      j["far_field_error"] = stats_json(nf::compare(fi, ex));
-      imgs.push_back(fi);
-      names.push_back("far field (1 goniometric point)");
-    }
+  }
+  if (r.far_field) {
+    j["far_field_error"] = stats_json(*r.far_field_error);
+    imgs.push_back(*r.far_field);
+    names.push_back("far field (1 goniometric point)");
   }
   auto tm = same_exposure(imgs);
   std::string base = o.out.substr(0, o.out.size() - fs::path(o.out).extension().string().size());
@@ -274,8 +249,8 @@ void run_render(const RenderOpts& o) {
   }
   iblcli::emit(j, [&] {
     fmt::print("rendered {} in {} at {}x{} with {} spotlight{}{}: {:.2f} s (+{:.2f} s reading and E' textures)\n", label,
-               scene.name, o.size, o.size, lights.size(), lights.size() == 1 ? "" : "s", o.no_shadows ? "" : " and shadow rays",
-               t_render, t_setup);
+               scene.name, o.size, o.size, r.spotlights, r.spotlights == 1 ? "" : "s", o.no_shadows ? "" : " and shadow rays",
+               r.render_seconds, r.setup_seconds);
     fmt::print("  wrote {}\n", o.out);
     if (j.contains("near_field_error")) {
       auto& a = j["near_field_error"];
@@ -329,7 +304,7 @@ void run_irradiance(const IrrOpts& o) {
   for (int y = 0; y < nfi.height(); ++y)
     for (int x = 0; x < nfi.width(); ++x) mean += nfi.rgb(x, y) * (1.0 / nfi.pixel_count());
   j["mean_irradiance"] = {mean.x, mean.y, mean.z};
-  auto lum = comparison(ds, ds.luminaire.empty() && o.exact == "auto" ? "none" : o.exact);
+  auto lum = nf::exact_luminaire(ds, ds.luminaire.empty() && o.exact == "auto" ? "none" : o.exact);
   std::string base = o.out.substr(0, o.out.size() - fs::path(o.out).extension().string().size());
   if (lum) {
     Image ex = nf::plane_irradiance_exact(*lum, pd);
@@ -469,11 +444,11 @@ void nearfield_step(iblcli::DemoContext& ctx) {
     ctx.pictures.push_back({fmt::format("nearfield {} planes (exact|near|far)", name), png});
     if (std::string(name) == "bikelight") {
       auto scene = ibl::lab::load_scene("crypt");
-      nf::SceneView sv(scene);
-      nf::View view;
+      nf::SceneView sv(ibl::lab::diffuse_surfaces(scene), scene.name);
+      ibl::geometry::Camera view;
       view.eye = {0.9, 1.5, 0.9};
       view.target = {-1.1, 0.3, -1.5};
-      view.vfov_deg = 55;
+      view.fov_y_deg = 55;
       view.width = view.height = 160;
       LightOpts lo;
       auto pl = placement_of(lo);

@@ -36,7 +36,7 @@ LabPhotograph photograph_frame(const std::string& scene_path, const render::Fram
   vd.samples = samples;
   vd.render = scene.render;
   vd.render.bounces = bounces;
-  const render::Camera cam = d.camera;
+  const geometry::Camera cam = d.camera;
   lab::View v = lab::photograph(
       scene, [&](double px, double py, Vec3* o, Vec3* dir) { *o = cam.eye; *dir = cam.ray_direction(px, py); }, vd, progress);
   p.radiance = std::move(v.radiance);

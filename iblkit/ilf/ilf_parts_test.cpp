@@ -75,6 +75,31 @@ TEST(IlfSequence, BadManifests) {
   expect_error([&] { read_sequence(m); }, {"probe 1", "duplicates probe 0"});
 }
 
+TEST(IlfSequence, WriteReadRoundTripKeepsDepthAndScene) {
+  auto d = temp_dir("roundtrip");
+  Sequence seq;
+  seq.mapping = sphere::MappingKind::LatLong;
+  seq.dead_angle_deg = 2.5;
+  seq.volume = {{-1, 0, -1}, {1, 2, 1}};
+  seq.scene = "low-scene1";
+  seq.probes = {{d + "/frames/a.exr", {0, 1, 0}, d + "/frames/a_depth.exr"}, {d + "/frames/b.exr", {0.5, 1, 0}, ""}};
+  write_sequence(d + "/s.json", seq);
+  // Paths inside the manifest's folder are written relative to it, read back absolute.
+  std::ifstream in(d + "/s.json");
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("\"frames/a_depth.exr\""), std::string::npos);
+  EXPECT_NE(text.find("\"scene\": \"low-scene1\""), std::string::npos);
+  const Sequence back = read_sequence(d + "/s.json");
+  EXPECT_EQ(back.scene, "low-scene1");
+  EXPECT_EQ(back.dead_angle_deg, 2.5);
+  ASSERT_EQ(back.probes.size(), 2u);
+  EXPECT_EQ(back.probes[0].image, fs::path(d + "/frames/a.exr").lexically_normal().string());
+  EXPECT_EQ(back.probes[0].depth, fs::path(d + "/frames/a_depth.exr").lexically_normal().string());
+  EXPECT_EQ(back.probes[1].depth, "");
+  EXPECT_EQ(back.volume.max.y, 2);
+  fs::remove_all(d);
+}
+
 TEST(IlfBuckets, SamplesAreTheFramesPixelsAndRunsAreReused) {
   auto d = temp_dir("buckets");
   auto seq = read_sequence(tiny_sequence(d, 5));

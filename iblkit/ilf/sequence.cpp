@@ -39,6 +39,7 @@ Sequence read_sequence(const std::string& path, const SequenceReadDesc& desc, Se
   auto kind = sphere::parse_mapping_kind(mapping);
   if (!kind) fail(ErrorKind::Format, "{}: field \"mapping\": unknown mapping \"{}\"", path, mapping);
   seq.mapping = *kind;
+  if (j.contains("scene") && j["scene"].is_string()) seq.scene = j["scene"].get<std::string>();
   if (j.contains("dead_angle_deg")) {
     if (!j["dead_angle_deg"].is_number()) fail(ErrorKind::Format, "{}: field \"dead_angle_deg\" is not a number", path);
     seq.dead_angle_deg = j["dead_angle_deg"].get<double>();
@@ -68,6 +69,10 @@ Sequence read_sequence(const std::string& path, const SequenceReadDesc& desc, Se
     ProbeEntry e;
     fs::path img = p["image"].get<std::string>();
     e.image = (img.is_absolute() ? img : base / img).lexically_normal().string();
+    if (p.contains("depth") && p["depth"].is_string()) {
+      fs::path dep = p["depth"].get<std::string>();
+      e.depth = (dep.is_absolute() ? dep : base / dep).lexically_normal().string();
+    }
     try {
       e.position = vec3_field(p["position"], where + ": field \"position\"");
     } catch (const Error&) {
@@ -126,12 +131,16 @@ Sequence read_sequence(const std::string& path, const SequenceReadDesc& desc, Se
 
 void write_sequence(const std::string& path, const Sequence& seq) {
   fs::path base = fs::absolute(fs::path(path)).parent_path();
+  auto relative = [&](const std::string& file) {
+    fs::path f = fs::absolute(file);
+    auto rel = f.lexically_relative(base);
+    return (!rel.empty() && *rel.begin() != "..") ? rel.generic_string() : f.generic_string();
+  };
   json probes = json::array();
   for (const auto& e : seq.probes) {
-    fs::path img = fs::absolute(e.image);
-    auto rel = img.lexically_relative(base);
-    std::string s = (!rel.empty() && *rel.begin() != "..") ? rel.generic_string() : img.generic_string();
-    probes.push_back({{"image", s}, {"position", {e.position.x, e.position.y, e.position.z}}});
+    json p = {{"image", relative(e.image)}, {"position", {e.position.x, e.position.y, e.position.z}}};
+    if (!e.depth.empty()) p["depth"] = relative(e.depth);
+    probes.push_back(p);
   }
   json rot = json::array();
   for (int r = 0; r < 3; ++r) rot.push_back({seq.rotation.m[r][0], seq.rotation.m[r][1], seq.rotation.m[r][2]});
@@ -142,6 +151,7 @@ void write_sequence(const std::string& path, const Sequence& seq) {
             {"volume", {{"min", {seq.volume.min.x, seq.volume.min.y, seq.volume.min.z}},
                         {"max", {seq.volume.max.x, seq.volume.max.y, seq.volume.max.z}}}},
             {"probes", probes}};
+  if (!seq.scene.empty()) j["scene"] = seq.scene;
   std::ofstream out(path);
   if (!out) fail(ErrorKind::Io, "{}: cannot write the sequence manifest", path);
   out << j.dump(1) << "\n";

@@ -25,6 +25,7 @@ struct Box {
 struct ProbeEntry {
   std::string image;  // absolute (or manifest-relative resolved) path of the frame
   Vec3 position;      // capture position, world metres
+  std::string depth;  // optional: path of a depth image beside the frame (lab captures; "" when none)
 };
 
 struct Sequence {
@@ -35,6 +36,7 @@ struct Sequence {
   Box volume;                       // capture volume (bounding box of the positions by default)
   bool volume_given = false;        // true when the manifest names the volume
   std::vector<ProbeEntry> probes;   // in capture order
+  std::string scene;                // optional: the lab scene the frames show ("" for real captures)
 };
 
 struct SequenceReadDesc {

@@ -1,5 +1,7 @@
 // Environment maps from files: one image in any mapping, or a folder of six cube faces
 // (px nx py ny pz nz, any image extension), assembled into a horizontal cross.
+// It lives in io/, above sphere/ (docs/architecture.md): reading a map needs the image reader and
+// sphere/'s mapping detection, and sphere/ stays free of file I/O and OpenImageIO.
 #pragma once
 #include <optional>
 #include <string>

@@ -5,6 +5,7 @@
 
 #include <tbb/task_arena.h>
 
+#include "iblkit/core/error.h"
 #include "iblkit/geometry/mesh.h"
 #include "iblkit/lab/capture.h"
 #include "iblkit/lab/radiance.h"
@@ -420,6 +421,26 @@ TEST(LabCapture, BallParallaxStartsRaysOnTheBall) {
   // Pixels outside the ball see nothing.
   EXPECT_EQ(par.depth.at(0, 0, 0), 0.0f);
   EXPECT_EQ(par.radiance.at(0, 0, 0), 0.0f);
+}
+
+TEST(LabTruth, RadianceAlongRaysUnderASkyOverAWhiteFloor) {
+  constexpr double kFloatTol = 1e-5;  // as EnvironmentIsSeenDirectlyAndLightsAWhiteFloorExactly
+  // A constant sky L over a white floor (E = πL): the floor and the sky both send L.
+  Scene f;
+  Surface floor;
+  floor.mesh = geometry::make_quad({0, 0, 0}, {0, 1, 0}, {0, 0, 1}, 4, 4);
+  floor.albedo.constant = {1, 1, 1};
+  f.surfaces.push_back(floor);
+  Emitter sky;
+  sky.type = EmitterType::Environment;
+  sky.radiance = {0.7, 0.7, 0.7};
+  f.emitters.push_back(sky);
+  f.build();
+  const std::vector<Vec3> dirs = {{0, -1, 0}, {0, 1, 0}, normalize(Vec3{1, -1, 0.5})};
+  const auto L = radiance_along(f, {0.1, 1, 0.2}, dirs, RenderDesc{}, 2);
+  ASSERT_EQ(L.size(), 3u);
+  for (Vec3 l : L) EXPECT_NEAR(l.y, 0.7, kFloatTol);
+  EXPECT_THROW(radiance_along(f, {0.1, 1, 0.2}, dirs, RenderDesc{}, 0), Error);
 }
 
 }  // namespace

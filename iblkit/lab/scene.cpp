@@ -150,4 +150,11 @@ geometry::TriMesh Scene::proxy_mesh() const {
   return m;
 }
 
+std::vector<geometry::DiffuseSurface> diffuse_surfaces(const Scene& scene) {
+  std::vector<geometry::DiffuseSurface> out;
+  for (const Surface& s : scene.surfaces)
+    if (s.role == SurfaceRole::Diffuse) out.push_back({s.name, s.mesh, [t = s.albedo](Vec2 uv) { return t.eval(uv); }});
+  return out;
+}
+
 }  // namespace ibl::lab

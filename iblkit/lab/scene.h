@@ -12,6 +12,7 @@
 #include "iblkit/core/vec.h"
 #include "iblkit/geometry/mesh.h"
 #include "iblkit/geometry/raytracer.h"
+#include "iblkit/geometry/surface.h"
 #include "iblkit/sphere/envmap.h"
 
 namespace ibl::lab {
@@ -122,5 +123,9 @@ class Scene {
   std::shared_ptr<geometry::RayTracer> tracer_;
   int env_index_ = -1;
 };
+
+// The scene's Lambertian reflectors (role Diffuse; emitters' geometry left out) as plain geometry with
+// their albedo: how a renderer outside the lab (nearfield::SceneView) sees a lab scene.
+std::vector<geometry::DiffuseSurface> diffuse_surfaces(const Scene& scene);
 
 }  // namespace ibl::lab

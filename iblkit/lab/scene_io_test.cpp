@@ -115,6 +115,12 @@ TEST(LabScene, TexturedAlbedoUnderAUniformSkyReflectsTheTexture) {
   EXPECT_NEAR(bl.x, 0.5, kTexTol);
   EXPECT_NEAR(tr.x, 0.9, kTexTol);
   EXPECT_NEAR(tr.z, 0.7, kTexTol);
+  // The same floor as geometry for renderers outside the lab: its mesh and the texture as albedo.
+  const auto ds = diffuse_surfaces(s);
+  ASSERT_EQ(ds.size(), 1u);
+  EXPECT_EQ(ds[0].mesh.triangle_count(), s.surfaces[0].mesh.triangle_count());
+  EXPECT_NEAR(ds[0].albedo({0.25, 0.25}).x, 0.5, kTexTol);  // bottom-left texel
+  EXPECT_NEAR(ds[0].albedo({0.75, 0.75}).z, 0.7, kTexTol);  // top-right texel
   fs::remove_all(dir);
 }
 

@@ -10,6 +10,7 @@
 
 #include "iblkit/core/error.h"
 #include "iblkit/geometry/mesh_io.h"
+#include "iblkit/ilf/sequence.h"
 #include "iblkit/io/draw.h"
 #include "iblkit/io/image_io.h"
 #include "iblkit/io/tonemap.h"
@@ -119,34 +120,34 @@ SequenceResult write_sequence(const Scene& scene, const std::vector<Vec3>& posit
   auto t0 = std::chrono::steady_clock::now();
   fs::path out(desc.out_dir);
   make_dir(out / "frames");
-  json probes = json::array();
+  ilf::Sequence seq;
+  seq.mapping = desc.capture.mapping;
+  seq.dead_angle_deg = desc.capture.dead_angle_deg;
+  seq.rotation = desc.capture.rotation;
+  seq.scene = scene.name;
   Vec3 lo = positions.empty() ? Vec3{} : positions[0], hi = lo;
   bool inside = true;
   for (Vec3 p : positions) {
-    json e = {{"image", fmt::format("frames/{:06d}{}", probes.size(), desc.frame_ext)}, {"position", vec_json(p)}};
-    if (desc.capture.depth) e["depth"] = fmt::format("frames/{:06d}_depth{}", probes.size(), desc.frame_ext);
-    probes.push_back(e);
+    ilf::ProbeEntry e;
+    e.image = (out / fmt::format("frames/{:06d}{}", seq.probes.size(), desc.frame_ext)).string();
+    e.position = p;
+    if (desc.capture.depth) e.depth = (out / fmt::format("frames/{:06d}_depth{}", seq.probes.size(), desc.frame_ext)).string();
+    seq.probes.push_back(e);
     for (int k = 0; k < 3; ++k) {
       lo[k] = std::min(lo[k], p[k]);
       hi[k] = std::max(hi[k], p[k]);
       inside = inside && p[k] >= scene.volume_min[k] && p[k] <= scene.volume_max[k];
     }
   }
+  seq.volume = inside ? ilf::Box{scene.volume_min, scene.volume_max} : ilf::Box{lo, hi};
+  seq.volume_given = true;
   auto pics = stream(scene, positions, desc, progress, [&](size_t k, const Capture& c) {
-    io::write_image((out / fmt::format("frames/{:06d}{}", k, desc.frame_ext)).string(), c.radiance, {desc.half});
-    if (c.depth.width())
-      io::write_image((out / fmt::format("frames/{:06d}_depth{}", k, desc.frame_ext)).string(), c.depth, {desc.half});
+    io::write_image(seq.probes[k].image, c.radiance, {desc.half});
+    if (c.depth.width()) io::write_image((out / fmt::format("frames/{:06d}_depth{}", k, desc.frame_ext)).string(), c.depth, {desc.half});
   });
-  json m = {{"format", "iblkit.sequence/1"},
-            {"mapping", sphere::mapping_name(desc.capture.mapping)},
-            {"dead_angle_deg", desc.capture.dead_angle_deg},
-            {"rotation", rotation_json(desc.capture.rotation)},
-            {"volume", {{"min", vec_json(inside ? scene.volume_min : lo)}, {"max", vec_json(inside ? scene.volume_max : hi)}}},
-            {"scene", scene.name},
-            {"probes", probes}};
   SequenceResult r;
   r.manifest = (out / "sequence.json").string();
-  std::ofstream(r.manifest) << m.dump(1) << "\n";
+  ilf::write_sequence(r.manifest, seq);
   r.contact_sheet = write_sheet(pics, out, describe(scene, desc));
   r.probes = positions.size();
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

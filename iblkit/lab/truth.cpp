@@ -6,6 +6,8 @@
 #include "iblkit/core/error.h"
 #include "iblkit/core/parallel.h"
 #include "iblkit/lab/capture.h"
+#include "iblkit/lab/radiance.h"
+#include "iblkit/lab/rng.h"
 #include "iblkit/sh/project.h"
 
 namespace ibl::lab {
@@ -70,6 +72,21 @@ Truth ground_truth(const Scene& scene, Vec3 position, const TruthDesc& desc, con
     t.irradiance.push_back(irradiance(t.radiance, n));
   }
   return t;
+}
+
+std::vector<Vec3> radiance_along(const Scene& scene, Vec3 position, const std::vector<Vec3>& directions,
+                                 const RenderDesc& desc, int streams) {
+  if (streams < 1) fail(ErrorKind::Value, "radiance along rays: {} random streams per ray (need ≥ 1)", streams);
+  std::vector<Vec3> out(directions.size());
+  parallel_for(0, static_cast<int64_t>(directions.size()), [&](int64_t i) {
+    Vec3 s;
+    for (int k = 0; k < streams; ++k) {
+      Rng rng(stream_key(desc.seed, 7, static_cast<uint64_t>(i), k));
+      s += radiance(scene, position, directions[static_cast<size_t>(i)], rng, desc);
+    }
+    out[static_cast<size_t>(i)] = s / streams;
+  }, 64);
+  return out;
 }
 
 }  // namespace ibl::lab

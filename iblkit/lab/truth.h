@@ -36,4 +36,10 @@ Vec3 irradiance(const sphere::EnvMap& map, Vec3 n);
 
 Truth ground_truth(const Scene& scene, Vec3 position, const TruthDesc& desc, const ProgressFn& progress = {});
 
+// Radiance arriving at `position` from each unit direction (lab::radiance along the ray leaving it), the
+// mean of `streams` independent random streams per ray (keyed by desc.seed and the ray's index); in
+// parallel. For pictures other than sphere maps, e.g. the true view beside a fused one.
+std::vector<Vec3> radiance_along(const Scene& scene, Vec3 position, const std::vector<Vec3>& directions,
+                                 const RenderDesc& desc, int streams = 4);
+
 }  // namespace ibl::lab

@@ -231,11 +231,11 @@ TEST(NearfieldIes, RotationallySymmetricCosineLobe) {
 
 TEST(NearfieldRender, CryptWithShadowsAgainstTheExactLuminaire) {
   auto scene = lab::load_scene("crypt");
-  SceneView sv(scene);
-  View view;
+  SceneView sv(lab::diffuse_surfaces(scene), scene.name);
+  geometry::Camera view;
   view.eye = {0.9, 1.5, 0.9};
   view.target = {-1.1, 0.3, -1.5};
-  view.vfov_deg = 55;
+  view.fov_y_deg = 55;
   view.width = view.height = 48;
   Placement pl;
   pl.position = {-0.55, 0.45, -0.75};

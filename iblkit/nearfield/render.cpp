@@ -77,26 +77,22 @@ ErrorStats compare(const Image& a, const Image& e) {
   return s;
 }
 
-SceneView::SceneView(const lab::Scene& scene) : scene_(&scene) {
-  for (size_t i = 0; i < scene.surfaces.size(); ++i) {
-    const auto& s = scene.surfaces[i];
-    if (s.role != lab::SurfaceRole::Diffuse || s.mesh.triangle_count() == 0) continue;
+SceneView::SceneView(std::vector<geometry::DiffuseSurface> surfaces, std::string name) : name_(std::move(name)) {
+  for (auto& s : surfaces) {
+    if (s.mesh.triangle_count() == 0) continue;
+    if (!s.albedo) fail(ErrorKind::Value, "scene '{}': surface '{}' has no albedo", name_, s.name);
     tracer_.add(s.mesh);
-    surface_of_mesh_.push_back(static_cast<int>(i));
+    surfaces_.push_back(std::move(s));
   }
-  if (surface_of_mesh_.empty()) fail(ErrorKind::Value, "scene '{}' has no diffuse surfaces to light", scene.name);
+  if (surfaces_.empty()) fail(ErrorKind::Value, "scene '{}' has no diffuse surfaces to light", name_);
   tracer_.commit();
 }
 
-bool SceneView::primary(const View& v, int x, int y, Vec3* p, Vec3* n, Vec3* albedo) const {
-  const Vec3 fwd = normalize(v.target - v.eye);
-  const Vec3 right = normalize(cross(fwd, v.up)), up = cross(right, fwd);
-  const double th = std::tan(0.5 * v.vfov_deg * kPi / 180), aspect = static_cast<double>(v.width) / v.height;
-  const double sx = (2 * (x + 0.5) / v.width - 1) * th * aspect, sy = (1 - 2 * (y + 0.5) / v.height) * th;
-  const Vec3 d = normalize(fwd + right * sx + up * sy);
+bool SceneView::primary(const geometry::Camera& v, int x, int y, Vec3* p, Vec3* n, Vec3* albedo) const {
+  const Vec3 d = v.pixel_direction(x, y);
   const auto hit = tracer_.intersect(v.eye, d);
   if (!hit.hit) return false;
-  const auto& s = scene_->surfaces[static_cast<size_t>(surface_of_mesh_[hit.mesh])];
+  const auto& s = surfaces_[hit.mesh];
   *p = v.eye + d * hit.t;
   Vec3 nn = s.mesh.normal(hit.triangle);
   if (dot(nn, d) > 0) nn = -nn;  // shade the side the camera sees
@@ -106,7 +102,7 @@ bool SceneView::primary(const View& v, int x, int y, Vec3* p, Vec3* n, Vec3* alb
     const auto& t = s.mesh.triangles[hit.triangle];
     uv = s.mesh.uvs[t[0]] * (1 - hit.b1 - hit.b2) + s.mesh.uvs[t[1]] * hit.b1 + s.mesh.uvs[t[2]] * hit.b2;
   }
-  *albedo = s.albedo.eval(uv);
+  *albedo = s.albedo(uv);
   return true;
 }
 
@@ -114,13 +110,13 @@ bool SceneView::blocked(Vec3 p, Vec3 q) const { return tracer_.occluded(p, q - p
 
 namespace {
 
-void check_view(const View& v) {
-  if (v.width < 1 || v.height < 1 || v.width > 16384 || v.height > 16384 || !(v.vfov_deg > 0 && v.vfov_deg < 179))
-    fail(ErrorKind::Value, "view: {}x{} pixels, field of view {}°: out of range", v.width, v.height, v.vfov_deg);
+void check_view(const geometry::Camera& v) {
+  if (v.width < 1 || v.height < 1 || v.width > 16384 || v.height > 16384 || !(v.fov_y_deg > 0 && v.fov_y_deg < 179))
+    fail(ErrorKind::Value, "view: {}x{} pixels, field of view {}°: out of range", v.width, v.height, v.fov_y_deg);
 }
 
 template <typename Shade>
-Image render_rows(const SceneView& sv, const View& view, const ProgressFn& progress, Shade shade) {
+Image render_rows(const SceneView& sv, const geometry::Camera& view, const ProgressFn& progress, Shade shade) {
   check_view(view);
   Image out(view.width, view.height, 3);
   std::atomic<int> done{0};
@@ -137,7 +133,7 @@ Image render_rows(const SceneView& sv, const View& view, const ProgressFn& progr
 
 }  // namespace
 
-Image render_spotlights(const SceneView& sv, const std::vector<TexturedSpotlight>& lights, const View& view, bool shadows,
+Image render_spotlights(const SceneView& sv, const std::vector<TexturedSpotlight>& lights, const geometry::Camera& view, bool shadows,
                         const ProgressFn& progress, int srgbe_group) {
   if (srgbe_group < 0) fail(ErrorKind::Value, "sRGBE pass size {} must be ≥ 0", srgbe_group);
   return render_rows(sv, view, progress, [&](Vec3 p, Vec3 n) {
@@ -155,7 +151,7 @@ Image render_spotlights(const SceneView& sv, const std::vector<TexturedSpotlight
   });
 }
 
-Image render_exact(const SceneView& sv, const Luminaire& lum, const Placement& placement, const View& view, bool shadows,
+Image render_exact(const SceneView& sv, const Luminaire& lum, const Placement& placement, const geometry::Camera& view, bool shadows,
                    const ProgressFn& progress) {
   const Frame f = placement.frame();
   std::vector<Vec3> centres;

@@ -1,17 +1,20 @@
-// CPU reference evaluation of near-field lighting: irradiance on receiver planes and views of a lab
-// scene, lit either by textured spotlights (Eq. 14 of Granier et al. 2003; one shadow ray per
-// spotlight towards its filter centre) or by the virtual luminaire itself (the exact answer: every
-// emitter disc integrated, one shadow ray per disc towards its centre — the discs are at most 5 mm
-// across, so their visibility is constant to within a penumbra of that size).
+// CPU reference evaluation of near-field lighting: irradiance on receiver planes and views of a scene
+// (any list of diffuse surfaces: measured, modelled, or a lab scene through lab::diffuse_surfaces), lit
+// either by textured spotlights (Eq. 14 of Granier et al. 2003; one shadow ray per spotlight towards
+// its filter centre) or by the virtual luminaire itself (the exact answer: every emitter disc
+// integrated, one shadow ray per disc towards its centre — the discs are at most 5 mm across, so
+// their visibility is constant to within a penumbra of that size).
 // Surfaces are Lambertian: the outgoing radiance is albedo/π · E(x, n). Direct light only.
 #pragma once
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "iblkit/core/image.h"
 #include "iblkit/core/progress.h"
+#include "iblkit/geometry/camera.h"
 #include "iblkit/geometry/raytracer.h"
-#include "iblkit/lab/scene.h"
+#include "iblkit/geometry/surface.h"
 #include "iblkit/nearfield/luminaire.h"
 #include "iblkit/nearfield/spotlight.h"
 
@@ -39,36 +42,30 @@ struct ErrorStats {
 };
 ErrorStats compare(const Image& approx, const Image& exact);
 
-// A pinhole camera.
-struct View {
-  Vec3 eye{0, 1.6, 3.5}, target{0, 1, 0}, up{0, 1, 0};
-  double vfov_deg = 60;
-  int width = 400, height = 400;
-};
-
-// The lab scene's diffuse surfaces in a ray tracer of their own (its emitters' geometry is left out).
+// A scene's diffuse surfaces in a ray tracer of their own. `name` is for messages.
 class SceneView {
  public:
-  explicit SceneView(const lab::Scene& scene);
-  // First diffuse hit of the camera ray through pixel centre (x, y): position, normal (towards the
-  // eye), albedo; false when the ray leaves the scene.
-  bool primary(const View& view, int x, int y, Vec3* p, Vec3* n, Vec3* albedo) const;
+  SceneView(std::vector<geometry::DiffuseSurface> surfaces, std::string name);
+  const std::string& name() const { return name_; }
+  // First diffuse hit of the camera ray through the centre of pixel (x, y): position, normal (towards
+  // the eye), albedo; false when the ray leaves the scene.
+  bool primary(const geometry::Camera& view, int x, int y, Vec3* p, Vec3* n, Vec3* albedo) const;
   // True when the segment p → q is blocked (p is offset along its normal by the caller).
   bool blocked(Vec3 p, Vec3 q) const;
 
  private:
-  const lab::Scene* scene_;
+  std::string name_;
+  std::vector<geometry::DiffuseSurface> surfaces_;  // the ones with triangles, in ray tracer mesh order
   geometry::RayTracer tracer_;
-  std::vector<int> surface_of_mesh_;
 };
 
 // Outgoing radiance images (RGB, W/(sr·m²)). `shadows` false drops every visibility test.
 // `srgbe_group` > 0 emulates the paper's 8-bit frame buffer (§4.1–4.2): the spotlights are summed in
 // passes of that many (the paper: 3), and after every pass the running irradiance sum is stored as
 // sRGBE (rgbe.h) and read back, as between the paper's rendering passes.
-Image render_spotlights(const SceneView& sv, const std::vector<TexturedSpotlight>& lights, const View& view,
+Image render_spotlights(const SceneView& sv, const std::vector<TexturedSpotlight>& lights, const geometry::Camera& view,
                         bool shadows, const ProgressFn& progress = {}, int srgbe_group = 0);
-Image render_exact(const SceneView& sv, const Luminaire& lum, const Placement& placement, const View& view,
+Image render_exact(const SceneView& sv, const Luminaire& lum, const Placement& placement, const geometry::Camera& view,
                    bool shadows, const ProgressFn& progress = {});
 
 }  // namespace ibl::nearfield

@@ -130,10 +130,10 @@ void raster_triangle(const ClipVertex& v0, const ClipVertex& v1, const ClipVerte
 }  // namespace
 
 RenderResult render_cpu(const FrameDesc& d, const ProgressFn& progress) {
-  const Camera& cam = d.camera;
+  const geometry::Camera& cam = d.camera;
   const int W = cam.width, H = cam.height;
   if (W <= 0 || H <= 0) fail(ErrorKind::Value, "frame size {}x{} is invalid", W, H);
-  Mat4f vp = mul(cam.projection(), cam.view());
+  geometry::Mat4f vp = geometry::mul(cam.projection(), cam.view());
   std::vector<Hit> hits(static_cast<size_t>(W) * H);
   // Rasterise in horizontal bands, one task each: every band tests every triangle's bounds.
   constexpr int kBand = 16;

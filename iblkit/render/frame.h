@@ -1,7 +1,7 @@
 // What both renderers draw: a mesh with a material, seen by a camera, under a lighting.
 #pragma once
 #include "iblkit/core/image.h"
-#include "iblkit/render/camera.h"
+#include "iblkit/geometry/camera.h"
 #include "iblkit/render/mesh.h"
 #include "iblkit/render/shading.h"
 
@@ -13,7 +13,7 @@ struct RenderObject {
 };
 
 struct FrameDesc {
-  Camera camera;
+  geometry::Camera camera;
   std::vector<RenderObject> objects;
   Lighting lighting;
   Vec3 background{0, 0, 0};  // radiance where no surface is hit

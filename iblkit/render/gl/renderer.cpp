@@ -11,6 +11,7 @@
 #include "iblkit/render/gl/program.h"
 #include "iblkit/render/gl/sh_glsl.h"
 #include "iblkit/render/gl/uploads.h"
+#include "iblkit/render/light_space.h"
 #include "iblkit/sh/convolve.h"
 
 namespace ibl::render::gl {
@@ -105,7 +106,7 @@ Renderer::~Renderer() = default;
 unsigned Renderer::color_texture() const { return impl_->uploads.last_color_texture(); }
 
 RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing, bool read_back) {
-  const Camera& cam = d.camera;
+  const geometry::Camera& cam = d.camera;
   const int W = cam.width, H = cam.height;
   if (W <= 0 || H <= 0 || W > 16384 || H > 16384) fail(ErrorKind::Value, "frame size {}x{} is invalid", W, H);
   const Lighting& L = d.lighting;
@@ -225,7 +226,7 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing,
         const double pd = sp.plane_distance, margin = std::max((sp.tex_max.x - sp.tex_min.x) / tw, (sp.tex_max.y - sp.tex_min.y) / th) + spread;
         const double tx = (std::max(std::abs(sp.tex_min.x), std::abs(sp.tex_max.x)) + margin) / pd;
         const double ty = (std::max(std::abs(sp.tex_min.y), std::abs(sp.tex_max.y)) + margin) / pd;
-        Camera c;
+        geometry::Camera c;
         c.eye = eye;
         c.target = eye + sp.frame.n;
         c.up = sp.frame.b;

@@ -1,63 +1,22 @@
-// A pinhole camera and the 4×4 matrices GL wants (column-major floats).
+// Light-space matrices for the GL renderer's shadow maps: an orthographic frustum for a directional
+// light, a perspective one for a point light outside the objects, six cube faces for one inside.
+// Built from the one pinhole camera (geometry/camera.h), column-major as GL takes them.
 #pragma once
+#include <algorithm>
 #include <array>
 #include <cmath>
 
-#include "iblkit/core/vec.h"
+#include "iblkit/geometry/camera.h"
 
 namespace ibl::render {
 
-using Mat4f = std::array<float, 16>;  // column-major: m[col * 4 + row]
-
-struct Camera {
-  Vec3 eye{0, 0.3, 1.2};
-  Vec3 target{0, 0, 0};
-  Vec3 up{0, 1, 0};
-  double fov_y_deg = 40.0;  // vertical field of view
-  int width = 1024, height = 768;
-  double znear = 0.01, zfar = 100.0;
-
-  // Unit world direction through pixel position (px, py) (continuous, y down).
-  Vec3 ray_direction(double px, double py) const {
-    Vec3 f = normalize(target - eye), r = normalize(cross(f, up)), u = cross(r, f);
-    double t = std::tan(fov_y_deg * kPi / 360.0), aspect = static_cast<double>(width) / height;
-    double sx = (2 * px / width - 1) * t * aspect, sy = (1 - 2 * py / height) * t;
-    return normalize(f + r * sx + u * sy);
-  }
-  Mat4f view() const {
-    Vec3 f = normalize(target - eye), r = normalize(cross(f, up)), u = cross(r, f);
-    return {static_cast<float>(r.x), static_cast<float>(u.x), static_cast<float>(-f.x), 0,
-            static_cast<float>(r.y), static_cast<float>(u.y), static_cast<float>(-f.y), 0,
-            static_cast<float>(r.z), static_cast<float>(u.z), static_cast<float>(-f.z), 0,
-            static_cast<float>(-dot(r, eye)), static_cast<float>(-dot(u, eye)), static_cast<float>(dot(f, eye)), 1};
-  }
-  Mat4f projection() const {
-    double t = 1.0 / std::tan(fov_y_deg * kPi / 360.0), aspect = static_cast<double>(width) / height;
-    Mat4f m{};
-    m[0] = static_cast<float>(t / aspect);
-    m[5] = static_cast<float>(t);
-    m[10] = static_cast<float>(-(zfar + znear) / (zfar - znear));
-    m[11] = -1;
-    m[14] = static_cast<float>(-2 * zfar * znear / (zfar - znear));
-    return m;
-  }
-};
-
-inline Mat4f mul(const Mat4f& a, const Mat4f& b) {
-  Mat4f r{};
-  for (int c = 0; c < 4; ++c)
-    for (int rr = 0; rr < 4; ++rr) {
-      float s = 0;
-      for (int k = 0; k < 4; ++k) s += a[k * 4 + rr] * b[c * 4 + k];
-      r[c * 4 + rr] = s;
-    }
-  return r;
-}
+using geometry::Mat4f;
+using geometry::mul;
 
 // Orthographic light-space matrix for a directional light shining along −dir_to_light, fitting a
 // bounding sphere (centre, radius).
 inline Mat4f light_view_projection(Vec3 dir_to_light, Vec3 centre, double radius) {
-  Camera c;
+  geometry::Camera c;
   c.eye = centre + normalize(dir_to_light) * (2 * radius);
   c.target = centre;
   c.up = std::abs(normalize(dir_to_light).y) > 0.99 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
@@ -79,7 +38,7 @@ inline bool point_light_view_projection(Vec3 position, Vec3 centre, double radiu
   Vec3 to = centre - position;
   double dist = length(to);
   if (!(dist > radius * 1.05)) return false;
-  Camera c;
+  geometry::Camera c;
   c.eye = position;
   c.target = centre;
   c.up = std::abs(to.y / dist) > 0.99 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
@@ -99,7 +58,7 @@ inline std::array<Mat4f, 6> cube_light_view_projections(Vec3 position, double fa
   static const Vec3 ups[6] = {{0, 1, 0}, {0, 1, 0}, {0, 0, 1}, {0, 0, -1}, {0, 1, 0}, {0, 1, 0}};
   std::array<Mat4f, 6> out;
   for (int f = 0; f < 6; ++f) {
-    Camera c;
+    geometry::Camera c;
     c.eye = position;
     c.target = position + axes[f];
     c.up = ups[f];
