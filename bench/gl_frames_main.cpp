@@ -28,21 +28,19 @@ double median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
-SHGridData make_grid(int n, int bands) {
-  SHGridData g;
-  g.bands = bands;
-  g.nx = g.ny = g.nz = n;
-  g.min = {-0.6, -0.6, -0.6};
-  g.max = {0.6, 0.6, 0.6};
+ilf::SHGrid make_grid(int n, int bands) {
+  ilf::GridDesc gd;
+  gd.nx = gd.ny = gd.nz = n;
+  gd.volume = {{-0.6, -0.6, -0.6}, {0.6, 0.6, 0.6}};
+  ilf::SHGrid g(gd, bands);
   const int K = bands * bands;
-  g.data.resize(static_cast<size_t>(n) * n * n * K * 3);
   for (int z = 0; z < n; ++z)
     for (int y = 0; y < n; ++y)
       for (int x = 0; x < n; ++x)
         for (int k = 0; k < K; ++k)
           for (int c = 0; c < 3; ++c) {
             size_t i = ((((static_cast<size_t>(z) * n + y) * n + x) * K + k) * 3 + c);
-            g.data[i] = static_cast<float>((k == 0 ? 2.0 : 0.3 / (1 + k)) * (1 + 0.3 * std::sin(0.3 * x + 0.2 * y - 0.1 * z + c)));
+            g.data()[i] = static_cast<float>((k == 0 ? 2.0 : 0.3 / (1 + k)) * (1 + 0.3 * std::sin(0.3 * x + 0.2 * y - 0.1 * z + c)));
           }
   return g;
 }

@@ -42,16 +42,7 @@ void load_lighting(const std::string& path, const LightingOptions& o, Lighting* 
   const io::EnvReadDesc& rd = o.read;
   std::string ext = fs::path(path).extension().string();
   if (ext == ".shgrid") {
-    ilf::SHGrid g = ilf::read_shgrid(path);
-    SHGridData d;
-    d.bands = g.bands();
-    d.nx = g.grid().nx;
-    d.ny = g.grid().ny;
-    d.nz = g.grid().nz;
-    d.min = g.grid().volume.min;
-    d.max = g.grid().volume.max;
-    d.data = g.data();
-    L->grid = std::move(d);
+    const ilf::SHGrid& g = L->grid.emplace(ilf::read_shgrid(path));
     *kind = fmt::format("SH grid {}x{}x{}, {} bands", g.grid().nx, g.grid().ny, g.grid().nz, g.bands());
     return;
   }
@@ -112,7 +103,7 @@ std::string grid_bounds_warning(const Lighting& L, const Mesh& object) {
   if (!L.grid) return {};
   Vec3 lo, hi;
   object.bounds(&lo, &hi);
-  const Vec3 gmin = L.grid->min, gmax = L.grid->max;
+  const Vec3 gmin = L.grid->grid().volume.min, gmax = L.grid->grid().volume.max;
   constexpr double kSlack = 1e-6;  // metres: an object exactly on the volume's faces is inside
   for (int a = 0; a < 3; ++a)
     if (lo[a] < gmin[a] - kSlack || hi[a] > gmax[a] + kSlack)

@@ -184,16 +184,13 @@ Agreement compare(const RenderResult& a, const RenderResult& b) {
 }
 
 // An SH grid of nx × ny × nz points over the box ±0.5, its values zero.
-SHGridData unit_box_grid(int bands, int nx, int ny, int nz) {
-  SHGridData g;
-  g.bands = bands;
-  g.nx = nx;
-  g.ny = ny;
-  g.nz = nz;
-  g.min = {-0.5, -0.5, -0.5};
-  g.max = {0.5, 0.5, 0.5};
-  g.data.assign(static_cast<size_t>(nx) * ny * nz * bands * bands * 3, 0.0f);
-  return g;
+ilf::SHGrid unit_box_grid(int bands, int nx, int ny, int nz) {
+  ilf::GridDesc gd;
+  gd.nx = nx;
+  gd.ny = ny;
+  gd.nz = nz;
+  gd.volume = {{-0.5, -0.5, -0.5}, {0.5, 0.5, 0.5}};
+  return ilf::SHGrid(gd, bands);
 }
 
 // A textured spotlight at `at` shining along `forward`, its texture over ±half on a plane 0.5 m
@@ -347,8 +344,8 @@ TEST_F(RenderGl, ShGridAgreesWithCpu) {
   gl::Context ctx;
   Mesh m = make_blob(6000, 0.5);
   FrameDesc d = sphere_scene(&m, 96, 72);
-  SHGridData g = unit_box_grid(5, 4, 5, 3);
-  for (size_t i = 0; i < g.data.size(); ++i) g.data[i] = static_cast<float>((i % 75 < 3 ? 2.0 : 0.1) * (1 + 0.5 * std::sin(0.37 * i)));
+  ilf::SHGrid g = unit_box_grid(5, 4, 5, 3);
+  for (size_t i = 0; i < g.data().size(); ++i) g.data()[i] = static_cast<float>((i % 75 < 3 ? 2.0 : 0.1) * (1 + 0.5 * std::sin(0.37 * i)));
   d.lighting.grid = g;
   d.objects[0].material.specular = {0.3, 0.3, 0.3};
   d.objects[0].material.exponent = 30;
@@ -499,9 +496,9 @@ TEST_F(RenderGl, KeptUploadsFollowChangedLighting) {
   gl::Context ctx;
   Mesh blob = make_blob(3000, 0.5);
   FrameDesc d = sphere_scene(&blob, 64, 48);
-  SHGridData g = unit_box_grid(3, 3, 3, 3);
-  std::fill(g.data.begin(), g.data.end(), 0.1f);
-  for (size_t p = 0; p < 27; ++p) g.data[p * 27] = g.data[p * 27 + 1] = g.data[p * 27 + 2] = 1.0f;
+  ilf::SHGrid g = unit_box_grid(3, 3, 3, 3);
+  std::fill(g.data().begin(), g.data().end(), 0.1f);
+  for (size_t p = 0; p < 27; ++p) g.data()[p * 27] = g.data()[p * 27 + 1] = g.data()[p * 27 + 2] = 1.0f;
   d.lighting.grid = g;
   gl::Renderer kept;
   auto same = [](const RenderResult& a, const RenderResult& b) {
@@ -511,7 +508,7 @@ TEST_F(RenderGl, KeptUploadsFollowChangedLighting) {
     return worst;
   };
   RenderResult first = kept.render(d);
-  d.lighting.grid->data[((2 * 3 + 1) * 3 + 1) * 27] = 3.0f;  // the same grid object: point (1,1,2)'s red DC term
+  d.lighting.grid->data()[((2 * 3 + 1) * 3 + 1) * 27] = 3.0f;  // the same grid object: point (1,1,2)'s red DC term
   RenderResult changed = kept.render(d);
   EXPECT_GT(same(first, changed), 1e-3);
   EXPECT_EQ(same(changed, gl::Renderer().render(d)), 0.0);

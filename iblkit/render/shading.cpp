@@ -9,38 +9,13 @@
 
 namespace ibl::render {
 
-sh::Coeffs SHGridData::at(Vec3 p) const {
-  const int K = bands * bands;
-  sh::Coeffs out;
-  out.bands = bands;
-  out.c.assign(K, Vec3{});
-  double f[3];
-  int i0[3], n[3] = {nx, ny, nz};
-  for (int a = 0; a < 3; ++a) {
-    double span = max[a] - min[a];
-    double t = span > 0 ? std::clamp((p[a] - min[a]) / span, 0.0, 1.0) * (n[a] - 1) : 0.0;
-    i0[a] = std::min(static_cast<int>(t), std::max(0, n[a] - 2));
-    f[a] = n[a] > 1 ? t - i0[a] : 0.0;
-  }
-  for (int corner = 0; corner < 8; ++corner) {
-    int ix = std::min(i0[0] + (corner & 1), nx - 1), iy = std::min(i0[1] + ((corner >> 1) & 1), ny - 1),
-        iz = std::min(i0[2] + ((corner >> 2) & 1), nz - 1);
-    double w = ((corner & 1) ? f[0] : 1 - f[0]) * (((corner >> 1) & 1) ? f[1] : 1 - f[1]) *
-               (((corner >> 2) & 1) ? f[2] : 1 - f[2]);
-    if (w == 0) continue;
-    const float* src = data.data() + ((static_cast<size_t>(iz) * ny + iy) * nx + ix) * K * 3;
-    for (int k = 0; k < K; ++k) out.c[k] += Vec3{src[3 * k], src[3 * k + 1], src[3 * k + 2]} * w;
-  }
-  return out;
-}
-
 Vec3 shade(const Lighting& lighting, const Material& m, Vec3 p, Vec3 n, Vec3 v, const VisibilityFn& visible) {
   Vec3 r = normalize(n * (2 * dot(n, v)) - v);
   Vec3 E, G;
   const sh::Coeffs* c = nullptr;
   sh::Coeffs local;
   if (lighting.grid) {
-    local = lighting.grid->at(p);
+    local = lighting.grid->coeffs_at(p);
     c = &local;
   } else if (lighting.environment) {
     c = &*lighting.environment;

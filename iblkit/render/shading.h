@@ -22,6 +22,7 @@
 
 #include "iblkit/core/image.h"
 #include "iblkit/core/vec.h"
+#include "iblkit/ilf/shgrid.h"
 #include "iblkit/nearfield/spotlight.h"
 #include "iblkit/render/prefilter.h"
 #include "iblkit/sh/coeffs.h"
@@ -63,20 +64,9 @@ struct PointLight {
   bool shadow = false;  // shadow rays on the CPU; a perspective shadow map on the GPU
 };
 
-// A regular grid of SH radiance (the .shgrid layout of DESIGN.md): value index
-// (((z·ny + y)·nx + x)·K + k)·3 + channel; point (i,j,k) at min + (max−min)·(i/(nx−1), …).
-struct SHGridData {
-  int bands = 0;
-  int nx = 0, ny = 0, nz = 0;
-  Vec3 min, max;
-  std::vector<float> data;
-  // Trilinear interpolation of the coefficients at p (clamped to the box).
-  sh::Coeffs at(Vec3 p) const;
-};
-
 struct Lighting {
   std::optional<sh::Coeffs> environment;  // distant light
-  std::optional<SHGridData> grid;         // local light field (takes precedence over environment)
+  std::optional<ilf::SHGrid> grid;        // local light field (takes precedence over environment)
   std::vector<DirectionalLight> lights;   // directional lights
   std::vector<PointLight> point_lights;   // point lights (e.g. fusion's localised lights)
   // Textured spotlights: the terms of a measured luminaire's near field (Granier et al. 2003,

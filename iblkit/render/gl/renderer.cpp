@@ -110,7 +110,7 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing,
   const int W = cam.width, H = cam.height;
   if (W <= 0 || H <= 0 || W > 16384 || H > 16384) fail(ErrorKind::Value, "frame size {}x{} is invalid", W, H);
   const Lighting& L = d.lighting;
-  int bands = L.grid ? L.grid->bands : (L.environment ? L.environment->bands : 0);
+  int bands = L.grid ? L.grid->bands() : (L.environment ? L.environment->bands : 0);
   bool glossy = false;
   for (const auto& o : d.objects) glossy |= max_component(o.material.specular) > 0;
   const bool deferred = impl_->desc.deferred;
@@ -273,14 +273,15 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing,
   // SH grid: one RGBA16F 3D texture, coefficient k in slices [k·nz, (k+1)·nz).
   GLuint grid_tex = 0;
   if (L.grid) {
-    const SHGridData& g = *L.grid;
-    if (g.nx < 1 || g.ny < 1 || g.nz < 1 || g.data.size() != static_cast<size_t>(g.nx) * g.ny * g.nz * K * 3)
-      fail(ErrorKind::Value, "SH grid {}x{}x{} with {} bands holds {} values, expected {}", g.nx, g.ny, g.nz, g.bands,
-           g.data.size(), static_cast<size_t>(g.nx) * g.ny * g.nz * K * 3);
+    const ilf::SHGrid& g = *L.grid;
+    const ilf::GridDesc& gd = g.grid();
+    if (g.data().size() != static_cast<size_t>(gd.count()) * K * 3)
+      fail(ErrorKind::Value, "SH grid {}x{}x{} with {} bands holds {} values, expected {}", gd.nx, gd.ny, gd.nz, g.bands(),
+           g.data().size(), static_cast<size_t>(gd.count()) * K * 3);
     GLint max3d = 0;
     glGetIntegerv(GL_MAX_3D_TEXTURE_SIZE, &max3d);
-    if (g.nz * K > max3d)
-      fail(ErrorKind::Unsupported, "SH grid needs a 3D texture {} deep; this GL allows {}", g.nz * K, max3d);
+    if (gd.nz * K > max3d)
+      fail(ErrorKind::Unsupported, "SH grid needs a 3D texture {} deep; this GL allows {}", gd.nz * K, max3d);
     grid_tex = impl_->uploads.grid_texture(g);
   }
 
@@ -423,9 +424,10 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing,
       for (int c = 0; c < 3; ++c) env[k * 3 + c] = static_cast<float>(L.environment->c[k][c]);
   glProgramUniform3fv(prog, glGetUniformLocation(prog, "u_env"), K, env.data());
   if (mode == 2) {
-    set_vec3(prog, "u_grid_min", L.grid->min);
-    set_vec3(prog, "u_grid_max", L.grid->max);
-    set_vec3(prog, "u_grid_res", {static_cast<double>(L.grid->nx), static_cast<double>(L.grid->ny), static_cast<double>(L.grid->nz)});
+    const ilf::GridDesc& gd = L.grid->grid();
+    set_vec3(prog, "u_grid_min", gd.volume.min);
+    set_vec3(prog, "u_grid_max", gd.volume.max);
+    set_vec3(prog, "u_grid_res", {static_cast<double>(gd.nx), static_cast<double>(gd.ny), static_cast<double>(gd.nz)});
   }
   if (bands > 0) {
     auto dz = sh::clamped_cosine_zh(bands);

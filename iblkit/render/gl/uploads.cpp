@@ -109,22 +109,23 @@ const Uploads::Geometry& Uploads::geometry(const std::vector<RenderObject>& obje
 }
 
 // (Compared in full: a memcmp costs a tenth of packing and uploading the values again.)
-unsigned Uploads::grid_texture(const SHGridData& g) {
-  if (grid_tex_ && g.nx == grid_key_.nx && g.ny == grid_key_.ny && g.nz == grid_key_.nz && g.bands == grid_key_.bands &&
-      g.data == grid_key_.data)
+unsigned Uploads::grid_texture(const ilf::SHGrid& g) {
+  const ilf::GridDesc &gd = g.grid(), &key = grid_key_.grid();
+  if (grid_tex_ && gd.nx == key.nx && gd.ny == key.ny && gd.nz == key.nz && g.bands() == grid_key_.bands() &&
+      g.data() == grid_key_.data())
     return grid_tex_;
   if (grid_tex_) glDeleteTextures(1, &grid_tex_);
   grid_tex_ = 0;  // (nothing stale is left if what follows throws)
   grid_key_ = {};
-  const int K = g.bands * g.bands;
-  const size_t points = static_cast<size_t>(g.nx) * g.ny * g.nz;
+  const int K = g.coeff_count();
+  const size_t points = static_cast<size_t>(gd.count());
   std::vector<float> packed(points * K * 4, 0.0f);
   for (int k = 0; k < K; ++k)
     for (size_t p = 0; p < points; ++p)
-      for (int c = 0; c < 3; ++c) packed[(static_cast<size_t>(k) * points + p) * 4 + c] = g.data[(p * K + k) * 3 + c];
+      for (int c = 0; c < 3; ++c) packed[(static_cast<size_t>(k) * points + p) * 4 + c] = g.data()[(p * K + k) * 3 + c];
   glCreateTextures(GL_TEXTURE_3D, 1, &grid_tex_);
-  glTextureStorage3D(grid_tex_, 1, GL_RGBA16F, g.nx, g.ny, g.nz * K);
-  glTextureSubImage3D(grid_tex_, 0, 0, 0, 0, g.nx, g.ny, g.nz * K, GL_RGBA, GL_FLOAT, packed.data());
+  glTextureStorage3D(grid_tex_, 1, GL_RGBA16F, gd.nx, gd.ny, gd.nz * K);
+  glTextureSubImage3D(grid_tex_, 0, 0, 0, 0, gd.nx, gd.ny, gd.nz * K, GL_RGBA, GL_FLOAT, packed.data());
   glTextureParameteri(grid_tex_, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
   glTextureParameteri(grid_tex_, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
   for (GLenum w : {GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T, GL_TEXTURE_WRAP_R}) glTextureParameteri(grid_tex_, w, GL_CLAMP_TO_EDGE);

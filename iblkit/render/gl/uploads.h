@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "iblkit/core/image.h"
+#include "iblkit/ilf/shgrid.h"
 #include "iblkit/nearfield/spotlight.h"
 #include "iblkit/render/frame.h"
 
@@ -43,7 +44,7 @@ class Uploads {
   const Geometry& geometry(const std::vector<RenderObject>& objects, bool deferred);
 
   // The SH grid in one RGBA16F 3D texture, coefficient k in slices [k·nz, (k+1)·nz).
-  unsigned grid_texture(const SHGridData& grid);
+  unsigned grid_texture(const ilf::SHGrid& grid);
 
   // The spotlights' textures in one mip-mapped RGBA16F 2D array, a layer per spotlight, each
   // divided by its largest |texel| (`scale`: half floats stop at 65504).
@@ -60,7 +61,7 @@ class Uploads {
   int color_w_ = 0, color_h_ = 0;
   Geometry geometry_;
   unsigned grid_tex_ = 0;
-  SHGridData grid_key_;
+  ilf::SHGrid grid_key_;
   SpotTextures spots_;
 };
 
