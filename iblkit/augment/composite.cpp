@@ -60,15 +60,16 @@ double patch_tfar(double dist) {
   return std::isinf(dist) ? std::numeric_limits<double>::infinity() : dist * (1 - kShadowShorten) - kRayEpsilon;
 }
 
-// E at x (normal n) from `count` stratified patch samples, visibility against `rt`.
-Vec3 irradiance(const Scene& s, const geometry::RayTracer& rt, Vec3 x, Vec3 n, int count, Rng& rng) {
+// E at x (normal n) from `count` stratified patch samples, visibility against `rt`; `shadowed`: the proxy's
+// patches darkened by the object's shadow on them (the light an object point receives).
+Vec3 irradiance(const Scene& s, const geometry::RayTracer& rt, Vec3 x, Vec3 n, int count, Rng& rng, bool shadowed = false) {
   Vec3 e;
   for (int k = 0; k < count; ++k) {
     double pmf;
     size_t i = s.light->sample((k + rng.uniform()) / count, &pmf);
     Vec3 w;
     double dist;
-    Vec3 c = s.light->contribution(i, x, n, &w, &dist);
+    Vec3 c = s.light->contribution(i, x, n, &w, &dist, shadowed);
     if (max_component(c) <= 0 || rt.occluded(x, w, kRayEpsilon, patch_tfar(dist))) continue;
     e += c / pmf;
   }
@@ -119,6 +120,25 @@ Vec3 object_light(const Scene& s, const std::vector<Vec3>& tri_radiance, Vec3 y,
     sum += tri_radiance[h.triangle] * cn;
   }
   return sum * (2 * kPi * (1 - cos_max) / count);  // uniform in the cone (a hemisphere when inside)
+}
+
+// The object's shadow on the proxy patches near it (within kShadowReach bounding radii of its centre),
+// as factors E_with / E₀ of their radiance: the floor under an object does not light its underside.
+constexpr double kShadowReach = 4;
+void shadow_patches(const Scene& s, LightField& field, int count, uint64_t seed) {
+  std::vector<size_t> near;
+  for (size_t i = 0; i < field.size(); ++i)
+    if (field.local(i) && length(field.point(i) - s.bound.c) < kShadowReach * s.bound.r) near.push_back(i);
+  std::vector<Vec3> factor(near.size(), Vec3{1, 1, 1});
+  parallel_for(0, static_cast<int64_t>(near.size()), [&](int64_t k) {
+    size_t i = near[static_cast<size_t>(k)];
+    Vec3 n = field.normal(i), e0, blocked;
+    Rng rng(seed, 0x706174 /* "pat" */, i);
+    proxy_irradiance(s, field.point(i) + n * kRayEpsilon, n, count, rng, &e0, &blocked);
+    for (int c = 0; c < 3; ++c)
+      if (e0[c] > kUnlitIrradiance) factor[static_cast<size_t>(k)][c] = std::clamp(1 - blocked[c] / e0[c], 0.0, 1.0);
+  }, 64);
+  for (size_t k = 0; k < near.size(); ++k) field.set_shadow(near[k], factor[k]);
 }
 
 void check_geometry(const Scene& s, const geometry::Camera& cam) {
@@ -181,6 +201,7 @@ CompositeResult composite(const Image& photo, const geometry::Camera& cam, const
   if (desc.check_geometry) check_geometry(s, cam);
   LightField field(light, proxy, s.proxy_rt);
   s.light = &field;
+  shadow_patches(s, field, desc.light_samples, desc.seed);
 
   // The object's radiance per triangle (for its light on the proxy).
   std::vector<Vec3> tri_radiance(object.triangle_count());
@@ -190,7 +211,7 @@ CompositeResult composite(const Image& photo, const geometry::Camera& cam, const
       Vec3 nn = object.normal(static_cast<size_t>(ti));
       Vec3 c = (object.positions[t[0]] + object.positions[t[1]] + object.positions[t[2]]) / 3.0;
       Rng rng(desc.seed, 0x747269 /* "tri" */, static_cast<uint64_t>(ti));
-      tri_radiance[static_cast<size_t>(ti)] = albedo * irradiance(s, s.both_rt, c + nn * kRayEpsilon, nn, desc.triangle_samples, rng) / kPi;
+      tri_radiance[static_cast<size_t>(ti)] = albedo * irradiance(s, s.both_rt, c + nn * kRayEpsilon, nn, desc.triangle_samples, rng, true) / kPi;
     }, 256);
   report(desc.progress, "object", 1.0);
 
@@ -223,7 +244,7 @@ CompositeResult composite(const Image& photo, const geometry::Camera& cam, const
           if (dot(nn, d) > 0) nn = -nn;
           Vec3 z = cam.eye + d * h.t;
           Rng rng(desc.seed, 0x6f626a /* "obj" */, pixel * 64 + static_cast<uint64_t>(kk));
-          obj_sum += albedo * irradiance(s, s.both_rt, z + nn * kRayEpsilon, nn, obj_per_ray, rng) / kPi;
+          obj_sum += albedo * irradiance(s, s.both_rt, z + nn * kRayEpsilon, nn, obj_per_ray, rng, true) / kPi;
           ++obj_hits;
         } else if (!have_proxy) {
           have_proxy = true;

@@ -15,6 +15,8 @@ namespace {
 constexpr double kMinCosCentre = 0.05;  // grazing texels: their patch area stops growing at 1/0.05 (≈ 87°)
 constexpr double kPowerShare = 0.8;     // sampling: this share by power, the rest by solid angle (no fireflies
                                         // from dim but near patches)
+// A patch's power is its mean RGB radiance × solid angle (not luminance: a red lamp is as much a light as a white one).
+double power_of(Vec3 L) { return (std::max(0.0, L.x) + std::max(0.0, L.y) + std::max(0.0, L.z)) / 3; }
 constexpr double kDepthInFront = 0.98;  // a depth this much shorter than the proxy's hit is a free emitter (a lamp)
 
 }  // namespace
@@ -90,16 +92,16 @@ LightField::LightField(const LocalLight& light, const geometry::TriMesh& proxy, 
   if (patches_.empty()) fail(ErrorKind::Value, "the {} light is black: nothing to light the scene with", light.source);
   double power = 0, solid = 0;
   for (const auto& p : patches_) {
-    power += luminance(p.radiance) * p.omega;
+    power += power_of(p.radiance) * p.omega;
     solid += p.omega;
   }
   total_ = power;
-  if (!(power > 0)) fail(ErrorKind::Value, "the {} light has no positive luminance", light.source);
+  if (!(power > 0)) fail(ErrorKind::Value, "the {} light has no positive radiance", light.source);
   cdf_.resize(patches_.size());
   double acc = 0;
   for (size_t i = 0; i < patches_.size(); ++i) {
     const Patch& p = patches_[i];
-    acc += kPowerShare * std::max(0.0, luminance(p.radiance)) * p.omega / power + (1 - kPowerShare) * p.omega / solid;
+    acc += kPowerShare * power_of(p.radiance) * p.omega / power + (1 - kPowerShare) * p.omega / solid;
     cdf_[i] = acc;
   }
   for (auto& c : cdf_) c /= acc;
@@ -113,13 +115,14 @@ size_t LightField::sample(double u, double* pmf) const {
   return i;
 }
 
-Vec3 LightField::contribution(size_t i, Vec3 x, Vec3 n, Vec3* w, double* dist) const {
+Vec3 LightField::contribution(size_t i, Vec3 x, Vec3 n, Vec3* w, double* dist, bool shadowed) const {
   const Patch& p = patches_[i];
+  const Vec3 L = shadowed ? p.radiance * p.shadow : p.radiance;
   if (p.distant) {
     *w = p.point;
     *dist = std::numeric_limits<double>::infinity();
     double c = dot(n, p.point);
-    return c > 0 ? p.radiance * (p.area * c) : Vec3{};
+    return c > 0 ? L * (p.area * c) : Vec3{};
   }
   Vec3 v = p.point - x;
   double r2 = dot(v, v), r = std::sqrt(r2);
@@ -128,7 +131,7 @@ Vec3 LightField::contribution(size_t i, Vec3 x, Vec3 n, Vec3* w, double* dist) c
   *dist = r;
   double cx = dot(n, *w), cq = -dot(p.normal, *w);
   if (cx <= 0 || cq <= 0) return {};
-  return p.radiance * (p.area * cq * cx / std::max(r2, p.area));  // r² ≥ A: a patch never covers more than ~π sr
+  return L * (p.area * cq * cx / std::max(r2, p.area));  // r² ≥ A: a patch never covers more than ~π sr
 }
 
 }  // namespace ibl::augment

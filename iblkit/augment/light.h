@@ -44,9 +44,16 @@ class LightField {
   size_t sample(double u, double* pmf) const;
   // L_t Ω_t(x) max(0, n·ω) of patch i at x with unit normal n (0 when either side faces away); *w the unit
   // direction towards it and *dist its distance (infinity for a distant patch).
-  Vec3 contribution(size_t i, Vec3 x, Vec3 n, Vec3* w, double* dist) const;
-  // ∫ L dω over the map (luminance), W/m²/sr·sr: for messages and tests.
-  double total_luminance() const { return total_; }
+  Vec3 contribution(size_t i, Vec3 x, Vec3 n, Vec3* w, double* dist, bool shadowed = false) const;
+  // Whether patch i lies on the proxy (or a lamp in front of it) rather than at infinity, and where.
+  bool local(size_t i) const { return !patches_[i].distant; }
+  Vec3 point(size_t i) const { return patches_[i].point; }
+  Vec3 normal(size_t i) const { return patches_[i].normal; }
+  // The object's shadow on patch i as a factor of its radiance (1: untouched), for the light the object
+  // receives from the proxy; contribution(…, shadowed = true) applies it.
+  void set_shadow(size_t i, Vec3 factor) { patches_[i].shadow = factor; }
+  // ∫ mean(R, G, B) dω over the map, W/m²: for messages and tests.
+  double total_power() const { return total_; }
 
  private:
   struct Patch {
@@ -56,6 +63,7 @@ class LightField {
     double area = 0;  // local: m²; distant: solid angle, sr
     double omega = 0; // solid angle seen from the centre, sr
     bool distant = false;
+    Vec3 shadow{1, 1, 1};  // the object's shadow on it (set_shadow)
   };
   std::vector<Patch> patches_;
   std::vector<double> cdf_;
