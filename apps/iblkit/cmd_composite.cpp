@@ -25,7 +25,7 @@ struct Opts {
                                    albedo = "0.7,0.7,0.7", out = "composite.exr", layers, backend = "cpu", truth;
   std::vector<std::string> light;
   double fov = 40, object_size = 0.3;
-  int triangles = 20000;
+  int triangles = 20000, median_cut = 0;
   ibl::augment::CompositeDesc desc;
 };
 
@@ -73,6 +73,7 @@ void run(const Opts& o, const ibl::io::EnvReadDesc& read) {
   li.read = read;
   ibl::augment::LoadedLight L = ibl::augment::load_light(li, lo, hi);
   for (const auto& w : L.warnings) iblcli::info("warning: " + w);
+  if (o.median_cut > 0) L.light = ibl::augment::as_median_cut(L.light, o.median_cut);
   ibl::augment::CompositeDesc d = o.desc;
   d.progress = iblcli::progress_bar();
   auto r = ibl::augment::composite(photo, cam, L.proxy, L.light, object, od.albedo, d);
@@ -147,6 +148,9 @@ void setup(CLI::App& app) {
       ->check(CLI::Range(0, 65536))->capture_default_str();
   app.add_option("--pixel-samples", o->desc.pixel_samples, "n×n camera rays per pixel (object edges)")->check(CLI::Range(1, 8))->capture_default_str();
   app.add_option("--seed", o->desc.seed, "random seed")->capture_default_str();
+  app.add_option("--median-cut", o->median_cut, "baseline: the light cut into N median-cut lights (shadows and shading from those only)")
+      ->check(CLI::Range(1, 4096));
+  app.add_flag("--no-shadows", [o](int64_t) { o->desc.shadows = false; }, "baseline: the object pasted without its shadow and light on the scene");
   app.add_option("--backend", o->backend, "cpu (the ray-traced reference; auto means cpu for now)")->capture_default_str();
   app.add_option("-o,--out", o->out, "the composite (.exr linear, .png tone mapped)")->capture_default_str();
   app.add_option("--layers", o->layers, "folder for mask, difference, albedo, render_with, render_without (.exr)");

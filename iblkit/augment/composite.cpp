@@ -201,7 +201,7 @@ CompositeResult composite(const Image& photo, const geometry::Camera& cam, const
   if (desc.check_geometry) check_geometry(s, cam);
   LightField field(light, proxy, s.proxy_rt);
   s.light = &field;
-  shadow_patches(s, field, desc.light_samples, desc.seed);
+  if (desc.shadows) shadow_patches(s, field, desc.light_samples, desc.seed);
 
   // The object's radiance per triangle (for its light on the proxy).
   std::vector<Vec3> tri_radiance(object.triangle_count());
@@ -255,7 +255,7 @@ CompositeResult composite(const Image& photo, const geometry::Camera& cam, const
       }
       const Vec3 ph = photo.rgb(x, y);
       Vec3 comp = ph, without, with, rho;
-      if (have_proxy) {
+      if (have_proxy && desc.shadows) {
         ++proxy_px;
         Vec3 nn = proxy.normal(proxy_tri);
         if (dot(nn, proxy_dir) > 0) nn = -nn;
@@ -268,7 +268,7 @@ CompositeResult composite(const Image& photo, const geometry::Camera& cam, const
         for (int c = 0; c < 3; ++c) {
           if (e0[c] > kUnlitIrradiance) {
             rho[c] = kPi * ph[c] / e0[c];
-            comp[c] = ph[c] * std::max(0.0, 1 + dE[c] / e0[c]);
+            comp[c] = std::max(0.0, ph[c] + std::min(rho[c], 1.0) * dE[c] / kPi);  // a reflectance > 1 changes no more than 1 would
             bad = bad || rho[c] > 1;
           } else {
             lit = false;

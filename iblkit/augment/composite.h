@@ -9,8 +9,10 @@
 //   ΔE(y) = − Σ_t L_t Ω_t(y) cos θ V_proxy [object blocks y→q_t]  its shadow, from every patch (sun and sky)
 //           + ∫_{ω hits the object} L_obj(z(ω)) cos θ dω          its light on y: one bounce object → proxy
 //   ┌────────────────────────────────────────────────────────────────┐
-//   │ composite = photo + ρ/π · ΔE  =  photo · (1 + ΔE / E₀)          │
+//   │ composite = photo + min(ρ, 1)/π · ΔE   (= photo · (1 + ΔE/E₀))  │
 //   └────────────────────────────────────────────────────────────────┘
+// (ρ > 1 means the captured light misses some of the light the photograph shows; the change is then
+// limited to what a white surface would show.)
 //
 // Both sums are estimated with the same patch samples (power-and-solid-angle sampling, light.h); only
 // sample rays that meet the object add to ΔE, so a pixel from which no ray meets the object keeps the
@@ -43,6 +45,7 @@ struct CompositeDesc {
   int pixel_samples = 2;       // n: n×n camera rays per pixel (object coverage at its edges)
   uint64_t seed = 1;           // random streams (same seed, same bytes)
   bool check_geometry = true;  // camera inside the proxy, object intersecting it: errors
+  bool shadows = true;         // false: the object pasted without its shadow and light on the proxy (a baseline)
   ProgressFn progress;         // stages "object", "composite" (by rows)
 };
 

@@ -4,9 +4,12 @@
 #include <cmath>
 #include <limits>
 
+#include <fmt/format.h>
+
 #include "iblkit/core/error.h"
 #include "iblkit/core/parallel.h"
 #include "iblkit/fusion/fuse.h"
+#include "iblkit/lights/cut.h"
 
 namespace ibl::augment {
 
@@ -47,6 +50,27 @@ LocalLight light_from_probes(const fusion::ProbeSet& set, Vec3 at, int size) {
   l.centre = at;
   l.source = "fused probes";
   return l;
+}
+
+LocalLight as_median_cut(const LocalLight& light, int count) {
+  if (light.map.mapping.kind() != sphere::MappingKind::LatLong) fail(ErrorKind::Value, "median-cut baseline: the {} map is not lat-long", light.source);
+  lights::CutDesc cd;
+  cd.count = count;
+  lights::LightSet set = lights::median_cut(light.map, cd);
+  LocalLight out = light;
+  out.source = fmt::format("{} as {} median-cut lights", light.source, set.lights.size());
+  const int W = light.map.image.width(), H = light.map.image.height();
+  out.map.image = Image(W, H, 3);
+  if (!light.depth.empty()) out.depth = Image(W, H, 1);
+  for (const auto& l : set.lights) {
+    double px, py;
+    if (!light.map.mapping.to_pixel(l.direction, &px, &py)) continue;
+    int x = std::clamp(static_cast<int>(px), 0, W - 1), y = std::clamp(static_cast<int>(py), 0, H - 1);
+    double sa = light.map.mapping.solid_angle(x, y);
+    out.map.image.set_rgb(x, y, out.map.image.rgb(x, y) + l.irradiance / sa);
+    if (!light.depth.empty()) out.depth.at(x, y, 0) = light.depth.at(x, y, 0);
+  }
+  return out;
 }
 
 LightField::LightField(const LocalLight& light, const geometry::TriMesh& proxy, const geometry::RayTracer& proxy_tracer) {

@@ -34,6 +34,11 @@ LocalLight light_from_grid(const ilf::SHGrid& grid, Vec3 at, int size = 64);
 // The probe set fused at `at` (fusion::fuse, footprint blend) as a lat-long map of 2·size × size.
 LocalLight light_from_probes(const fusion::ProbeSet& set, Vec3 at, int size = 128);
 
+// A baseline: the light cut into `count` median-cut lights (lights::median_cut, Debevec 2005), each put into
+// the one texel of its direction with all of its region's power (and that texel's depth): what a renderer
+// with N shadow-casting lights sees. The map must be lat-long.
+LocalLight as_median_cut(const LocalLight& light, int count);
+
 // The light's patches on the proxy, and their sampling.
 class LightField {
  public:
