@@ -6,7 +6,9 @@
 # table; leaves everything under $OUT (default /tmp/augment_accuracy).
 # Usage: bench/augment_accuracy.sh BUILD/iblkit [WIDTHxHEIGHT] [TRUTH_SAMPLES]
 set -eu
+# PHOTO_ARGS / CAPTURE_ARGS (environment): extra options of every photograph / capture (e.g. more area samples).
 BIN=$1; SIZE=${2:-320x240}; TS=${3:-8}; OUT=${OUT:-/tmp/augment_accuracy}
+read -ra PA <<<"${PHOTO_ARGS:-}"; read -ra CA <<<"${CAPTURE_ARGS:-}"
 W=${SIZE%x*}; H=${SIZE#*x}
 mkdir -p "$OUT"
 row() {  # row SCENE LABEL ARGS… : one composite, one table row
@@ -24,12 +26,12 @@ scene_run() {  # scene_run SCENE AT EYE TARGET VOLUME FUSED_PROBES
   local scene=$1 at=$2; CAM=(--eye "$3" --target "$4" --fov 40); local vol=$5 fused=$6
   OBJ=(--object blob --at "$at" --object-size 0.3)
   local name; name=$(basename "$scene" .json); local d="$OUT/$name"; mkdir -p "$d"
-  "$BIN" lab photograph "$scene" "${CAM[@]}" --width "$W" --height "$H" --samples "$TS" --out "$d/photo.exr" --quiet >/dev/null
-  "$BIN" lab photograph "$scene" "${CAM[@]}" --width "$W" --height "$H" --samples "$TS" "${OBJ[@]}" --mask "$d/mask.exr" \
+  "$BIN" lab photograph "$scene" "${CAM[@]}" --width "$W" --height "$H" --samples "$TS" "${PA[@]}" --out "$d/photo.exr" --quiet >/dev/null
+  "$BIN" lab photograph "$scene" "${CAM[@]}" --width "$W" --height "$H" --samples "$TS" "${PA[@]}" "${OBJ[@]}" --mask "$d/mask.exr" \
     --out "$d/truth.exr" --quiet >/dev/null
-  "$BIN" lab capture "$scene" --fusion --probe "$at" --size 128 --out "$d/one" --quiet >/dev/null
+  "$BIN" lab capture "$scene" --fusion --probe "$at" --size 128 "${CA[@]}" --out "$d/one" --quiet >/dev/null
   local probes=(); IFS=';' read -ra pts <<<"$fused"; for p in "${pts[@]}"; do probes+=(--probe "$p"); done
-  "$BIN" lab capture "$scene" --fusion "${probes[@]}" --size 128 --out "$d/fused" --quiet >/dev/null
+  "$BIN" lab capture "$scene" --fusion "${probes[@]}" --size 128 "${CA[@]}" --out "$d/fused" --quiet >/dev/null
   "$BIN" lab capture "$scene" --grid 6,6,6 --volume "$vol" --size 32 --out "$d/seq" --quiet >/dev/null
   "$BIN" ilf build "$d/seq/sequence.json" --grid 6 --bands 5 --out "$d/grid.shgrid" --quiet >/dev/null
   row "$scene" "one probe" --probes "$d/one/probes.json" --layers "$d/layers"

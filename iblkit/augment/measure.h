@@ -1,9 +1,11 @@
 // How far a composite is from the truth (a lab photograph of the scene with the object really in it),
 // in three parts (docs/augment.md):
 //   object     Σ|c − t| / Σ t over the pixels the object covers wholly (mask = 1), RGB L1
-//   shadow     Σ|c − t| / Σ (p − t) over the pixels the object darkens: Y(p) − Y(t) > τ·Y(p) (p the
+//   shadow     Σ|c − t| / Σ |p − t| over the pixels the object darkens: Y(p) − Y(t) > τ·Y(p) (p the
 //              photograph without the object): the error relative to the shadow signal
 //   unchanged  Σ|c − t| / Σ t over the other pixels the object does not touch (|Y(p) − Y(t)| ≤ τ·Y(p))
+// Y is the luminance averaged over the pixel's 3×3 neighbourhood (only for deciding which pixel is which:
+// a path-traced truth's grain is not a shadow); the sums are over single pixels.
 #pragma once
 #include <cstdint>
 
