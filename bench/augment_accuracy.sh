@@ -32,7 +32,7 @@ scene_run() {  # scene_run SCENE AT EYE TARGET VOLUME FUSED_PROBES
   "$BIN" lab capture "$scene" --fusion --probe "$at" --size 128 "${CA[@]}" --out "$d/one" --quiet >/dev/null
   local probes=(); IFS=';' read -ra pts <<<"$fused"; for p in "${pts[@]}"; do probes+=(--probe "$p"); done
   "$BIN" lab capture "$scene" --fusion "${probes[@]}" --size 128 "${CA[@]}" --out "$d/fused" --quiet >/dev/null
-  "$BIN" lab capture "$scene" --grid 6,6,6 --volume "$vol" --size 32 --out "$d/seq" --quiet >/dev/null
+  "$BIN" lab capture "$scene" --grid 6,6,6 --volume "$vol" --size 32 "${CA[@]}" --out "$d/seq" --quiet >/dev/null
   "$BIN" ilf build "$d/seq/sequence.json" --grid 6 --bands 5 --out "$d/grid.shgrid" --quiet >/dev/null
   row "$scene" "one probe" --probes "$d/one/probes.json" --layers "$d/layers"
   row "$scene" "fused probes" --probes "$d/fused/probes.json"

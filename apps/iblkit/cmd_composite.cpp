@@ -29,7 +29,7 @@ struct Opts {
   ibl::augment::CompositeDesc desc;
 };
 
-void write_png_and_exr(const fs::path& dir, const std::string& name, const ibl::Image& img) {
+void write_layer(const fs::path& dir, const std::string& name, const ibl::Image& img) {
   ibl::io::write_image((dir / (name + ".exr")).string(), img);
 }
 
@@ -86,11 +86,11 @@ void run(const Opts& o, const ibl::io::EnvReadDesc& read) {
   if (!o.layers.empty()) {
     fs::create_directories(o.layers);
     fs::path dir(o.layers);
-    write_png_and_exr(dir, "mask", r.mask);
-    write_png_and_exr(dir, "difference", r.difference);
-    write_png_and_exr(dir, "albedo", r.albedo);
-    write_png_and_exr(dir, "render_with", r.render_with);
-    write_png_and_exr(dir, "render_without", r.render_without);
+    write_layer(dir, "mask", r.mask);
+    write_layer(dir, "difference", r.difference);
+    write_layer(dir, "albedo", r.albedo);
+    write_layer(dir, "render_with", r.render_with);
+    write_layer(dir, "render_without", r.render_without);
   }
   const auto& s = r.stats;
   nlohmann::json j = {{"out", o.out},

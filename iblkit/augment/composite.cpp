@@ -255,8 +255,8 @@ CompositeResult composite(const Image& photo, const geometry::Camera& cam, const
       }
       const Vec3 ph = photo.rgb(x, y);
       Vec3 comp = ph, without, with, rho;
+      if (have_proxy) ++proxy_px;
       if (have_proxy && desc.shadows) {
-        ++proxy_px;
         Vec3 nn = proxy.normal(proxy_tri);
         if (dot(nn, proxy_dir) > 0) nn = -nn;
         Vec3 yp = cam.eye + proxy_dir * proxy_t + nn * kRayEpsilon;
