@@ -1,5 +1,6 @@
-// iblkit lab capture SCENE …  and  iblkit lab truth SCENE --at x,y,z …: synthetic probes, probe
-// sequences and fusion probe sets of analytic scenes, and their exact ground truth (docs/lab.md).
+// iblkit lab capture SCENE …, iblkit lab truth SCENE --at x,y,z … and iblkit lab photograph SCENE …:
+// synthetic probes, probe sequences and fusion probe sets of analytic scenes, their exact ground truth,
+// and pinhole photographs with or without an inserted object (docs/lab.md).
 #ifdef IBLKIT_HAVE_GEOMETRY
 #include <chrono>
 #include <filesystem>
@@ -13,10 +14,13 @@
 #include "iblkit/core/json_file.h"
 #include "iblkit/io/image_io.h"
 #include "iblkit/io/tonemap.h"
+#include "iblkit/augment/camera_io.h"
+#include "iblkit/augment/object.h"
 #include "iblkit/lab/capture.h"
 #include "iblkit/lab/scene_io.h"
 #include "iblkit/lab/sequence.h"
 #include "iblkit/lab/truth.h"
+#include "iblkit/lab/view.h"
 #include "iblkit/sh/coeffs.h"
 
 namespace {
@@ -158,6 +162,75 @@ void run_truth(const TruthOpts& o) {
   });
 }
 
+
+struct PhotoOpts {
+  std::string scene, out, eye = "0,1.2,2.4", target = "0,0.6,0", up = "0,1,0", camera, object, at = "0,0.3,0", albedo = "0.7,0.7,0.7",
+              mask;
+  double fov = 40, object_size = 0.3;
+  int width = 640, height = 480, samples = 4, bounces = 1, area_samples = 0, env_samples = 0, triangles = 20000;
+  uint64_t seed = 1;
+};
+
+void run_photograph(const PhotoOpts& o) {
+  ibl::lab::Scene scene = ibl::lab::load_scene(o.scene, false);
+  ibl::geometry::Camera cam;
+  if (!o.camera.empty()) {
+    cam = ibl::augment::read_camera(o.camera);
+  } else {
+    cam.eye = iblcli::parse_vec3(o.eye, "--eye");
+    cam.target = iblcli::parse_vec3(o.target, "--target");
+    cam.up = iblcli::parse_vec3(o.up, "--up");
+    cam.fov_y_deg = o.fov;
+  }
+  if (o.camera.empty() || cam.width == 0) cam.width = o.width;
+  if (o.camera.empty() || cam.height == 0) cam.height = o.height;
+  ibl::augment::validate_camera(cam, o.camera.empty() ? "the camera" : o.camera);
+  int object = -1;
+  if (!o.object.empty()) {
+    ibl::augment::ObjectDesc od;
+    od.kind = o.object;
+    od.size = o.object_size;
+    od.triangles = o.triangles;
+    od.at = iblcli::parse_vec3(o.at, "--at");
+    od.albedo = iblcli::parse_vec3(o.albedo, "--albedo");
+    object = ibl::lab::add_object(scene, "object", ibl::augment::make_object(od), od.albedo);
+  }
+  scene.build();
+  ibl::lab::ViewDesc vd;
+  vd.width = cam.width;
+  vd.height = cam.height;
+  vd.samples = o.samples;
+  vd.render = scene.render;
+  vd.render.bounces = o.bounces;
+  if (o.area_samples > 0) vd.render.area_samples = o.area_samples;
+  if (o.env_samples > 0) vd.render.env_samples = o.env_samples;
+  vd.render.seed = o.seed;
+  auto t0 = std::chrono::steady_clock::now();
+  ibl::lab::View v = ibl::lab::photograph(
+      scene, [&](double px, double py, Vec3* org, Vec3* dir) { *org = cam.eye; *dir = cam.ray_direction(px, py); }, vd, iblcli::progress_bar());
+  iblcli::progress_done();
+  double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  ibl::io::write_image(o.out, v.radiance);
+  int64_t object_pixels = 0;
+  if (!o.mask.empty()) {
+    ibl::Image m(cam.width, cam.height, 1);
+    for (int y = 0; y < cam.height; ++y)
+      for (int x = 0; x < cam.width; ++x)
+        if (object >= 0 && static_cast<int>(v.surface.at(x, y, 0)) == object) m.at(x, y, 0) = 1;
+    ibl::io::write_image(o.mask, m);
+  }
+  for (int y = 0; y < cam.height; ++y)
+    for (int x = 0; x < cam.width; ++x) object_pixels += object >= 0 && static_cast<int>(v.surface.at(x, y, 0)) == object;
+  nlohmann::json j = {{"scene", scene.name}, {"out", o.out}, {"width", cam.width}, {"height", cam.height}, {"seconds", secs},
+                      {"bounces", vd.render.bounces}, {"object_pixels", object_pixels}, {"camera", ibl::augment::camera_to_json(cam)}};
+  if (!o.mask.empty()) j["mask"] = o.mask;
+  iblcli::emit(j, [&] {
+    fmt::print("photographed {} ({}x{}, {}x{} rays per pixel, {} bounce{}) in {:.2f} s: {}\n", scene.name, cam.width, cam.height, o.samples,
+               o.samples, vd.render.bounces, vd.render.bounces == 1 ? "" : "s", secs, o.out);
+    if (object >= 0) fmt::print("  the object covers {} pixel centres{}\n", object_pixels, o.mask.empty() ? "" : "; mask: " + o.mask);
+  });
+}
+
 void setup(CLI::App& app) {
   app.require_subcommand(1);
   auto* c = app.add_subcommand("capture", "Capture a probe, a probe sequence (iblkit.sequence/1) or a fusion probe set (iblkit.probes/1)");
@@ -212,6 +285,35 @@ void setup(CLI::App& app) {
   t->add_option("-o,--out", to->out, "folder for radiance.exr/.png, sh.json, truth.json");
   t->footer("Example:\n  iblkit lab truth low-scene1 --at 0,1,0 --size 256 --out truth");
   t->callback([to] { run_truth(*to); });
+
+  auto* ph = app.add_subcommand("photograph", "A pinhole photograph of a scene, optionally with an object in it (path traced; the truth of a composite)");
+  auto* po = new PhotoOpts();
+  ph->add_option("scene", po->scene, "scene file or built-in name")->required();
+  ph->add_option("--eye", po->eye, "camera position x,y,z")->capture_default_str();
+  ph->add_option("--target", po->target, "the point seen at the frame's centre")->capture_default_str();
+  ph->add_option("--up", po->up, "world direction that appears upwards")->capture_default_str();
+  ph->add_option("--fov", po->fov, "vertical field of view, degrees")->capture_default_str();
+  ph->add_option("--camera", po->camera, "an iblkit.camera/1 file instead of --eye/--target/--up/--fov (its size, if any, too)");
+  ph->add_option("--width", po->width, "frame width, pixels")->check(CLI::Range(1, 16384))->capture_default_str();
+  ph->add_option("--height", po->height, "frame height, pixels")->check(CLI::Range(1, 16384))->capture_default_str();
+  ph->add_option("--samples", po->samples, "n×n rays per pixel")->check(CLI::Range(1, 64))->capture_default_str();
+  ph->add_option("--bounces", po->bounces,
+                 "indirect bounces (a probe captured with B bounces sees the light a photograph with B + 1 reflects)")
+      ->check(CLI::Range(0, 16))->capture_default_str();
+  ph->add_option("--area-samples", po->area_samples, "shadow rays per area light per hit (default: the scene's)");
+  ph->add_option("--env-samples", po->env_samples, "shadow rays towards the environment per hit (default: the scene's)");
+  ph->add_option("--seed", po->seed, "random seed")->capture_default_str();
+  ph->add_option("--object", po->object, "insert an object: blob, sphere, or a mesh file (OBJ, PLY, glTF)");
+  ph->add_option("--at", po->at, "where the object's centre goes")->capture_default_str();
+  ph->add_option("--object-size", po->object_size, "the object's largest extent, metres (0 keeps a mesh file's size and place)")
+      ->capture_default_str();
+  ph->add_option("--albedo", po->albedo, "the object's Lambertian albedo r,g,b")->capture_default_str();
+  ph->add_option("--triangles", po->triangles, "triangles of the blob")->check(CLI::Range(100, 5000000))->capture_default_str();
+  ph->add_option("--mask", po->mask, "also write the object's mask (1 where a pixel centre sees it)");
+  ph->add_option("-o,--out", po->out, "output image (.exr)")->required();
+  ph->footer("Example:\n  iblkit lab photograph low-scene2 --eye 0,1.2,2.4 --target 0,0.3,0 --fov 40 --object blob --at 0,0.15,0 "
+             "--object-size 0.3 --out truth.exr");
+  ph->callback([po] { run_photograph(*po); });
 }
 
 iblcli::Command reg("lab", "Analytic lighting scenes: synthetic captures and exact ground truth", setup, 60);

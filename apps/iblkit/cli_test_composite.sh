@@ -1,0 +1,46 @@
+#!/usr/bin/env bash
+# End-to-end checks of `iblkit lab photograph` and `iblkit composite` (CTest cli_composite): a tiny
+# low-scene2 photograph with and without the blob, a one-probe fusion set, the composite measured
+# against the truth, the layers, a camera file, and bad input failing with one short line.
+set -u
+source "$(dirname "$0")/cli_check.sh" "$1"
+
+if ! "$BIN" --help | grep -q "^  composite"; then echo "no composite subcommand in this build: skipped"; exit 0; fi
+
+CAM=(--eye 0,1.3,2.2 --target 0,0.3,0 --fov 40)
+OBJ=(--object blob --at 0,0.2,0 --object-size 0.3 --triangles 2000)
+check photo ok "photographed low-scene2" -- "$BIN" lab photograph low-scene2 "${CAM[@]}" --width 48 --height 36 --samples 1 \
+  --out "$T/photo.exr"
+check truth ok "the object covers" -- "$BIN" lab photograph low-scene2 "${CAM[@]}" --width 48 --height 36 --samples 1 "${OBJ[@]}" \
+  --mask "$T/mask.exr" --out "$T/truth.exr"
+"$BIN" lab capture low-scene2 --fusion --probe 0,0.5,0 --size 16 --out "$T/fus" --quiet >/dev/null 2>&1
+check composite ok "against .*object .* shadow .* unchanged" -- "$BIN" composite "$T/photo.exr" "${CAM[@]}" --probes "$T/fus/probes.json" \
+  "${OBJ[@]}" --samples 16 --object-samples 32 --out "$T/comp.exr" --layers "$T/layers" --truth "$T/truth.exr"
+for f in mask difference albedo render_with render_without; do
+  if [ -f "$T/layers/$f.exr" ]; then pass=$((pass+1)); else echo "FAIL layers: no $f.exr"; fail=$((fail+1)); fi
+done
+check json ok '"object_pixels"' -- "$BIN" composite "$T/photo.exr" "${CAM[@]}" --probes "$T/fus/probes.json" "${OBJ[@]}" --samples 4 \
+  --object-samples 4 --out "$T/comp.png" --json
+
+# A camera file: the same frame; one of another size is refused.
+echo '{"format":"iblkit.camera/1","eye":[0,1.3,2.2],"target":[0,0.3,0],"up":[0,1,0],"fov_y_deg":40}' >"$T/cam.json"
+check camera-file ok "composited" -- "$BIN" composite "$T/photo.exr" --camera "$T/cam.json" --probes "$T/fus/probes.json" "${OBJ[@]}" \
+  --samples 4 --object-samples 4 --out "$T/c2.exr"
+echo '{"format":"iblkit.camera/1","eye":[0,1.3,2.2],"target":[0,0.3,0],"fov_y_deg":40,"width":640,"height":480}' >"$T/cam640.json"
+check camera-size fail "is 640x480 but the photograph" -- "$BIN" composite "$T/photo.exr" --camera "$T/cam640.json" \
+  --probes "$T/fus/probes.json" "${OBJ[@]}" --out "$T/c3.exr"
+
+# Bad input.
+check object-in-floor fail "the object intersects the proxy" -- "$BIN" composite "$T/photo.exr" "${CAM[@]}" --probes "$T/fus/probes.json" \
+  --object blob --at 0,0.05,0 --object-size 0.3 --triangles 2000 --out "$T/c4.exr"
+check no-camera fail "give the photograph's camera" -- "$BIN" composite "$T/photo.exr" --probes "$T/fus/probes.json" --out "$T/c5.exr"
+check no-light fail "give the light" -- "$BIN" composite "$T/photo.exr" "${CAM[@]}" "${OBJ[@]}" --out "$T/c6.exr"
+check probe-no-position fail "needs its position" -- "$BIN" composite "$T/photo.exr" "${CAM[@]}" "${OBJ[@]}" --light "$T/fus/probes/p0.exr" \
+  --proxy "$T/fus/proxy.obj" --out "$T/c7.exr"
+check probe-outside-warns ok "lies outside the proxy" -- "$BIN" composite "$T/photo.exr" "${CAM[@]}" "${OBJ[@]}" --light "$T/fus/probes/p0.exr" \
+  --at-probe 0,5,0 --proxy "$T/fus/proxy.obj" --samples 4 --object-samples 4 --out "$T/c8.exr"
+check gl-backend fail "only the CPU reference" -- "$BIN" composite "$T/photo.exr" "${CAM[@]}" --probes "$T/fus/probes.json" --backend gl \
+  --out "$T/c9.exr"
+
+echo "$pass passed, $fail failed, $skip skipped"
+[ $fail -eq 0 ]

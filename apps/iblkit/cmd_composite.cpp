@@ -1,0 +1,169 @@
+// iblkit composite PHOTO …: a virtual object inserted into a photograph with its shading, occlusion,
+// shadows and interreflection (differential rendering, augment/composite.h; docs/augment.md).
+#ifdef IBLKIT_HAVE_GEOMETRY
+#include <filesystem>
+
+#include <fmt/format.h>
+
+#include "cli.h"
+#include "iblkit/augment/camera_io.h"
+#include "iblkit/augment/composite.h"
+#include "iblkit/augment/load.h"
+#include "iblkit/augment/measure.h"
+#include "iblkit/augment/object.h"
+#include "iblkit/core/error.h"
+#include "iblkit/io/image_io.h"
+#include "iblkit/io/tonemap.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using ibl::Vec3;
+
+struct Opts {
+  std::string photo, eye, target, up = "0,1,0", camera, probes, proxy, at_probe, probe_depth, object = "blob", at = "0,0.15,0",
+                                   albedo = "0.7,0.7,0.7", out = "composite.exr", layers, backend = "cpu", truth;
+  std::vector<std::string> light;
+  double fov = 40, object_size = 0.3;
+  int triangles = 20000, median_cut = 0;
+  ibl::augment::CompositeDesc desc;
+};
+
+void write_layer(const fs::path& dir, const std::string& name, const ibl::Image& img) {
+  ibl::io::write_image((dir / (name + ".exr")).string(), img);
+}
+
+void run(const Opts& o, const ibl::io::EnvReadDesc& read) {
+  if (o.backend != "cpu" && o.backend != "auto")
+    ibl::fail(ibl::ErrorKind::Value, "--backend {}: only the CPU reference (cpu) composites for now", o.backend);
+  if (o.light.size() > 1) ibl::fail(ibl::ErrorKind::Value, "--light: give one light file");
+  ibl::Image photo = ibl::io::read_image(o.photo);
+  ibl::geometry::Camera cam;
+  if (!o.camera.empty()) {
+    if (!o.eye.empty() || !o.target.empty()) ibl::fail(ibl::ErrorKind::Value, "give either --camera or --eye/--target, not both");
+    cam = ibl::augment::read_camera(o.camera);
+    if ((cam.width != 0 && cam.width != photo.width()) || (cam.height != 0 && cam.height != photo.height()))
+      ibl::fail(ibl::ErrorKind::Value, "{} is {}x{} but the photograph {} is {}x{}", o.camera, cam.width, cam.height, o.photo,
+                photo.width(), photo.height());
+  } else {
+    if (o.eye.empty() || o.target.empty()) ibl::fail(ibl::ErrorKind::Value, "give the photograph's camera: --eye and --target (and --fov), or --camera");
+    cam.eye = iblcli::parse_vec3(o.eye, "--eye");
+    cam.target = iblcli::parse_vec3(o.target, "--target");
+    cam.up = iblcli::parse_vec3(o.up, "--up");
+    cam.fov_y_deg = o.fov;
+  }
+  cam.width = photo.width();
+  cam.height = photo.height();
+  ibl::augment::validate_camera(cam, o.camera.empty() ? "the camera" : o.camera);
+  ibl::augment::ObjectDesc od;
+  od.kind = o.object;
+  od.size = o.object_size;
+  od.triangles = o.triangles;
+  od.at = iblcli::parse_vec3(o.at, "--at");
+  od.albedo = iblcli::parse_vec3(o.albedo, "--albedo");
+  ibl::geometry::TriMesh object = ibl::augment::make_object(od);
+  Vec3 lo, hi;
+  object.bounds(&lo, &hi);
+  ibl::augment::LightInput li;
+  li.probes = o.probes;
+  if (!o.light.empty()) li.light = o.light[0];
+  li.proxy = o.proxy;
+  if (!o.at_probe.empty()) li.at_probe = iblcli::parse_vec3(o.at_probe, "--at-probe");
+  li.probe_depth = o.probe_depth;
+  li.read = read;
+  ibl::augment::LoadedLight L = ibl::augment::load_light(li, lo, hi);
+  for (const auto& w : L.warnings) iblcli::info("warning: " + w);
+  if (o.median_cut > 0) L.light = ibl::augment::as_median_cut(L.light, o.median_cut);
+  ibl::augment::CompositeDesc d = o.desc;
+  d.progress = iblcli::progress_bar();
+  auto r = ibl::augment::composite(photo, cam, L.proxy, L.light, object, od.albedo, d);
+  iblcli::progress_done();
+  for (const auto& w : r.warnings) iblcli::info("warning: " + w);
+  if (fs::path(o.out).extension() == ".png")
+    ibl::io::write_image(o.out, ibl::io::tonemap(r.composite));
+  else
+    ibl::io::write_image(o.out, r.composite);
+  if (!o.layers.empty()) {
+    fs::create_directories(o.layers);
+    fs::path dir(o.layers);
+    write_layer(dir, "mask", r.mask);
+    write_layer(dir, "difference", r.difference);
+    write_layer(dir, "albedo", r.albedo);
+    write_layer(dir, "render_with", r.render_with);
+    write_layer(dir, "render_without", r.render_without);
+  }
+  const auto& s = r.stats;
+  nlohmann::json j = {{"out", o.out},
+                      {"light", L.light.source},
+                      {"seconds", s.seconds},
+                      {"proxy_pixels", s.proxy_pixels},
+                      {"object_pixels", s.object_pixels},
+                      {"changed_pixels", s.changed_pixels},
+                      {"albedo_over_one", s.albedo_over_one},
+                      {"unlit_pixels", s.unlit},
+                      {"warnings", r.warnings}};
+  if (!o.layers.empty()) j["layers"] = o.layers;
+  ibl::augment::CompositeErrors e;
+  if (!o.truth.empty()) {
+    e = ibl::augment::measure(photo, r.composite, ibl::io::read_image(o.truth), r.mask);
+    j["errors"] = {{"object", e.object},          {"shadow", e.shadow},       {"unchanged", e.unchanged},
+                   {"object_pixels", e.object_pixels}, {"shadow_pixels", e.shadow_pixels}, {"unchanged_pixels", e.unchanged_pixels},
+                   {"brightened_pixels", e.brightened_pixels}, {"shadow_signal", e.shadow_signal}};
+  }
+  iblcli::emit(j, [&] {
+    fmt::print("composited the object into {} ({}x{}, light: {}) in {:.2f} s: {}\n", o.photo, cam.width, cam.height, L.light.source,
+               s.seconds, o.out);
+    fmt::print("  {} object pixels, {} proxy pixels changed by its shadow and light\n", s.object_pixels, s.changed_pixels);
+    if (!o.layers.empty()) fmt::print("  layers: {}/mask, difference, albedo, render_with, render_without (.exr)\n", o.layers);
+    if (!o.truth.empty())
+      fmt::print("  against {}: object {:.1f} % ({} px), shadow {:.1f} % of the shadow signal ({} px, {:.0f} % darker), unchanged {:.2f} % ({} px)\n",
+                 o.truth, 100 * e.object, e.object_pixels, 100 * e.shadow, e.shadow_pixels, 100 * e.shadow_signal, 100 * e.unchanged,
+                 e.unchanged_pixels);
+  });
+}
+
+void setup(CLI::App& app) {
+  auto* o = new Opts();
+  app.add_option("photo", o->photo, "the background photograph (HDR, linear; any format OpenImageIO reads)")->required();
+  app.add_option("--eye", o->eye, "the photograph's camera position x,y,z");
+  app.add_option("--target", o->target, "the point at the frame's centre");
+  app.add_option("--up", o->up, "world direction that appears upwards")->capture_default_str();
+  app.add_option("--fov", o->fov, "vertical field of view, degrees")->capture_default_str();
+  app.add_option("--camera", o->camera, "an iblkit.camera/1 file instead of --eye/--target/--up/--fov");
+  app.add_option("--probes", o->probes, "an iblkit.probes/1 set with its proxy (one probe: Debevec 1998; several: fused at the object)");
+  app.add_option("--light", o->light, "an SH grid (.shgrid) or a probe image (with --at-probe), with --proxy");
+  app.add_option("--proxy", o->proxy, "the local scene's mesh (OBJ, PLY, glTF): receives shadows, occludes the object");
+  app.add_option("--at-probe", o->at_probe, "where the --light probe was captured, x,y,z");
+  app.add_option("--probe-depth", o->probe_depth, "the --light probe's depth map (metres; lights in front of the proxy)");
+  auto& rd = iblcli::add_probe_read_options(app);
+  app.add_option("--object", o->object, "blob, sphere, or a mesh file")->capture_default_str();
+  app.add_option("--at", o->at, "where the object's centre goes")->capture_default_str();
+  app.add_option("--object-size", o->object_size, "largest extent, metres (0 keeps a mesh file's own size and place)")->capture_default_str();
+  app.add_option("--albedo", o->albedo, "the object's Lambertian albedo r,g,b")->capture_default_str();
+  app.add_option("--triangles", o->triangles, "triangles of the blob")->check(CLI::Range(100, 5000000))->capture_default_str();
+  app.add_option("--samples", o->desc.light_samples, "light samples per proxy pixel (albedo and shadows)")->check(CLI::Range(1, 65536))
+      ->capture_default_str();
+  app.add_option("--object-samples", o->desc.object_samples, "light samples per object pixel")->check(CLI::Range(1, 65536))->capture_default_str();
+  app.add_option("--bounce-samples", o->desc.bounce_samples, "samples of the object's light per proxy pixel (0: no interreflection)")
+      ->check(CLI::Range(0, 65536))->capture_default_str();
+  app.add_option("--pixel-samples", o->desc.pixel_samples, "n×n camera rays per pixel (object edges)")->check(CLI::Range(1, 8))->capture_default_str();
+  app.add_option("--seed", o->desc.seed, "random seed")->capture_default_str();
+  app.add_option("--median-cut", o->median_cut, "baseline: the light cut into N median-cut lights (shadows and shading from those only)")
+      ->check(CLI::Range(1, 4096));
+  app.add_flag("--no-shadows", [o](int64_t) { o->desc.shadows = false; }, "baseline: the object pasted without its shadow and light on the scene");
+  app.add_option("--backend", o->backend, "cpu (the ray-traced reference; auto means cpu for now)")->capture_default_str();
+  app.add_option("-o,--out", o->out, "the composite (.exr linear, .png tone mapped)")->capture_default_str();
+  app.add_option("--layers", o->layers, "folder for mask, difference, albedo, render_with, render_without (.exr)");
+  app.add_option("--truth", o->truth, "a photograph with the object really there (iblkit lab photograph): print the errors");
+  app.footer(
+      "Examples:\n  iblkit composite photo.exr --eye 0,1.2,2.4 --target 0,0.3,0 --fov 40 --probes fusion/probes.json --object blob "
+      "--at 0,0.15,0 --out comp.exr --layers layers\n"
+      "  iblkit composite photo.exr --camera cam.json --light grid.shgrid --proxy room.obj --object sphere --at 0,0.2,0\n"
+      "  iblkit composite photo.exr --camera cam.json --light probe.exr --at-probe 0,0.5,0 --proxy floor.obj");
+  app.callback([o, &rd] { run(*o, rd); });
+}
+
+iblcli::Command reg("composite", "Composite a virtual object into a photograph with its shadows (differential rendering)", setup, 85);
+
+}  // namespace
+#endif  // IBLKIT_HAVE_GEOMETRY

@@ -1,0 +1,214 @@
+// augment/ against closed forms on a tiny scene: a 4 m floor seen from straight above (64×48 pixels),
+// lit by a constant sky (the white furnace: E = π L on the floor, L_obj = ρ L on an object) or a sun.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+
+#include "iblkit/augment/camera_io.h"
+#include "iblkit/augment/composite.h"
+#include "iblkit/augment/measure.h"
+#include "iblkit/augment/object.h"
+#include "iblkit/core/error.h"
+
+namespace ibl::augment {
+namespace {
+
+constexpr int kW = 64, kH = 48;
+constexpr double kFloorAlbedo = 0.5;
+
+geometry::Camera top_camera() {
+  geometry::Camera c;
+  c.eye = {0, 3, 0};
+  c.target = {0, 0, 0};
+  c.up = {0, 0, -1};  // image up is −Z, image right is +X
+  c.fov_y_deg = 60;
+  c.width = kW;
+  c.height = kH;
+  return c;
+}
+
+// The pixel that sees floor point (x, 0, z) from top_camera().
+std::pair<int, int> pixel_of(double x, double z) {
+  geometry::Camera c = top_camera();
+  double t = std::tan(c.fov_y_deg * kPi / 360.0), aspect = static_cast<double>(kW) / kH;
+  double px = (x / 3 / (t * aspect) + 1) * kW / 2, py = (1 - (-z / 3) / t) * kH / 2;
+  return {static_cast<int>(px), static_cast<int>(py)};
+}
+
+geometry::TriMesh floor_mesh() { return geometry::make_quad({0, 0, 0}, {0, 1, 0}, {0, 0, -1}, 6, 6); }
+
+LocalLight constant_sky(Vec3 L, Vec3 centre) {
+  LocalLight l;
+  Image img(64, 32, 3);
+  for (int y = 0; y < 32; ++y)
+    for (int x = 0; x < 64; ++x) img.set_rgb(x, y, L);
+  l.map = sphere::EnvMap(img, sphere::Mapping(sphere::MappingKind::LatLong, 64, 32));
+  l.centre = centre;
+  l.source = "test sky";
+  return l;
+}
+
+Image constant_photo(double v) {
+  Image p(kW, kH, 3);
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x) p.set_rgb(x, y, {v, v, v});
+  return p;
+}
+
+geometry::TriMesh sphere_at(Vec3 c, double size) {
+  ObjectDesc d;
+  d.kind = "sphere";
+  d.size = size;
+  d.at = c;
+  return make_object(d);
+}
+
+TEST(AugmentComposite, WhiteFurnaceFloorGivesItsAlbedoAndAHiddenObjectChangesNothing) {
+  // Photo: ρ L on a floor under a constant sky L = 1. The object sits below the floor: no ray meets it.
+  Image photo = constant_photo(kFloorAlbedo);
+  auto r = composite(photo, top_camera(), floor_mesh(), constant_sky({1, 1, 1}, {0, 0.5, 0}), sphere_at({0, -1, 0}, 0.4), {0.7, 0.7, 0.7});
+  constexpr double kMeanAlbedoTol = 0.01;  // 64 stratified patch samples per pixel, averaged over 3072 pixels
+  double sum = 0;
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x) {
+      sum += r.albedo.rgb(x, y).y;
+      ASSERT_EQ(r.composite.rgb(x, y).y, photo.rgb(x, y).y);  // exactly the photograph
+      ASSERT_EQ(r.difference.rgb(x, y).y, 0.0);
+      ASSERT_NEAR(r.render_without.rgb(x, y).y, photo.rgb(x, y).y, 1e-6);
+    }
+  EXPECT_NEAR(sum / (kW * kH), kFloorAlbedo, kMeanAlbedoTol);
+  EXPECT_EQ(r.stats.changed_pixels, 0);
+  EXPECT_EQ(r.stats.object_pixels, 0);
+  EXPECT_EQ(r.stats.proxy_pixels, kW * kH);
+}
+
+TEST(AugmentComposite, DifferenceIsExactlyZeroWhereAWallHidesTheObject) {
+  geometry::TriMesh proxy = floor_mesh();
+  proxy.append(geometry::make_quad({0.3, 1.5, 0}, {-1, 0, 0}, {0, 1, 0}, 6, 3));  // a wall at x = 0.3
+  Image photo = constant_photo(kFloorAlbedo);
+  geometry::Camera cam = top_camera();  // above the far side of the wall, so that it sees the floor there
+  cam.eye.x = cam.target.x = 1.2;
+  auto r = composite(photo, cam, proxy, constant_sky({1, 1, 1}, {-0.5, 0.5, 0}), sphere_at({-0.5, 0.25, 0}, 0.4), {0.7, 0.7, 0.7});
+  int changed_left = 0;
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x) {
+      Vec3 d = cam.pixel_direction(x, y);
+      double fx = cam.eye.x + 3 * d.x / -d.y;  // floor x seen at the pixel (or behind the wall)
+      if (fx > 0.35) {
+        ASSERT_EQ(r.difference.rgb(x, y).y, 0.0) << x << "," << y;
+      }
+      if (fx < 0.3 && r.difference.rgb(x, y).y != 0) ++changed_left;
+    }
+  EXPECT_EQ(changed_left, 0);  // the wall's back, seen from this side, does not see the object either
+  auto r2 = composite(photo, top_camera(), proxy, constant_sky({1, 1, 1}, {-0.5, 0.5, 0}), sphere_at({-0.5, 0.25, 0}, 0.4), {0.7, 0.7, 0.7});
+  EXPECT_GT(r2.stats.changed_pixels, 0);  // from above the object: its floor and the wall's front do change
+}
+
+TEST(AugmentComposite, SunCastsAFullShadowAndLeavesTheSunlitFloorAlone) {
+  LocalLight sun;
+  Image img(64, 32, 3);
+  img.set_rgb(20, 8, {5000, 5000, 5000});  // one texel ≈ 48° from the zenith
+  sun.map = sphere::EnvMap(img, sphere::Mapping(sphere::MappingKind::LatLong, 64, 32));
+  sun.centre = {0, 0.5, 0};
+  Vec3 d;
+  sun.map.mapping.to_direction(20.5, 8.5, &d);
+  const Vec3 c{0, 0.5, 0};
+  Vec3 umbra = c - d * (c.y / d.y);
+  CompositeDesc desc;
+  desc.bounce_samples = 0;
+  Image photo = constant_photo(kFloorAlbedo);
+  auto r = composite(photo, top_camera(), floor_mesh(), sun, sphere_at(c, 0.4), {0.7, 0.7, 0.7}, desc);
+  auto [ux, uy] = pixel_of(umbra.x, umbra.z);
+  ASSERT_EQ(r.mask.at(ux, uy, 0), 0.0f);  // the shadow is not hidden behind the object
+  constexpr double kUmbraTol = 1e-9;  // every sample is the sun's texel, blocked
+  EXPECT_NEAR(r.composite.rgb(ux, uy).y, 0.0, kUmbraTol);
+  auto [fx, fy] = pixel_of(-1.5, 1.2);  // far from the shadow, in the sun
+  EXPECT_EQ(r.composite.rgb(fx, fy).y, photo.rgb(fx, fy).y);
+}
+
+TEST(AugmentComposite, ObjectUnderTheWhiteFurnaceHasRadianceAlbedoTimesL) {
+  constexpr double kL = 2.0, kRho = 0.6;
+  Image photo = constant_photo(kFloorAlbedo * kL);
+  auto r = composite(photo, top_camera(), floor_mesh(), constant_sky({kL, kL, kL}, {0, 0.5, 0}), sphere_at({0, 0.5, 0}, 0.6),
+                     {kRho, kRho, kRho});
+  double sum = 0;
+  int n = 0;
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x)
+      if (r.mask.at(x, y, 0) >= 1) {
+        sum += r.composite.rgb(x, y).y;
+        ++n;
+      }
+  ASSERT_GT(n, 50);
+  constexpr double kObjectTol = 0.02;  // 256 samples per pixel; the floor patches are flat 1/0.05-clamped texels
+  EXPECT_NEAR(sum / n, kRho * kL, kObjectTol * kRho * kL);
+  EXPECT_GT(r.stats.changed_pixels, 0);  // it shadows and lights the floor around it
+}
+
+TEST(AugmentComposite, BadInputFailsWithAClearMessage) {
+  Image photo = constant_photo(kFloorAlbedo);
+  auto sky = constant_sky({1, 1, 1}, {0, 0.5, 0});
+  geometry::Camera cam = top_camera();
+  cam.width = 32;
+  try {
+    composite(photo, cam, floor_mesh(), sky, sphere_at({0, 0.5, 0}, 0.4), {0.5, 0.5, 0.5});
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("the photograph is 64x48 but the camera's frame is 32x48"), std::string::npos) << e.what();
+  }
+  try {
+    composite(photo, top_camera(), floor_mesh(), sky, sphere_at({0, 0.1, 0}, 0.4), {0.5, 0.5, 0.5});
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("the object intersects the proxy"), std::string::npos) << e.what();
+  }
+  try {  // the camera inside a closed box whose faces point outwards
+    composite(photo, top_camera(), geometry::make_box({-4, -1, -4}, {4, 5, 4}), sky, sphere_at({0, 0.5, 0}, 0.4), {0.5, 0.5, 0.5});
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("is inside the proxy"), std::string::npos) << e.what();
+  }
+}
+
+TEST(AugmentCamera, JsonRoundTripAndErrors) {
+  geometry::Camera c = top_camera();
+  geometry::Camera back = camera_from_json(camera_to_json(c), "test");
+  EXPECT_EQ(back.eye.y, 3);
+  EXPECT_EQ(back.up.z, -1);
+  EXPECT_EQ(back.fov_y_deg, 60);
+  EXPECT_EQ(back.width, kW);
+  EXPECT_EQ(back.height, kH);
+  auto path = (std::filesystem::temp_directory_path() / "augment_test_camera.json").string();
+  write_camera(path, c, false);
+  geometry::Camera r = read_camera(path);
+  EXPECT_EQ(r.width, 0);  // no size in the file: the photograph's
+  EXPECT_EQ(r.target.x, 0);
+  std::filesystem::remove(path);
+  nlohmann::json j = camera_to_json(c);
+  j["fov_y_deg"] = 190;
+  EXPECT_THROW(camera_from_json(j, "test"), Error);
+  j = camera_to_json(c);
+  j["format"] = "iblkit.sh/1";
+  EXPECT_THROW(camera_from_json(j, "test"), Error);
+  j = camera_to_json(c);
+  j["target"] = j["eye"];
+  EXPECT_THROW(camera_from_json(j, "test"), Error);
+}
+
+TEST(AugmentMeasure, PerfectCompositeHasNoErrorAndShadowErrorIsRelative) {
+  Image photo = constant_photo(1.0), truth = constant_photo(1.0), mask(kW, kH, 1);
+  for (int x = 0; x < 10; ++x) mask.at(x, 0, 0) = 1;
+  for (int x = 0; x < 10; ++x) truth.set_rgb(x, 5, {0.5, 0.5, 0.5});  // a shadow: half as bright
+  CompositeErrors e = measure(photo, truth, truth, mask);
+  EXPECT_EQ(e.object, 0);
+  EXPECT_EQ(e.shadow, 0);
+  EXPECT_EQ(e.unchanged, 0);
+  EXPECT_GE(e.shadow_pixels, 10);  // the row and, through the 3×3 classification, its neighbours
+  EXPECT_GT(e.shadow_signal, 0.1);
+  Image pasted = photo;  // no shadow at all: the whole signal is the error
+  EXPECT_NEAR(measure(photo, pasted, truth, mask).shadow, 1.0, 1e-12);
+}
+
+}  // namespace
+}  // namespace ibl::augment

@@ -1,0 +1,88 @@
+#include "iblkit/augment/camera_io.h"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "iblkit/core/error.h"
+#include "iblkit/core/json_file.h"
+
+namespace ibl::augment {
+
+namespace {
+
+constexpr double kMaxCoordinate = 1e6;  // metres: anything larger is a unit mistake
+
+Vec3 vec3_field(const nlohmann::json& j, const char* key, const std::string& what) {
+  if (!j.contains(key)) fail(ErrorKind::Format, "{}: \"{}\" is missing", what, key);
+  const auto& a = j[key];
+  if (!a.is_array() || a.size() != 3 || !a[0].is_number() || !a[1].is_number() || !a[2].is_number())
+    fail(ErrorKind::Format, "{}: \"{}\" must be [x, y, z]", what, key);
+  return {a[0].get<double>(), a[1].get<double>(), a[2].get<double>()};
+}
+
+bool finite_point(Vec3 p) {
+  for (int a = 0; a < 3; ++a)
+    if (!std::isfinite(p[a]) || std::abs(p[a]) > kMaxCoordinate) return false;
+  return true;
+}
+
+}  // namespace
+
+void validate_camera(const geometry::Camera& c, const std::string& what) {
+  if (!finite_point(c.eye)) fail(ErrorKind::Value, "{}: eye ({}, {}, {}) is not a finite point within 1e6 m", what, c.eye.x, c.eye.y, c.eye.z);
+  if (!finite_point(c.target))
+    fail(ErrorKind::Value, "{}: target ({}, {}, {}) is not a finite point within 1e6 m", what, c.target.x, c.target.y, c.target.z);
+  if (!finite_point(c.up) || length(c.up) == 0) fail(ErrorKind::Value, "{}: up ({}, {}, {}) has no direction", what, c.up.x, c.up.y, c.up.z);
+  Vec3 f = c.target - c.eye;
+  if (length(f) == 0) fail(ErrorKind::Value, "{}: eye and target are the same point", what);
+  if (length(cross(normalize(f), normalize(c.up))) < 1e-6) fail(ErrorKind::Value, "{}: up is parallel to the view direction", what);
+  if (!(c.fov_y_deg > 0 && c.fov_y_deg < 179)) fail(ErrorKind::Value, "{}: fov_y_deg {} must lie in (0, 179)", what, c.fov_y_deg);
+  if (c.width < 1 || c.height < 1 || c.width > 16384 || c.height > 16384)
+    fail(ErrorKind::Value, "{}: frame size {}x{} must lie in 1..16384", what, c.width, c.height);
+}
+
+nlohmann::json camera_to_json(const geometry::Camera& c, bool with_size) {
+  auto v = [](Vec3 p) { return nlohmann::json::array({p.x, p.y, p.z}); };
+  nlohmann::json j = {{"format", "iblkit.camera/1"}, {"eye", v(c.eye)}, {"target", v(c.target)}, {"up", v(c.up)}, {"fov_y_deg", c.fov_y_deg}};
+  if (with_size) {
+    j["width"] = c.width;
+    j["height"] = c.height;
+  }
+  return j;
+}
+
+geometry::Camera camera_from_json(const nlohmann::json& j, const std::string& what) {
+  require_format(j, what, "iblkit.camera/1");
+  geometry::Camera c;
+  c.eye = vec3_field(j, "eye", what);
+  c.target = vec3_field(j, "target", what);
+  c.up = j.contains("up") ? vec3_field(j, "up", what) : Vec3{0, 1, 0};
+  if (!j.contains("fov_y_deg") || !j["fov_y_deg"].is_number()) fail(ErrorKind::Format, "{}: \"fov_y_deg\" (a number) is missing", what);
+  c.fov_y_deg = j["fov_y_deg"].get<double>();
+  c.width = c.height = 0;
+  for (const char* key : {"width", "height"})
+    if (j.contains(key) && !j[key].is_number_integer()) fail(ErrorKind::Format, "{}: \"{}\" must be an integer", what, key);
+  if (j.contains("width")) c.width = j["width"].get<int>();
+  if (j.contains("height")) c.height = j["height"].get<int>();
+  geometry::Camera check = c;
+  if (check.width == 0) check.width = 1;
+  if (check.height == 0) check.height = 1;
+  validate_camera(check, what);
+  return c;
+}
+
+geometry::Camera read_camera(const std::string& path) { return camera_from_json(read_json_file(path), path); }
+
+void write_camera(const std::string& path, const geometry::Camera& cam, bool with_size) {
+  std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp);
+    if (!out) fail(ErrorKind::Io, "{}: cannot write", path);
+    out << camera_to_json(cam, with_size).dump(1) << "\n";
+    if (!out) fail(ErrorKind::Io, "{}: write failed", path);
+  }
+  std::filesystem::rename(tmp, path);
+}
+
+}  // namespace ibl::augment

@@ -1,0 +1,79 @@
+// Differential rendering (Debevec, "Rendering synthetic objects into real scenes", SIGGRAPH 1998 [1]):
+// a virtual object inserted into a photograph with its shading, its occlusion by the local scene, its
+// shadows on it and its light reflected onto it. CPU reference, ray traced with Embree.
+//
+// For a photograph pixel that sees the proxy at y (normal n) and the light field of light.h:
+//
+//   E₀(y) = Σ_t L_t Ω_t(y) cos θ V_proxy(y, q_t)                 the light there without the object
+//   ρ(y)  = π · photo / E₀(y)                                    the proxy's Lambertian albedo [1, §5]
+//   ΔE(y) = − Σ_t L_t Ω_t(y) cos θ V_proxy [object blocks y→q_t]  its shadow, from every patch (sun and sky)
+//           + ∫_{ω hits the object} L_obj(z(ω)) cos θ dω          its light on y: one bounce object → proxy
+//   ┌────────────────────────────────────────────────────────────────┐
+//   │ composite = photo + min(ρ, 1)/π · ΔE   (= photo · (1 + ΔE/E₀))  │
+//   └────────────────────────────────────────────────────────────────┘
+// (ρ > 1 means the captured light misses some of the light the photograph shows; the change is then
+// limited to what a white surface would show.)
+//
+// Both sums are estimated with the same patch samples (power-and-solid-angle sampling, light.h); only
+// sample rays that meet the object add to ΔE, so a pixel from which no ray meets the object keeps the
+// photograph's value exactly. The bounce term samples the cone of the object's bounding sphere; the
+// object's radiance L_obj = ρ_obj/π · E_obj is computed once per triangle. Pixels that see the object
+// (camera ray's first hit: the depth test against the proxy) show its render, ρ_obj/π · E_obj(z), with E_obj
+// from all patches (so the proxy's light reaches it) occluded by the proxy and the object itself; edge
+// pixels mix object and composite by the share of n×n camera rays that hit the object.
+//
+//  [1] P. Debevec, "Rendering synthetic objects into real scenes: bridging traditional and image-based
+//      graphics with global illumination and high dynamic range photography", SIGGRAPH 1998.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "iblkit/augment/light.h"
+#include "iblkit/core/image.h"
+#include "iblkit/core/progress.h"
+#include "iblkit/geometry/camera.h"
+#include "iblkit/geometry/mesh.h"
+
+namespace ibl::augment {
+
+struct CompositeDesc {
+  int light_samples = 64;      // patch samples per proxy pixel (albedo and shadow)
+  int object_samples = 256;    // patch samples per object pixel (split over its camera rays)
+  int bounce_samples = 16;     // cone samples per proxy pixel for the object's light on it (0: no bounce)
+  int triangle_samples = 64;   // patch samples per object triangle (its radiance for the bounce)
+  int pixel_samples = 2;       // n: n×n camera rays per pixel (object coverage at its edges)
+  uint64_t seed = 1;           // random streams (same seed, same bytes)
+  bool check_geometry = true;  // camera inside the proxy, object intersecting it: errors
+  bool shadows = true;         // false: the object pasted without its shadow and light on the proxy (a baseline)
+  ProgressFn progress;         // stages "object", "composite" (by rows)
+};
+
+struct CompositeStats {
+  int64_t proxy_pixels = 0;    // pixels whose camera ray hits the proxy
+  int64_t object_pixels = 0;   // pixels some camera ray of which hits the object
+  int64_t changed_pixels = 0;  // proxy pixels with ΔE ≠ 0 (shadowed or lit by the object)
+  int64_t albedo_over_one = 0; // proxy pixels whose estimated albedo exceeds 1 in some channel
+  int64_t unlit = 0;           // proxy pixels with no captured light (albedo unknown; left as photographed)
+  double seconds = 0;          // wall time of composite()
+};
+
+struct CompositeResult {
+  Image composite;       // RGB, the photograph with the object
+  Image mask;            // 1 channel: the share of each pixel the object covers
+  Image difference;      // RGB: composite − photograph (shadow < 0, interreflection > 0)
+  Image albedo;          // RGB: estimated proxy albedo (0 off the proxy and where unlit)
+  Image render_without;  // RGB: ρ/π E₀ on the proxy (the photograph where the albedo holds)
+  Image render_with;     // RGB: ρ/π (E₀ + ΔE) on the proxy, the object's render over it
+  CompositeStats stats;
+  std::vector<std::string> warnings;  // e.g. albedo > 1, unlit pixels
+};
+
+// `photo` is the background (RGB, linear); cam's width and height must be its size; `proxy` the local
+// scene (open or closed; its triangles face the camera's side); `object` the virtual object (world space)
+// of Lambertian albedo `albedo`. Throws ibl::Error on sizes that disagree, the camera inside the proxy or
+// the object intersecting it.
+CompositeResult composite(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy,
+                          const LocalLight& light, const geometry::TriMesh& object, Vec3 albedo, const CompositeDesc& desc = {});
+
+}  // namespace ibl::augment

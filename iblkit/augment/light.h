@@ -1,0 +1,78 @@
+// The captured light of a local scene, as a composite uses it: a radiance map seen from one point (a
+// probe at its position, an SH grid or fused probes evaluated at the object) projected onto the proxy
+// (Debevec 1998, §4: the light-based model of the local scene). Every texel becomes a patch — the
+// proxy surface it sees (or a direction, where its ray leaves the proxy) with the texel's radiance —
+// so the light arriving at any point x of the local scene is a sum over patches:
+//
+//   E(x, n) = Σ_t L_t · Ω_t(x) · max(0, n·ω_t(x)) · V(x, q_t),     Ω_t(x) = A_t cos θ_q / |q_t − x|²
+//
+// A_t = Ω_t r_t² / cos θ_c, the patch's area (r_t its distance from the map's centre c, θ_c the angle its
+// normal makes with the way back to c), so that Ω_t(c) = Ω_t; a distant patch keeps Ω_t for every x.
+// Estimates sample patches in proportion to a mix of their power and their solid angle (seen from c).
+#pragma once
+#include <string>
+#include <vector>
+
+#include "iblkit/core/image.h"
+#include "iblkit/core/vec.h"
+#include "iblkit/fusion/probe_set.h"
+#include "iblkit/geometry/raytracer.h"
+#include "iblkit/ilf/shgrid.h"
+#include "iblkit/sphere/envmap.h"
+
+namespace ibl::augment {
+
+struct LocalLight {
+  sphere::EnvMap map{Image(2, 1, 3), sphere::Mapping(sphere::MappingKind::LatLong, 2, 1)};  // radiance arriving at centre
+  Vec3 centre;         // where the map was taken, world metres
+  Image depth;         // optional, 1 channel, the map's size: metres from centre to what each texel sees (0: none)
+  std::string source;  // "probe", "SH grid", "fused probes": for messages
+};
+
+// The grid's radiance at `at` as a lat-long map of 2·size × size (negative SH ringing clamped to 0).
+LocalLight light_from_grid(const ilf::SHGrid& grid, Vec3 at, int size = 64);
+// The probe set fused at `at` (fusion::fuse, footprint blend) as a lat-long map of 2·size × size.
+LocalLight light_from_probes(const fusion::ProbeSet& set, Vec3 at, int size = 128);
+
+// A baseline: the light cut into `count` median-cut lights (lights::median_cut, Debevec 2005), each put into
+// the one texel of its direction with all of its region's power (and that texel's depth): what a renderer
+// with N shadow-casting lights sees. The map must be lat-long.
+LocalLight as_median_cut(const LocalLight& light, int count);
+
+// The light's patches on the proxy, and their sampling.
+class LightField {
+ public:
+  // `proxy_tracer` holds `proxy` as its mesh 0 (and nothing else).
+  LightField(const LocalLight& light, const geometry::TriMesh& proxy, const geometry::RayTracer& proxy_tracer);
+  size_t size() const { return patches_.size(); }
+  // The patch a uniform u in [0, 1) picks, and the probability of picking it.
+  size_t sample(double u, double* pmf) const;
+  // L_t Ω_t(x) max(0, n·ω) of patch i at x with unit normal n (0 when either side faces away); *w the unit
+  // direction towards it and *dist its distance (infinity for a distant patch).
+  Vec3 contribution(size_t i, Vec3 x, Vec3 n, Vec3* w, double* dist, bool shadowed = false) const;
+  // Whether patch i lies on the proxy (or a lamp in front of it) rather than at infinity, and where.
+  bool local(size_t i) const { return !patches_[i].distant; }
+  Vec3 point(size_t i) const { return patches_[i].point; }
+  Vec3 normal(size_t i) const { return patches_[i].normal; }
+  // The object's shadow on patch i as a factor of its radiance (1: untouched), for the light the object
+  // receives from the proxy; contribution(…, shadowed = true) applies it.
+  void set_shadow(size_t i, Vec3 factor) { patches_[i].shadow = factor; }
+  // ∫ mean(R, G, B) dω over the map, W/m²: for messages and tests.
+  double total_power() const { return total_; }
+
+ private:
+  struct Patch {
+    Vec3 point;       // world point on the proxy, or the unit direction of a distant patch
+    Vec3 normal;      // facing the centre (local patches)
+    Vec3 radiance;    // W/(sr·m²)
+    double area = 0;  // local: m²; distant: solid angle, sr
+    double omega = 0; // solid angle seen from the centre, sr
+    bool distant = false;
+    Vec3 shadow{1, 1, 1};  // the object's shadow on it (set_shadow)
+  };
+  std::vector<Patch> patches_;
+  std::vector<double> cdf_;
+  double total_ = 0;
+};
+
+}  // namespace ibl::augment
