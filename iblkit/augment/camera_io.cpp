@@ -75,14 +75,7 @@ geometry::Camera camera_from_json(const nlohmann::json& j, const std::string& wh
 geometry::Camera read_camera(const std::string& path) { return camera_from_json(read_json_file(path), path); }
 
 void write_camera(const std::string& path, const geometry::Camera& cam, bool with_size) {
-  std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp);
-    if (!out) fail(ErrorKind::Io, "{}: cannot write", path);
-    out << camera_to_json(cam, with_size).dump(1) << "\n";
-    if (!out) fail(ErrorKind::Io, "{}: write failed", path);
-  }
-  std::filesystem::rename(tmp, path);
+  write_json_file(path, camera_to_json(cam, with_size));
 }
 
 }  // namespace ibl::augment

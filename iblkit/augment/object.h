@@ -1,5 +1,6 @@
 // The virtual object a composite inserts (and the lab photographs as its truth): the blob, a sphere or
-// a mesh file, as world-space triangles with flat per-triangle normals (the lab's shading too).
+// a mesh file, as world-space triangles (made by render::make_object, the objects `iblkit render` shows;
+// the composite and the lab shade them with flat per-triangle normals).
 #pragma once
 #include <string>
 
@@ -9,7 +10,7 @@
 namespace ibl::augment {
 
 struct ObjectDesc {
-  std::string kind = "blob";  // "blob" (render::make_blob), "sphere", or a mesh file (OBJ, PLY, glTF)
+  std::string kind = "blob";  // "blob" (geometry::make_blob), "sphere", or a mesh file (OBJ, PLY, glTF)
   double size = 0.3;          // largest extent, metres (0: a mesh file keeps its own size and place)
   int triangles = 20000;      // triangles of the blob
   Vec3 at{0, 0, 0};           // where the object's centre goes, metres
