@@ -7,7 +7,7 @@
 namespace ibl::ilf {
 
 namespace detail {
-plugin::Provided<VdbWriter> vdb_writer{"vdb", "OpenVDB writer"};
+constinit plugin::Provided<VdbWriter> vdb_writer{"vdb", "OpenVDB writer"};
 }  // namespace detail
 
 #ifdef IBLKIT_HAVE_OPENVDB

@@ -1,11 +1,14 @@
 // PNG output through libpng: the pictures every command writes, without loading OpenImageIO.
 // 8 bits per channel, grey or RGB (image_io leaves images with alpha to OpenImageIO, which
-// un-premultiplies them), each value v in [0, 1] stored as
-// ⌊255·v + ½⌋ as OpenImageIO stores it, with the sRGB, gAMA and cHRM chunks OpenImageIO writes for
-// an sRGB image (so its reader, and every viewer, takes the values as sRGB-encoded).
+// un-premultiplies them), each value v in [0, 1] stored as round(255·v) computed in float, as
+// OpenImageIO's vectorised conversion stores it (its scalar remainder, used for the last values of a
+// row when the row's value count is not a multiple of 16, computes ⌊255·v + ½⌋ instead, which differs
+// only within an ulp of a half step); with the sRGB, gAMA and cHRM chunks OpenImageIO writes for an
+// sRGB image, so that its reader, and every viewer, takes the values as sRGB-encoded.
 #include <png.h>
 
 #include <algorithm>
+#include <cmath>
 #include <csetjmp>
 #include <cstdio>
 #include <cstring>
@@ -56,7 +59,7 @@ void write_png(const std::string& path, const Image& img) {
   std::vector<unsigned char> bytes(img.size());
   for (size_t i = 0; i < img.size(); ++i) {
     float v = std::clamp(img.data()[i], 0.0f, 1.0f);
-    bytes[i] = static_cast<unsigned char>(v * 255.0f + 0.5f);
+    bytes[i] = static_cast<unsigned char>(std::round(v * 255.0f));
   }
   std::vector<png_bytep> rows(static_cast<size_t>(h));
   for (int y = 0; y < h; ++y) rows[static_cast<size_t>(y)] = bytes.data() + static_cast<size_t>(y) * w * nc;

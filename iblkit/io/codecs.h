@@ -33,7 +33,9 @@ struct Header {
 enum class FileKind { OpenExr, Rgbe, Pfm, Other };
 FileKind sniff(const std::string& path);
 
-// The header of any image file, through the codec that reads it (defined in image_io.cpp).
+// The file decoded by our own codec for its kind, or nullopt when it is for OpenImageIO; and the
+// header of any image file through the codec that reads it (both defined in image_io.cpp).
+std::optional<Decoded> read_own(const std::string& path);
 Header read_header(const std::string& path);
 
 // Own codecs. read_* return std::nullopt for a valid file they leave to OpenImageIO; they throw
@@ -47,7 +49,7 @@ Header read_pfm_header(const std::string& path);
 void write_exr(const std::string& path, const Image& img, bool half);  // every channel, ZIP compression
 void write_rgbe(const std::string& path, const Image& img);            // 3 channels
 // 8 bits per channel, grey or RGB; `img` holds values in [0, 1] already encoded (sRGB): each
-// becomes ⌊255·v + ½⌋.
+// becomes round(255·v).
 void write_png(const std::string& path, const Image& img);
 
 // OpenImageIO's side, provided by the oiio plugin (io/codec_oiio.cpp).

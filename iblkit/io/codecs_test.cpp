@@ -49,13 +49,8 @@ void expect_same(const Decoded& a, const Decoded& b, const std::string& what) {
 
 // Our reader against OpenImageIO's on one file; false when ours leaves the file to OpenImageIO.
 bool compare_reads(const std::string& path) {
-  std::optional<Decoded> ours;
-  switch (sniff(path)) {
-    case FileKind::OpenExr: ours = read_exr(path); break;
-    case FileKind::Rgbe: ours = read_rgbe(path); break;
-    case FileKind::Pfm: ours = read_pfm(path); break;
-    case FileKind::Other: ADD_FAILURE() << path << ": not a kind we read"; return false;
-  }
+  EXPECT_NE(sniff(path), FileKind::Other) << path;
+  std::optional<Decoded> ours = read_own(path);
   if (!ours) return false;
   expect_same(*ours, oiio().read(path), path);
   Header h = read_header(path), hr = oiio().read_header(path);
@@ -173,12 +168,19 @@ TEST(Codecs, RgbeWrittenByEitherReadsTheSame) {
   }
 }
 
+// Rows of a multiple of 16 values, where OpenImageIO rounds every value the same way (codec_png.cpp).
 TEST(Codecs, PngWrittenByEitherReadsTheSame) {
   for (int nc : {1, 3}) {
-    Image img(256, 3, nc);
+    Image img(256, 9, nc);
+    std::mt19937 rng(5);
     for (int x = 0; x < 256; ++x)
-      for (int y = 0; y < 3; ++y)
-        for (int c = 0; c < nc; ++c) img.at(x, y, c) = std::clamp((x + 0.5f * y + 0.25f * c) / 255.0f - 0.002f, 0.0f, 1.0f);
+      for (int y = 0; y < 9; ++y)
+        for (int c = 0; c < nc; ++c) {
+          // Every level, and half steps give or take a few ulps (where rounding rules differ).
+          float v = y < 3 ? (x + 0.5f * y + 0.25f * c) / 255.0f : (x + 0.5f) / 255.0f;
+          for (int k = static_cast<int>(rng() % 9) - 4; k != 0; k += k > 0 ? -1 : 1) v = std::nextafter(v, k > 0 ? 2.0f : -1.0f);
+          img.at(x, y, c) = std::clamp(v, 0.0f, 1.0f);
+        }
     std::string a = (tmpdir() / fmt::format("oiio_{}.png", nc)).string(), b = (tmpdir() / fmt::format("ours_{}.png", nc)).string();
     oiio().write(a, img, true, false);
     write_png(b, img);

@@ -58,7 +58,7 @@ int check_pixels(Image& img, const std::string& what, bool sanitize) {
 
 namespace detail {
 
-plugin::Provided<OiioCodec> oiio_codec{"oiio", "OpenImageIO codec"};
+constinit plugin::Provided<OiioCodec> oiio_codec{"oiio", "OpenImageIO codec"};
 
 FileKind sniff(const std::string& path) {
   unsigned char b[4] = {};
@@ -70,6 +70,16 @@ FileKind sniff(const std::string& path) {
   if (n >= 2 && b[0] == '#' && b[1] == '?') return FileKind::Rgbe;
   if (n >= 3 && b[0] == 'P' && (b[1] == 'F' || b[1] == 'f') && std::isspace(b[2])) return FileKind::Pfm;
   return FileKind::Other;
+}
+
+std::optional<Decoded> read_own(const std::string& path) {
+  switch (sniff(path)) {
+    case FileKind::OpenExr: return read_exr(path);
+    case FileKind::Rgbe: return read_rgbe(path);
+    case FileKind::Pfm: return read_pfm(path);
+    case FileKind::Other: break;
+  }
+  return std::nullopt;
 }
 
 Header read_header(const std::string& path) {
@@ -89,13 +99,7 @@ Image read_image(const std::string& path, const ReadDesc& desc, ReadReport* repo
   std::error_code ec;
   if (!fs::exists(path, ec)) fail(ErrorKind::Io, "{}: no such file", path);
   if (fs::is_directory(path, ec)) fail(ErrorKind::Io, "{}: is a folder, not an image", path);
-  std::optional<detail::Decoded> d;
-  switch (detail::sniff(path)) {
-    case detail::FileKind::OpenExr: d = detail::read_exr(path); break;
-    case detail::FileKind::Rgbe: d = detail::read_rgbe(path); break;
-    case detail::FileKind::Pfm: d = detail::read_pfm(path); break;
-    case detail::FileKind::Other: break;
-  }
+  std::optional<detail::Decoded> d = detail::read_own(path);
   if (!d) d = detail::oiio_codec.get().read(path);
   Image& img = d->image;
   int nc = img.channels();
