@@ -28,6 +28,11 @@ if [ -f "$PROBE" ]; then
 else
   echo "no blender-data probe: the probe checks are skipped"; skip=$((skip+1))
 fi
+# The ILF (in the executable) writes OpenVDB through its plugin.
+check ilf-synth ok "" -- "$BIN" --quiet ilf synth --out "$T/seq" --probes 40 --size 16
+out=$("$BIN" --quiet ilf build "$T/seq/sequence.json" --grid 4 --out "$T/g.shgrid" --vdb "$T/g.vdb" 2>&1); rc=$?
+if { [ $rc -eq 0 ] && [ -s "$T/g.vdb" ]; } || { [ $rc -ne 0 ] && grep -q "no OpenVDB" <<<"$out"; }; then ok; else bad "ilf build --vdb: rc $rc: $out"; fi
+check alone-vdb-needs-plugin fail "libiblkit_vdb.so|no OpenVDB" -- "$A" --quiet ilf build "$T/seq/sequence.json" --grid 4 --out "$T/g2.shgrid" --vdb "$T/g2.vdb"
 if "$BIN" --help | grep -q "^  render"; then
   check alone-render-needs-plugin fail "libiblkit_geometry.so: plugin not found" -- "$A" render --help
   # From another folder, and through a symbolic link: the plugins are found beside the real file.
