@@ -18,7 +18,7 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 HDR="$work/$(basename "${EXR%.*}").hdr"
 "$BIN" -q convert "$EXR" "$HDR" >/dev/null
-echo "executable: ldd lists $(ldd "$BIN" | wc -l) entries; probe $(basename "$HDR"): $("$BIN" info "$HDR" | awk '/^size/{print $2 $3 $4}')"
+echo "executable: ldd lists $(ldd "$BIN" | wc -l) entries; probe $(basename "$HDR"): $("$BIN" info "$HDR" | awk '/^size/{sub(",", "", $4); print $2 "x" $4}')"
 rss=$( { /usr/bin/time -f "%M" "$BIN" --version >/dev/null; } 2>&1 )
 echo "iblkit --version: maximum resident set ${rss} kB"
 cd "$work"  # cmgen writes nothing with these flags, but run it where it could
