@@ -26,9 +26,7 @@ std::vector<CommandEntry>& command_registry() {
   static std::vector<CommandEntry> r;
   return r;
 }
-Command::Command(std::string name, std::string description, Setup setup, int order) {
-  command_registry().push_back({std::move(name), std::move(description), std::move(setup), order});
-}
+Command::Command(std::string name, Setup setup) { command_registry().push_back({std::move(name), std::move(setup)}); }
 
 std::vector<DemoEntry>& demo_registry() {
   static std::vector<DemoEntry> r;

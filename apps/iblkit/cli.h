@@ -21,17 +21,17 @@ struct Globals {
 };
 Globals& globals();
 
-// A subcommand registers itself from its own file:
-//   static iblcli::Command reg("sh", "Project a probe onto spherical harmonics", setup_fn);
-// setup_fn adds options to the CLI11 sub-app and sets its callback.
+// A subcommand registers its setup from its own file:
+//   static iblcli::Command reg("sh", setup_fn);
+// setup_fn adds options to the CLI11 sub-app and sets its callback. Its name, description and
+// place in --help are listed in main.cpp, which prints them without loading any plugin.
 struct Command {
   using Setup = std::function<void(CLI::App&)>;
-  Command(std::string name, std::string description, Setup setup, int order = 100);
+  Command(std::string name, Setup setup);
 };
 struct CommandEntry {
-  std::string name, description;
+  std::string name;
   Command::Setup setup;
-  int order;
 };
 std::vector<CommandEntry>& command_registry();
 

@@ -163,7 +163,7 @@ void setup(CLI::App& app) {
   app.callback([o, &rd] { run(*o, rd); });
 }
 
-iblcli::Command reg("composite", "Composite a virtual object into a photograph with its shadows (differential rendering)", setup, 85);
+iblcli::Command reg("composite", setup);
 
 }  // namespace
 #endif  // IBLKIT_HAVE_GEOMETRY

@@ -71,6 +71,6 @@ void setup(CLI::App& app) {
   });
 }
 
-iblcli::Command reg("convert", "Convert a probe to another mapping, size or file format", setup, 20);
+iblcli::Command reg("convert", setup);
 
 }  // namespace

@@ -107,6 +107,6 @@ void setup(CLI::App& app) {
   });
 }
 
-iblcli::Command reg("demo", "Run the built-in demo: a real probe through every module, pictures and numbers", setup, 1000);
+iblcli::Command reg("demo", setup);
 
 }  // namespace

@@ -276,7 +276,7 @@ void setup(CLI::App& app) {
   });
 }
 
-Command reg("fuse", "Local environment maps anywhere from probes on a proxy mesh (Pedersen 2008)", setup, 65);
+Command reg("fuse", setup);
 
 }  // namespace
 }  // namespace iblcli

@@ -314,6 +314,6 @@ void setup(CLI::App& app) {
   setup_synth(*app.add_subcommand("synth", "Write a synthetic probe sequence of a closed-form light field"));
 }
 
-iblcli::Command reg("ilf", "Incident light fields: probe sequences -> SH grids, queries, slices", setup, 50);
+iblcli::Command reg("ilf", setup);
 
 }  // namespace

@@ -45,6 +45,6 @@ void setup(CLI::App& app) {
   });
 }
 
-iblcli::Command reg("info", "Describe a probe: size, mapping, range, total power", setup, 10);
+iblcli::Command reg("info", setup);
 
 }  // namespace

@@ -316,7 +316,7 @@ void setup(CLI::App& app) {
   ph->callback([po] { run_photograph(*po); });
 }
 
-iblcli::Command reg("lab", "Analytic lighting scenes: synthetic captures and exact ground truth", setup, 60);
+iblcli::Command reg("lab", setup);
 
 // Demo: each built-in scene seen from its volume's centre, low-scene1 through the mirror-ball
 // camera and as a depth map, and the time one 250×250 mirror-ball probe of low-scene1 takes.

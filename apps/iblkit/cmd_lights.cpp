@@ -112,8 +112,7 @@ void setup_lights(CLI::App& app) {
   app.callback([o, &rd] { run_lights(*o, rd); });
 }
 
-iblcli::Command reg_lights("lights", "Directional lights from a probe: median cut, variance cut, irradiance optimisation",
-                           setup_lights, 40);
+iblcli::Command reg_lights("lights", setup_lights);
 
 // ---- iblkit eval --------------------------------------------------------------------------------
 
@@ -233,8 +232,7 @@ void setup_eval(CLI::App& app) {
   app.callback([o, &rd] { run_eval(*o, rd); });
 }
 
-iblcli::Command reg_eval("eval", "Irradiance error of light sets against the exact ground truth (Madsen & Laursen Fig. 4)",
-                         setup_eval, 41);
+iblcli::Command reg_eval("eval", setup_eval);
 
 // ---- demo step ----------------------------------------------------------------------------------
 

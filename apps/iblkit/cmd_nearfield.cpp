@@ -402,7 +402,7 @@ void setup(CLI::App& app) {
   });
 }
 
-iblcli::Command reg("nearfield", "Near-field luminaires: simulated acquisition, textured spotlights, exact comparison", setup, 75);
+iblcli::Command reg("nearfield", setup);
 
 // Demo: the bike light (9×7) and the flashlight (7×7) simulated, receiver planes at four distances
 // and the crypt, each against the exact answer and the far field; Fig. 3.

@@ -36,6 +36,6 @@ void setup(CLI::App& app) {
   });
 }
 
-iblcli::Command reg("preview", "Write a tone-mapped PNG of an HDR image", setup, 30);
+iblcli::Command reg("preview", setup);
 
 }  // namespace

@@ -425,7 +425,7 @@ void demo_step(iblcli::DemoContext& ctx) {
 
 iblcli::DemoStep demo("render", 80, demo_step);
 
-iblcli::Command reg("render", "Render an object lit by a probe, SH, an SH grid, lights or a luminaire (CPU reference or OpenGL)", setup, 80);
+iblcli::Command reg("render", setup);
 
 }  // namespace
 #endif

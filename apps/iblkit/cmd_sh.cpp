@@ -108,7 +108,7 @@ void setup(CLI::App& app) {
   });
 }
 
-iblcli::Command reg("sh", "Project a probe onto spherical harmonics; export, window, render irradiance", setup, 40);
+iblcli::Command reg("sh", setup);
 
 // Demo: the probe to 3 and 5 bands, the exports, and the 3- and 5-band irradiance as pictures.
 void demo_step(iblcli::DemoContext& ctx) {

@@ -305,7 +305,7 @@ void setup(CLI::App& app) {
   app.callback([o, &rd] { run(*o, rd); });
 }
 
-iblcli::Command reg("view", "Interactive viewer (GLFW window): orbit, move the object, switch lightings", setup, 85);
+iblcli::Command reg("view", setup);
 
 }  // namespace
 #endif

@@ -1,13 +1,87 @@
 // iblkit: image-based lighting with captured light. One subcommand per file (cmd_*.cpp), each
-// registering itself with iblcli::Command.
+// registering its setup with iblcli::Command; the table below lists them all.
+//
+// Start-up (docs/startup.md): this executable holds the light modules; the subcommands that need
+// Embree, assimp or OpenGL live in plugins beside it (libiblkit_<name>.so), loaded only when one of
+// them runs, so that `iblkit --help`, `iblkit sh` and the other light commands start in a few
+// milliseconds. The table is what --help prints without loading anything.
 #include <algorithm>
 #include <cstdio>
+#include <cstring>
+#include <string_view>
 
 #include <CLI/CLI.hpp>
 
 #include "cli.h"
 #include "iblkit/core/atomic_file.h"
 #include "iblkit/core/error.h"
+#include "iblkit/core/plugin.h"
+
+namespace {
+
+struct Subcommand {
+  const char* name;
+  const char* description;
+  const char* plugin;  // the plugin that holds its code, or nullptr: this executable
+};
+
+// Every subcommand, in the order --help lists them.
+constexpr Subcommand kSubcommands[] = {
+    {"info", "Describe a probe: size, mapping, range, total power", nullptr},
+    {"convert", "Convert a probe to another mapping, size or file format", nullptr},
+    {"preview", "Write a tone-mapped PNG of an HDR image", nullptr},
+    {"lights", "Directional lights from a probe: median cut, variance cut, irradiance optimisation", nullptr},
+    {"sh", "Project a probe onto spherical harmonics; export, window, render irradiance", nullptr},
+    {"eval", "Irradiance error of light sets against the exact ground truth (Madsen & Laursen Fig. 4)", nullptr},
+    {"ilf", "Incident light fields: probe sequences -> SH grids, queries, slices", nullptr},
+#ifdef IBLKIT_HAVE_GEOMETRY
+    {"lab", "Analytic lighting scenes: synthetic captures and exact ground truth", "geometry"},
+    {"fuse", "Local environment maps anywhere from probes on a proxy mesh (Pedersen 2008)", "geometry"},
+    {"nearfield", "Near-field luminaires: simulated acquisition, textured spotlights, exact comparison", "geometry"},
+    {"render", "Render an object lit by a probe, SH, an SH grid, lights or a luminaire (CPU reference or OpenGL)",
+     "geometry"},
+    {"composite", "Composite a virtual object into a photograph with its shadows (differential rendering)", "geometry"},
+#endif
+#if defined(IBLKIT_HAVE_GL) && defined(IBLKIT_HAVE_GLFW)
+    {"view", "Interactive viewer (GLFW window): orbit, move the object, switch lightings", "view"},
+#endif
+    {"demo", "Run the built-in demo: a real probe through every module, pictures and numbers", nullptr},
+};
+
+// The demo runs the demo steps of every module, so it loads every plugin that has some.
+constexpr const char* kDemoPlugins[] = {
+#ifdef IBLKIT_HAVE_GEOMETRY
+    "geometry",
+#endif
+    nullptr};
+
+// The subcommand named on the command line: the first argument that is not an option (the global
+// options --json, -q/--quiet, --help and --version take no value), or nullptr.
+const Subcommand* requested(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {
+    if (argv[i][0] == '-') continue;
+    for (const auto& s : kSubcommands)
+      if (std::strcmp(s.name, argv[i]) == 0) return &s;
+    return nullptr;
+  }
+  return nullptr;
+}
+
+// Loads the code a subcommand needs.
+void load_for(const Subcommand& s) {
+  if (s.plugin) ibl::plugin::load(s.plugin);
+  if (std::string_view(s.name) == "demo")
+    for (const char* p : kDemoPlugins)
+      if (p) ibl::plugin::load(p);
+}
+
+int report(const std::exception& e) {
+  iblcli::progress_done();
+  std::fprintf(stderr, "iblkit: error: %s\n", e.what());
+  return 1;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   ibl::remove_temp_files_on_signals();  // Ctrl-C or a kill mid-write leaves no temporary file behind
@@ -25,25 +99,36 @@ int main(int argc, char** argv) {
   auto& g = iblcli::globals();
   app.add_flag("--json", g.json, "print results as JSON on stdout");
   app.add_flag("-q,--quiet", g.quiet, "no progress bar or chatter on stderr");
-  auto& reg = iblcli::command_registry();
-  std::stable_sort(reg.begin(), reg.end(), [](const auto& a, const auto& b) { return a.order < b.order; });
-  for (auto& c : reg) {
-    CLI::App* sub = app.add_subcommand(c.name, c.description);
+  const Subcommand* chosen = requested(argc, argv);
+  try {
+    if (chosen) load_for(*chosen);
+  } catch (const ibl::Error& e) {
+    return report(e);
+  }
+  const auto& reg = iblcli::command_registry();
+  for (const auto& c : reg)
+    if (std::none_of(std::begin(kSubcommands), std::end(kSubcommands), [&](const Subcommand& s) { return c.name == s.name; })) {
+      std::fprintf(stderr, "iblkit: internal error: subcommand '%s' is registered but not listed in main.cpp\n", c.name.c_str());
+      return 1;
+    }
+  for (const auto& s : kSubcommands) {
+    CLI::App* sub = app.add_subcommand(s.name, s.description);
     sub->fallthrough();
-    c.setup(*sub);
+    auto it = std::find_if(reg.begin(), reg.end(), [&](const auto& c) { return c.name == s.name; });
+    if (it != reg.end()) {
+      it->setup(*sub);
+    } else if (&s == chosen) {
+      std::fprintf(stderr, "iblkit: internal error: subcommand '%s' has no code in %s\n", s.name,
+                   s.plugin ? ibl::plugin::path_of(s.plugin).c_str() : "this executable");
+      return 1;
+    }
   }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
-  } catch (const ibl::Error& e) {
-    iblcli::progress_done();
-    std::fprintf(stderr, "iblkit: error: %s\n", e.what());
-    return 1;
   } catch (const std::exception& e) {
-    iblcli::progress_done();
-    std::fprintf(stderr, "iblkit: error: %s\n", e.what());
-    return 1;
+    return report(e);
   }
   return 0;
 }

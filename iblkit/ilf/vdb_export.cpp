@@ -1,19 +1,17 @@
 // OpenVDB export of an SH grid (`ilf build --vdb`), for Houdini and Blender users: one Vec3f grid per
 // coefficient, voxel (i, j, k) = grid point (i, j, k), a scale+translate transform to world metres.
-#include "iblkit/core/error.h"
-#include "iblkit/core/atomic_file.h"
-#include "iblkit/ilf/shgrid.h"
-
-#ifdef IBLKIT_HAVE_OPENVDB
+// Built only with OpenVDB, into the "vdb" plugin for the iblkit command (ilf/vdb.cpp calls it).
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Dense.h>
-#endif
 
-namespace ibl::ilf {
+#include "iblkit/core/atomic_file.h"
+#include "iblkit/core/error.h"
+#include "iblkit/ilf/shgrid.h"
+#include "iblkit/ilf/vdb_writer.h"
 
-#ifdef IBLKIT_HAVE_OPENVDB
+namespace ibl::ilf::vdb_file {
 
-bool have_vdb() { return true; }
+namespace {
 
 void write_vdb(const std::string& path, const SHGrid& g) {
   openvdb::initialize();
@@ -62,14 +60,9 @@ void write_vdb(const std::string& path, const SHGrid& g) {
   out.commit();
 }
 
-#else
+const detail::VdbWriter kWriter{write_vdb};
+[[maybe_unused]] const bool kProvided = (detail::vdb_writer.provide(&kWriter), true);
 
-bool have_vdb() { return false; }
+}  // namespace
 
-void write_vdb(const std::string& path, const SHGrid&) {
-  fail(ErrorKind::Unsupported, "{}: this build has no OpenVDB (configure with OpenVDB found to write .vdb grids)", path);
-}
-
-#endif
-
-}  // namespace ibl::ilf
+}  // namespace ibl::ilf::vdb_file

@@ -4,8 +4,7 @@
 #include <cmath>
 #include <filesystem>
 
-#include <OpenImageIO/imagebuf.h>
-#include <OpenImageIO/imagebufalgo.h>
+#include "iblkit/io/codecs.h"
 
 namespace ibl::io {
 
@@ -29,10 +28,7 @@ void blend(Image& img, int x, int y, Vec3 rgb, double a) {
 bool draw_text(Image& img, int x, int y, const std::string& text, int size, Vec3 rgb) {
   const char* font = font_path();
   if (!font || img.channels() < 3) return false;
-  OIIO::ImageSpec spec(img.width(), img.height(), img.channels(), OIIO::TypeDesc::FLOAT);
-  OIIO::ImageBuf buf(spec, img.data());  // wraps our pixels
-  float col[4] = {static_cast<float>(rgb.x), static_cast<float>(rgb.y), static_cast<float>(rgb.z), 1.0f};
-  return OIIO::ImageBufAlgo::render_text(buf, x, y, text, size, font, OIIO::cspan<float>(col, img.channels() >= 4 ? 4 : 3));
+  return detail::oiio_codec.get().draw_text(img, x, y, text, size, font, rgb);  // OpenImageIO's FreeType renderer
 }
 
 void draw_line(Image& img, double x0, double y0, double x1, double y1, Vec3 rgb, double width) {

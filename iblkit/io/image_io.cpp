@@ -1,15 +1,16 @@
 #include "iblkit/io/image_io.h"
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
-#include <filesystem>
 #include <cstdio>
-#include <memory>
+#include <filesystem>
+#include <optional>
 #include <vector>
-
-#include <OpenImageIO/imageio.h>
 
 #include "iblkit/core/atomic_file.h"
 #include "iblkit/core/error.h"
+#include "iblkit/io/codecs.h"
 
 namespace ibl::io {
 
@@ -56,34 +57,54 @@ int check_pixels(Image& img, const std::string& what, bool sanitize) {
   return bad;
 }
 
+namespace detail {
+
+constinit plugin::Provided<OiioCodec> oiio_codec{"oiio", "OpenImageIO codec"};
+
+FileKind sniff(const std::string& path) {
+  unsigned char b[4] = {};
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) return FileKind::Other;  // OpenImageIO's open says why
+  size_t n = std::fread(b, 1, 4, f);
+  std::fclose(f);
+  if (n == 4 && b[0] == 0x76 && b[1] == 0x2f && b[2] == 0x31 && b[3] == 0x01) return FileKind::OpenExr;
+  if (n >= 2 && b[0] == '#' && b[1] == '?') return FileKind::Rgbe;
+  if (n >= 3 && b[0] == 'P' && (b[1] == 'F' || b[1] == 'f') && std::isspace(b[2])) return FileKind::Pfm;
+  return FileKind::Other;
+}
+
+std::optional<Decoded> read_own(const std::string& path) {
+  switch (sniff(path)) {
+    case FileKind::OpenExr: return read_exr(path);
+    case FileKind::Rgbe: return read_rgbe(path);
+    case FileKind::Pfm: return read_pfm(path);
+    case FileKind::Other: break;
+  }
+  return std::nullopt;
+}
+
+Header read_header(const std::string& path) {
+  std::optional<Header> h;
+  switch (sniff(path)) {
+    case FileKind::OpenExr: h = read_exr_header(path); break;
+    case FileKind::Rgbe: h = read_rgbe_header(path); break;
+    case FileKind::Pfm: h = read_pfm_header(path); break;
+    case FileKind::Other: break;
+  }
+  return h ? *h : oiio_codec.get().read_header(path);
+}
+
+}  // namespace detail
+
 Image read_image(const std::string& path, const ReadDesc& desc, ReadReport* report) {
   std::error_code ec;
   if (!fs::exists(path, ec)) fail(ErrorKind::Io, "{}: no such file", path);
   if (fs::is_directory(path, ec)) fail(ErrorKind::Io, "{}: is a folder, not an image", path);
-  auto in = OIIO::ImageInput::open(path);
-  if (!in) {
-    std::string err = OIIO::geterror();
-    if (err.find("not exist") != std::string::npos || err.find("Could not open") != std::string::npos)
-      fail(ErrorKind::Io, "{}: cannot open ({})", path, err);
-    fail(ErrorKind::Format, "{}: not an image format this build reads ({})", path, err);
-  }
-  const OIIO::ImageSpec& spec = in->spec();
-  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0)
-    fail(ErrorKind::Format, "{}: image has no pixels ({}x{}x{})", path, spec.width, spec.height, spec.nchannels);
-  if (static_cast<int64_t>(spec.width) * spec.height > (int64_t(1) << 30))
-    fail(ErrorKind::Value, "{}: image {}x{} is too large", path, spec.width, spec.height);
-  int nc = spec.nchannels;
-  Image img(spec.width, spec.height, nc);
-  if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, img.data())) {
-    std::string err = in->geterror();
-    fail(ErrorKind::Format, "{}: corrupt or truncated image data ({})", path, err.empty() ? "read failed" : err);
-  }
-  std::string fmt_name = in->format_name();
-  in->close();
-  bool ldr = spec.format.basetype == OIIO::TypeDesc::UINT8 || spec.format.basetype == OIIO::TypeDesc::UINT16;
-  std::string cs = spec.get_string_attribute("oiio:ColorSpace");
-  bool srgb = ldr && (cs.empty() || cs == "sRGB" || cs == "srgb_rec709_scene");
-  if (srgb) {
+  std::optional<detail::Decoded> d = detail::read_own(path);
+  if (!d) d = detail::oiio_codec.get().read(path);
+  Image& img = d->image;
+  int nc = img.channels();
+  if (d->srgb) {
     int color_channels = std::min(nc, 3);
     for (size_t i = 0; i < img.pixel_count(); ++i)
       for (int c = 0; c < color_channels; ++c) img.data()[i * nc + c] = srgb_to_linear(img.data()[i * nc + c]);
@@ -92,10 +113,10 @@ Image read_image(const std::string& path, const ReadDesc& desc, ReadReport* repo
   int fixed = check_pixels(img, path, desc.sanitize);
   if (report) {
     report->sanitized = fixed;
-    report->srgb_decoded = srgb;
-    report->format = fmt_name;
+    report->srgb_decoded = d->srgb;
+    report->format = d->format;
   }
-  return img;
+  return std::move(img);
 }
 
 namespace {
@@ -117,26 +138,26 @@ void write_pfm(const std::string& file, const std::string& path, const Image& im
   ok = (std::fclose(f) == 0) && ok;
   if (!ok) fail(ErrorKind::Io, "{}: write failed", path);
 }
+
+
+// Our own writers where they write what OpenImageIO would; OpenImageIO (a plugin) for the rest (PNG
+// with alpha among them: OpenImageIO divides colour by alpha on writing it).
+void write_encoded(const std::string& file, const std::string& ext, const Image& src, bool ldr, bool half) {
+  const int nc = src.channels();
+  if (ext == ".exr" && nc <= 4) return detail::write_exr(file, src, half);
+  if (ext == ".hdr" && nc == 3) return detail::write_rgbe(file, src);
+  if (ext == ".png" && (nc == 1 || nc == 3)) return detail::write_png(file, src);
+  detail::oiio_codec.get().write(file, src, ldr, half && ext == ".exr");
+}
 }  // namespace
 
 void write_image(const std::string& path, const Image& img, const WriteDesc& desc) {
   if (img.empty()) fail(ErrorKind::Value, "{}: refusing to write an empty image", path);
   std::string ext = fs::path(path).extension().string();
   for (auto& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
-  AtomicFile file(path);  // OIIO writes to file.temp_path(), which keeps the extension
-  if (ext == ".pfm") {
-    write_pfm(file.temp_path(), path, img);
-    return file.commit();
-  }
-  auto out = OIIO::ImageOutput::create(file.temp_path());
-  if (!out) fail(ErrorKind::Format, "{}: no image writer for extension '{}' ({})", path, ext, OIIO::geterror());
   bool ldr = ext == ".png" || ext == ".jpg" || ext == ".jpeg";
   int nc = img.channels();
   if (ext == ".hdr" || ext == ".jpg" || ext == ".jpeg") nc = std::min(nc, 3);
-  OIIO::TypeDesc type = ldr ? OIIO::TypeDesc::UINT8 : (desc.half && ext == ".exr" ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::FLOAT);
-  OIIO::ImageSpec spec(img.width(), img.height(), nc, type);
-  if (ldr) spec.attribute("oiio:ColorSpace", "sRGB");
-  if (ext == ".exr") spec.attribute("compression", "zip");
   Image src = nc == img.channels() ? img : img.with_channels(nc);
   if (ldr) {
     int color = std::min(nc, 3);
@@ -146,10 +167,17 @@ void write_image(const std::string& path, const Image& img, const WriteDesc& des
         v = c < color ? linear_to_srgb(v) : std::clamp(v, 0.0f, 1.0f);
       }
   }
-  if (!out->open(file.temp_path(), spec)) fail(ErrorKind::Io, "{}: cannot write ({})", path, out->geterror());
-  if (!out->write_image(OIIO::TypeDesc::FLOAT, src.data())) fail(ErrorKind::Io, "{}: write failed ({})", path, out->geterror());
-  if (!out->close()) fail(ErrorKind::Io, "{}: close failed ({})", path, out->geterror());
-  out.reset();
+  // Every writer writes to a temporary name beside `path` (keeping the extension, which picks the
+  // format) and the file is renamed into place only when complete; messages name `path`.
+  AtomicFile file(path);
+  try {
+    if (ext == ".pfm") write_pfm(file.temp_path(), path, img);
+    else write_encoded(file.temp_path(), ext, src, ldr, desc.half);
+  } catch (const Error& e) {
+    std::string msg = e.what();
+    for (size_t at; (at = msg.find(file.temp_path())) != std::string::npos;) msg.replace(at, file.temp_path().size(), path);
+    throw Error(e.kind(), msg);
+  }
   file.commit();
 }
 

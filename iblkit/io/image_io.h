@@ -1,6 +1,7 @@
-// Reading and writing images through OpenImageIO: .exr, .hdr (RGBE), .pfm, .tif, .png/.jpg
-// (8-bit sRGB, decoded to linear on read and encoded on write). Every failure throws ibl::Error
-// naming the file.
+// Reading and writing images: .exr, .hdr (RGBE), .pfm, .tif, .png/.jpg (8-bit sRGB, decoded to
+// linear on read and encoded on write), and whatever else OpenImageIO reads. EXR, RGBE, PFM and PNG
+// output go through iblkit's own codecs, everything else through OpenImageIO, loaded only then
+// (io/codecs.h); the pixels are the same either way. Every failure throws ibl::Error naming the file.
 #pragma once
 #include <string>
 
@@ -18,7 +19,7 @@ struct ReadDesc {
 struct ReadReport {
   int sanitized = 0;         // values replaced because of `sanitize`
   bool srgb_decoded = false;  // 8-bit sRGB input decoded to linear
-  std::string format;         // OpenImageIO format name ("openexr", "hdr", …)
+  std::string format;         // OpenImageIO's name of the format ("openexr", "hdr", "pnm", …)
 };
 
 Image read_image(const std::string& path, const ReadDesc& desc = {}, ReadReport* report = nullptr);

@@ -1,0 +1,153 @@
+// OpenEXR files through the OpenEXR library, as OpenImageIO 2.4 reads and writes them.
+// Read: part 0, its data window, channels R, G, B, Y, A in that order (OpenImageIO sorts a layer's
+// channels by a list of known names: R, Red, G, Green, B, Blue, Y, …, A, …); half and float
+// channels become float. Files with layers, other channel names, subsampled, integer or deep
+// channels are left to OpenImageIO. Write: channels named as OpenImageIO names them (one channel
+// "Y", else R, G, B, A), ZIP compression, float or half (Imath's round-to-nearest conversion).
+#include <algorithm>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include <Imath/half.h>
+#include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfFrameBuffer.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfInputFile.h>
+#include <OpenEXR/ImfOutputFile.h>
+#include <OpenEXR/ImfPartType.h>
+#include <OpenEXR/ImfThreading.h>
+
+#include "iblkit/core/error.h"
+#include "iblkit/io/codecs.h"
+
+namespace ibl::io::detail {
+
+namespace {
+
+// OpenImageIO decodes with a thread per core; so do we (the pool starts on the first EXR).
+void use_all_cores() {
+  static std::once_flag once;
+  std::call_once(once, [] { Imf::setGlobalThreadCount(static_cast<int>(std::max(1u, std::thread::hardware_concurrency()))); });
+}
+
+// Position of a channel name in the order OpenImageIO gives, or -1 for a name we leave to it.
+int channel_rank(const std::string& name) {
+  static const char* order[] = {"R", "G", "B", "Y", "A"};
+  for (int i = 0; i < 5; ++i)
+    if (name == order[i]) return i;
+  return -1;
+}
+
+struct Layout {
+  int width = 0, height = 0;
+  Imath::Box2i window;
+  std::vector<std::string> channels;  // in the order they are returned
+};
+
+// The layout of a file we read ourselves, or nullopt when OpenImageIO should read it.
+std::optional<Layout> layout_of(const Imf::Header& h) {
+  if (h.hasType() && Imf::isDeepData(h.type())) return std::nullopt;
+  Layout l;
+  l.window = h.dataWindow();
+  l.width = l.window.max.x - l.window.min.x + 1;
+  l.height = l.window.max.y - l.window.min.y + 1;
+  std::vector<std::pair<int, std::string>> ranked;
+  for (auto c = h.channels().begin(); c != h.channels().end(); ++c) {
+    int r = channel_rank(c.name());
+    const Imf::Channel& ch = c.channel();
+    if (r < 0 || ch.xSampling != 1 || ch.ySampling != 1 || ch.type == Imf::UINT) return std::nullopt;
+    ranked.push_back({r, c.name()});
+  }
+  if (ranked.empty()) return std::nullopt;
+  std::sort(ranked.begin(), ranked.end());
+  for (auto& [r, n] : ranked) l.channels.push_back(n);
+  return l;
+}
+
+template <typename F>
+auto header_step(const std::string& path, F&& f) {
+  try {
+    return f();
+  } catch (const Error&) {
+    throw;
+  } catch (const std::exception& e) {
+    fail(ErrorKind::Format, "{}: not an image format this build reads ({})", path, e.what());
+  }
+}
+
+}  // namespace
+
+std::optional<Header> read_exr_header(const std::string& path) {
+  return header_step(path, [&]() -> std::optional<Header> {
+    Imf::InputFile file(path.c_str());
+    auto l = layout_of(file.header());
+    if (!l) return std::nullopt;
+    return Header{l->width, l->height, static_cast<int>(l->channels.size()), "openexr"};
+  });
+}
+
+std::optional<Decoded> read_exr(const std::string& path) {
+  use_all_cores();
+  return header_step(path, [&]() -> std::optional<Decoded> {
+    Imf::InputFile file(path.c_str());
+    auto l = layout_of(file.header());
+    if (!l) return std::nullopt;
+    if (l->width <= 0 || l->height <= 0) fail(ErrorKind::Format, "{}: image has no pixels ({}x{})", path, l->width, l->height);
+    if (static_cast<int64_t>(l->width) * l->height > (int64_t(1) << 30))
+      fail(ErrorKind::Value, "{}: image {}x{} is too large", path, l->width, l->height);
+    const int nc = static_cast<int>(l->channels.size());
+    Decoded d;
+    d.format = "openexr";
+    d.image = Image(l->width, l->height, nc);
+    // The frame buffer's origin sits at the data window's corner: point it back by that offset.
+    const size_t xs = sizeof(float) * nc, ys = xs * l->width;
+    char* base = reinterpret_cast<char*>(d.image.data()) - static_cast<ptrdiff_t>(l->window.min.x) * xs -
+                 static_cast<ptrdiff_t>(l->window.min.y) * ys;
+    Imf::FrameBuffer fb;
+    for (int c = 0; c < nc; ++c) fb.insert(l->channels[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), xs, ys));
+    file.setFrameBuffer(fb);
+    try {
+      file.readPixels(l->window.min.y, l->window.max.y);
+    } catch (const std::exception& e) {
+      fail(ErrorKind::Format, "{}: corrupt or truncated image data ({})", path, e.what());
+    }
+    return d;
+  });
+}
+
+void write_exr(const std::string& path, const Image& img, bool half) {
+  use_all_cores();
+  static const char* rgba[] = {"R", "G", "B", "A"};
+  const int nc = img.channels();
+  if (nc > 4) fail(ErrorKind::Internal, "{}: write_exr takes 1 to 4 channels (got {})", path, nc);
+  const int w = img.width(), h = img.height();
+  Imf::Header header(w, h);
+  header.compression() = Imf::ZIP_COMPRESSION;
+  const Imf::PixelType type = half ? Imf::HALF : Imf::FLOAT;
+  std::vector<std::string> names;
+  for (int c = 0; c < nc; ++c) names.push_back(nc == 1 ? "Y" : rgba[c]);
+  for (auto& n : names) header.channels().insert(n, Imf::Channel(type));
+  std::vector<Imath::half> halves;
+  Imf::FrameBuffer fb;
+  if (half) {
+    halves.resize(img.size());
+    std::transform(img.data(), img.data() + img.size(), halves.begin(), [](float v) { return Imath::half(v); });
+    for (int c = 0; c < nc; ++c)
+      fb.insert(names[c], Imf::Slice(Imf::HALF, reinterpret_cast<char*>(halves.data() + c), sizeof(Imath::half) * nc,
+                                     sizeof(Imath::half) * nc * w));
+  } else {
+    char* base = const_cast<char*>(reinterpret_cast<const char*>(img.data()));  // OpenEXR only reads it
+    for (int c = 0; c < nc; ++c)
+      fb.insert(names[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), sizeof(float) * nc, sizeof(float) * nc * w));
+  }
+  try {
+    Imf::OutputFile file(path.c_str(), header);
+    file.setFrameBuffer(fb);
+    file.writePixels(h);
+  } catch (const std::exception& e) {
+    fail(ErrorKind::Io, "{}: cannot write ({})", path, e.what());
+  }
+}
+
+}  // namespace ibl::io::detail
