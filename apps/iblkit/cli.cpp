@@ -1,5 +1,6 @@
 #include "cli.h"
 
+#include <cmath>
 #include <unistd.h>
 
 #include <algorithm>
@@ -110,6 +111,8 @@ ibl::Vec3 parse_vec3(const std::string& s, const std::string& what) {
   }
   if (i != 3 || std::getline(ss, part, ','))
     ibl::fail(ibl::ErrorKind::Value, "{} '{}': expected three numbers x,y,z", what, s);
+  if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
+    ibl::fail(ibl::ErrorKind::Value, "{} '{}': the numbers must be finite", what, s);
   return v;
 }
 

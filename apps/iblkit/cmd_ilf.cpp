@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "cli.h"
+#include "iblkit/core/check.h"
 #include "iblkit/core/error.h"
 #include "iblkit/ilf/analytic.h"
 #include "iblkit/ilf/build.h"
@@ -180,6 +181,7 @@ void setup_query(CLI::App& app) {
   app.callback([o] {
     auto g = ilf::read_shgrid(o->grid);
     Vec3 p = iblcli::parse_vec3(o->at, "--at"), n = o->normal.empty() ? Vec3{0, 1, 0} : iblcli::parse_vec3(o->normal, "--normal");
+    require_point("--at", p);
     if (!g.grid().volume.contains(p)) iblcli::info("note: the point lies outside the grid volume; values are clamped to its boundary");
     auto c = g.coeffs_at(p);
     Vec3 e = g.irradiance(p, n);
@@ -210,7 +212,7 @@ Image irradiance_slice(const ilf::SHGrid& g, int axis, double value, int size, d
   const auto& v = g.grid().volume;
   int a1 = axis == 0 ? 2 : 0, a2 = axis == 1 ? 2 : 1;  // image x, y axes
   Vec3 ext = v.size();
-  int w = size, h = std::max(1, int(std::lround(size * ext[a2] / ext[a1])));
+  int w = size, h = int(std::clamp(std::lround(size * ext[a2] / ext[a1]), 1L, 16384L));
   Image img(w, h, 3);
   Vec3 n{0, 0, 0};
   n[axis] = normal_sign;
@@ -245,6 +247,9 @@ void setup_slice(CLI::App& app) {
     try { val = std::stod(o->plane.substr(eq + 1)); } catch (const std::exception&) {
       fail(ErrorKind::Value, "--plane: \"{}\" is not a number", o->plane.substr(eq + 1));
     }
+    if (!std::isfinite(val) || std::abs(val) > kMaxCoordinate)
+      fail(ErrorKind::Value, "--plane: {} must be a finite coordinate within ±{:g} m", o->plane, kMaxCoordinate);
+    if (o->size < 1 || o->size > 16384) fail(ErrorKind::Value, "--size {}: expected 1 to 16384 pixels", o->size);
     Image img = irradiance_slice(g, axis, val, o->size, o->down ? -1 : 1);
     std::string ext = fs::path(o->out).extension().string();
     if (ext == ".png" || ext == ".jpg") io::write_image(o->out, io::tonemap(img));

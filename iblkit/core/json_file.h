@@ -25,6 +25,17 @@ inline nlohmann::json read_json_file(const std::string& path) {
   }
 }
 
+// nlohmann's message without its "[json.exception.type_error.302] " tag, for messages that name the
+// file and the field themselves: "type must be number, but is string".
+inline std::string json_error_text(const nlohmann::json::exception& e) {
+  std::string s = e.what();
+  if (s.rfind("[json.exception.", 0) == 0) {
+    auto k = s.find("] ");
+    if (k != std::string::npos) s = s.substr(k + 2);
+  }
+  return s;
+}
+
 // Fails (ErrorKind::Format) unless j is an object whose "format" is `format`, e.g. "iblkit.probes/1".
 inline void require_format(const nlohmann::json& j, const std::string& path, const std::string& format) {
   if (!j.is_object() || j.value("format", "") != format)

@@ -5,6 +5,7 @@
 namespace ibl::render {
 
 void check_objects(const FrameDesc& d) {
+  geometry::require_camera(d.camera);
   for (size_t i = 0; i < d.objects.size(); ++i) {
     const geometry::TriMesh* m = d.objects[i].mesh;
     if (!m) fail(ErrorKind::Value, "object {} has no mesh", i);

@@ -1,0 +1,62 @@
+#!/usr/bin/env bash
+# Issue 19's crash list, kept (CTest cli_robust): every input that once aborted inside Embree,
+# segfaulted in the SH grid lookup or ran out of memory now fails with a one-line message.
+set -u
+source "$(dirname "$0")/cli_check.sh" "$1"
+BIN=$(realpath "$BIN"); cd "$T"
+
+# The issue's setup, smaller where the size does not matter.
+"$BIN" lab capture low-scene2 --grid 2,2,2 --mapping mirrorball --size 16 --out cap >/dev/null 2>&1 &&
+  "$BIN" ilf build cap/sequence.json --grid 4 --bands 3 --out room.shgrid >/dev/null 2>&1 || { echo "FAIL setup ilf"; exit 1; }
+"$BIN" lab capture t-corridor --fusion --probe 0,1.5,-1 --probe 0,1.5,5 --size 16 --out tc >/dev/null 2>&1 || { echo "FAIL setup fusion"; exit 1; }
+"$BIN" nearfield simulate flashlight --grid 3x3 --resolution 16 --out nf/nf.json >/dev/null 2>&1 || { echo "FAIL setup nearfield"; exit 1; }
+
+# Non-finite or huge coordinates (Embree's ray.valid() abort).
+for v in nan inf 1e30; do
+  check "probe-$v" fail "--probe|probe position" -- "$BIN" lab capture low-scene2 --probe "$v,1,0" --size 8 --out c
+  check "truth-$v" fail "--at|ground-truth position" -- "$BIN" lab truth low-scene2 --at "$v,1,0" --size 8
+  check "random-volume-$v" fail "volume" -- "$BIN" lab capture low-scene2 --random 3 --volume "$v,0,0;1,1,1" --size 8 --out c
+  check "grid-volume-$v" fail "volume" -- "$BIN" lab capture low-scene2 --grid 2,2,2 --volume "0,0,0;$v,1,1" --size 8 --out c
+  check "path-$v" fail "--path|path point 2" -- "$BIN" lab capture low-scene2 --path "0,1,0;$v,1,1" --size 8 --out c
+  check "fuse-at-$v" fail "--at|the point" -- "$BIN" fuse tc/probes.json --at "$v,1.5,1" --out f.exr
+  check "fuse-eval-$v" fail "--at|evaluation point" -- "$BIN" fuse eval tc/probes.json --scene t-corridor --at "$v,1.5,1" --out ev
+  check "render-eye-$v" fail "--eye|camera eye" -- "$BIN" render blob --light room.shgrid --eye "$v,1,1" --truth low-scene2 --size 16x12 --out r.png
+  check "nearfield-eye-$v" fail "--eye|camera eye" -- "$BIN" nearfield render nf/nf.json --eye "$v,0,0" --out n.png
+  check "nearfield-at-$v" fail "--at|luminaire position" -- "$BIN" nearfield render nf/nf.json --at "$v,0,0" --out n.png
+  check "ilf-query-$v" fail "--at|not finite" -- "$BIN" ilf query room.shgrid --at "$v,1,0"
+  check "ilf-slice-$v" fail "--plane" -- "$BIN" ilf slice room.shgrid --plane "y=$v" --out s.png
+done
+check render-eye-1e30-gl fail "camera eye" -- "$BIN" render blob --light room.shgrid --eye 1e30,1,1 --size 16x12 --out r.png
+printf '[[0,1.5,0],[1e30,1.5,1]]' > path.json
+check path-file-1e30 fail "point 2" -- "$BIN" fuse tc/probes.json --path path.json --out pf
+python3 - <<'PY'
+import json
+j = json.load(open("tc/probes.json")); j["probes"][1]["position"] = [1e30, 1.5, 5]
+json.dump(j, open("tc/far.json", "w"))
+PY
+check probe-set-1e30 fail 'probes\[1\]: field "position"' -- "$BIN" fuse tc/far.json --at 0,1.5,1 --out f.exr
+
+# The SH grid: a header with min/max ±1e308, and one that declares 200³ points in a 256-byte file.
+python3 - <<'PY'
+import json
+def mk(name, hdr, nbytes):
+    h = "IBLKIT-SHGRID 1\n" + json.dumps(dict(hdr, dtype="float32", layout="z,y,x,coefficient,channel"))
+    total = ((len(h) + 1 + 63) // 64) * 64
+    open(name, "wb").write((h + " " * (total - len(h) - 1) + "\n").encode() + b"\0" * nbytes)
+mk("huge.shgrid", dict(bands=1, resolution=[2, 2, 2], min=[-1e308] * 3, max=[1e308] * 3), 96)
+mk("big.shgrid", dict(bands=5, resolution=[200, 200, 200], min=[0, 0, 0], max=[1, 1, 1]), 128)
+PY
+check shgrid-1e308-info fail '"min", "max"' -- "$BIN" ilf info huge.shgrid
+check shgrid-1e308-query fail '"min", "max"' -- "$BIN" ilf query huge.shgrid --at 0,0,0
+check shgrid-declared-size fail "truncated: the header declares 200x200x200" -- "$BIN" ilf info big.shgrid
+
+# Sizes bounded before allocation.
+check capture-grid-huge fail "exceeds the 1e\+06.*choose fewer grid points" -- "$BIN" lab capture low-scene2 --grid 100000,100000,100000 --out c
+check capture-random-huge fail "exceeds the 1e\+06.*random probe count" -- "$BIN" lab capture low-scene2 --random 1000000000 --out c
+printf '{"format":"iblkit.scene/1","name":"t","surfaces":[{"type":"sphere","name":"s","center":[0,1,0],"radius":0.5,"rings":100000,"segments":100000}]}' > bigsphere.json
+check sphere-rings-huge fail "surfaces\[0\]: a sphere of 100000 rings.*choose fewer rings" -- "$BIN" lab capture bigsphere.json --probe 0,1,0 --size 8 --out c
+printf '{"format":"iblkit.scene/1","name":"t","surfaces":[{"type":"sphere","name":"s","center":[0,1,0],"radius":0.5,"rings":1e20}]}' > bigsphere2.json
+check sphere-rings-1e20 fail "surfaces\[0\]\.rings: expected a whole number" -- "$BIN" lab capture bigsphere2.json --probe 0,1,0 --size 8 --out c
+
+echo "$pass passed, $fail failed, $skip skipped"
+[ $fail -eq 0 ]
