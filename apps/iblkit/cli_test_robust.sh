@@ -28,6 +28,7 @@ for v in nan inf 1e30; do
 done
 check render-eye-1e30-gl fail "camera eye" -- "$BIN" render blob --light room.shgrid --eye 1e30,1,1 --size 16x12 --out r.png
 printf '[[0,1.5,0],[1e30,1.5,1]]' > path.json
+printf '[[0,1.5,0],[0,1.5,1]]' > path2.json
 check path-file-1e30 fail "point 2" -- "$BIN" fuse tc/probes.json --path path.json --out pf
 python3 - <<'PY'
 import json
@@ -57,6 +58,30 @@ printf '{"format":"iblkit.scene/1","name":"t","surfaces":[{"type":"sphere","name
 check sphere-rings-huge fail "surfaces\[0\]: a sphere of 100000 rings.*choose fewer rings" -- "$BIN" lab capture bigsphere.json --probe 0,1,0 --size 8 --out c
 printf '{"format":"iblkit.scene/1","name":"t","surfaces":[{"type":"sphere","name":"s","center":[0,1,0],"radius":0.5,"rings":1e20}]}' > bigsphere2.json
 check sphere-rings-1e20 fail "surfaces\[0\]\.rings: expected a whole number" -- "$BIN" lab capture bigsphere2.json --probe 0,1,0 --size 8 --out c
+
+# Values that once passed and should not.
+check convert-size-16384 fail "would allocate .* GB.*choose a smaller --size" -- "$BIN" convert "$T/tc/probes/p0.exr" x.exr --mapping hcross --size 16384
+check ilf-kernel-1e9 fail "kernel.*would allocate.*kernel_cells" -- "$BIN" ilf build cap/sequence.json --grid 4 --bands 3 --kernel 1e9 --out k.shgrid
+check preview-exposure-nan fail "exposure" -- "$BIN" preview tc/probes/p0.exr p.png --exposure nan
+for v in nan -1; do
+  check "lights-min-separation-$v" fail "minimum separation" -- "$BIN" lights tc/probes/p0.exr --min-separation "$v" --out l.json
+  check "ilf-subsample-$v" fail "subsample: threshold" -- "$BIN" ilf build cap/sequence.json --grid 4 --bands 3 --subsample "$v" --out k.shgrid
+  check "fuse-tau-$v" fail "time constant" -- "$BIN" fuse tc/probes.json --path "$T/path2.json" --tau "$v" --out pf
+  check "render-albedo-$v" fail "albedo" -- "$BIN" render blob --light tc/probes/p0.exr --albedo "$v,0.5,0.5" --backend cpu --size 16x12 --out r.png
+done
+check fuse-lights-huge ok "warning: --lights 1000000: .* gives only" -- "$BIN" fuse tc/probes.json --at 0,1.5,1 --lights 1000000 --out f.exr
+printf '{"format":"iblkit.sh/1","bands":0,"coefficients":[]}' > sh0.json
+check sh-bands-0 fail '"bands" must be in 1' -- "$BIN" render blob --light sh0.json --backend cpu --size 16x12 --out r.png
+python3 - <<'PY'
+import struct
+def pfm(name, w, h, vals):
+    open(name, "wb").write(f"PF\n{w} {h}\n-1.0\n".encode() + struct.pack("<%df" % len(vals), *vals))
+v = [1.0] * 24; v[4] = 3e38
+pfm("huge.pfm", 4, 2, v)
+pfm("ball1.pfm", 1, 1, [1.0] * 3)
+PY
+check pixel-3e38 fail "pixel \(1, 1\) channel 1 is above 1e20" -- "$BIN" lights huge.pfm --out l.json
+check mirror-ball-1x1 ok "12.566" -- "$BIN" info ball1.pfm --in-mapping mirrorball
 
 echo "$pass passed, $fail failed, $skip skipped"
 [ $fail -eq 0 ]

@@ -98,7 +98,8 @@ void setup_build(CLI::App& app) {
     std::string grid = bd.nx == bd.ny && bd.ny == bd.nz ? std::to_string(bd.nx) : fmt::format("{},{},{}", bd.nx, bd.ny, bd.nz);
     std::string repair = ilf::repair_name(bd.project.repair), memory = format_bytes(bd.buckets.memory_bytes);
     std::string directions = directions_name(bd.buckets.octahedral);
-    double subsample = -1, subsample_dist = ilf::SubsampleDesc{}.max_distance;  // subsample < 0: off
+    double subsample = -1, subsample_dist = ilf::SubsampleDesc{}.max_distance;  // off unless given
+    CLI::Option* subsample_opt = nullptr;
     bool no_reuse = !bd.buckets.reuse;
   };
   auto* o = new Opts();
@@ -115,7 +116,7 @@ void setup_build(CLI::App& app) {
   app.add_option("--memory", o->memory, "peak memory budget (e.g. 2G, 512M)")->capture_default_str();
   app.add_option("--buckets", o->buckets, "folder for the direction buckets (default: OUT.buckets; reused by re-runs)");
   app.add_option("--directions", o->directions, "direction buckets: auto, pixel (one per probe pixel, the paper's) or N (N×N octahedral cells)")->capture_default_str();
-  app.add_option("--subsample", o->subsample, "drop probes whose difference energy to both neighbours is below this (e.g. 0.05)");
+  o->subsample_opt = app.add_option("--subsample", o->subsample, "drop probes whose difference energy to both neighbours is below this (e.g. 0.05)");
   app.add_option("--subsample-distance", o->subsample_dist, "… and whose neighbours lie within this many metres")->capture_default_str();
   app.add_option("--vdb", o->vdb, "also write the grid as OpenVDB (one Vec3f grid per coefficient)");
   app.add_flag("--skip-bad", bd0.buckets.skip_bad, "skip bad probes (missing/unreadable frames, wrong size, NaN, outside the volume, duplicates) and report how many");
@@ -139,7 +140,7 @@ void setup_build(CLI::App& app) {
       if (v.size() != 1 || v[0] < 2 || v[0] > 1024) fail(ErrorKind::Value, "--directions: expected auto, pixel or N in [2, 1024]");
       bd.buckets.octahedral = v[0];
     }
-    if (o->subsample >= 0) bd.subsample = ilf::SubsampleDesc{o->subsample, o->subsample_dist};
+    if (o->subsample_opt->count() > 0) bd.subsample = ilf::SubsampleDesc{o->subsample, o->subsample_dist};
     ilf::SequenceReadDesc rd;
     rd.skip_bad = bd.buckets.skip_bad;
     ilf::SequenceReport srep;

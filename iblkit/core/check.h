@@ -58,8 +58,11 @@ inline double require_number(std::string_view what, double v, double lo, double 
 
 // This machine's physical memory in bytes (16 GB when the system does not say).
 inline double physical_memory() {
-  long pages = sysconf(_SC_PHYS_PAGES), size = sysconf(_SC_PAGE_SIZE);
-  return pages > 0 && size > 0 ? double(pages) * double(size) : 16e9;
+  static const double bytes = [] {
+    long pages = sysconf(_SC_PHYS_PAGES), size = sysconf(_SC_PAGE_SIZE);
+    return pages > 0 && size > 0 ? double(pages) * double(size) : 16e9;
+  }();
+  return bytes;
 }
 
 // Fails (ErrorKind::Value) before an allocation of `count` items of `bytes_each` bytes that exceeds
