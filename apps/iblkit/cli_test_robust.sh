@@ -83,5 +83,39 @@ PY
 check pixel-3e38 fail "pixel \(1, 1\) channel 1 is above 1e20" -- "$BIN" lights huge.pfm --out l.json
 check mirror-ball-1x1 ok "12.566" -- "$BIN" info ball1.pfm --in-mapping mirrorball
 
+# Messages: one line naming the file, the field and the value; never nlohmann's raw text; hints name
+# the flags the command has.
+nojson() { ! grep -q "json.exception" <<<"$("$@" 2>&1)"; }
+printf '[1,2]' > arr.json
+check msg-lighting-array fail "arr.json: expected a JSON object" -- "$BIN" render blob --light arr.json --backend cpu --size 16x12 --out r.png
+printf '{"format":"iblkit.sequence/1","mapping":3,"probes":[]}' > seqmap.json
+check msg-sequence-mapping fail 'seqmap.json: field "mapping" must be a string, got 3' -- "$BIN" ilf build seqmap.json --out q.shgrid
+python3 - <<'PY'
+import json
+j = json.load(open("tc/probes.json")); j["dead_angle_deg"] = "a"; json.dump(j, open("tc/dead.json", "w"))
+j = json.load(open("tc/probes.json")); j["probes"][0]["position"] = [0, 1, "a"]; json.dump(j, open("tc/pos.json", "w"))
+PY
+check msg-probes-dead-angle fail 'dead.json: field "dead_angle_deg" must be a number, got "a"' -- "$BIN" fuse tc/dead.json --at 0,1.5,1 --out f.exr
+check msg-probes-position fail 'pos.json: probes\[0\]: field "position"' -- "$BIN" fuse tc/pos.json --at 0,1.5,1 --out f.exr
+printf '{"format":"iblkit.lights/1","method":7,"lights":[]}' > lm.json
+check msg-lights-method fail 'lm.json: field "method" must be a string' -- "$BIN" render blob --light lm.json --backend cpu --size 16x12 --out r.png
+printf '{"format":"iblkit.lights/1","lights":[{"direction":[0,1,0],"irradiance":[1,1,1],"solid_angle":"x"}]}' > ls.json
+check msg-lights-solid-angle fail 'ls.json: lights\[0\]: field "solid_angle" must be a number' -- "$BIN" render blob --light ls.json --backend cpu --size 16x12 --out r.png
+printf '{"format":"iblkit.sh/1","bands":1}' > shc.json
+check msg-sh-coefficients fail 'shc.json: "coefficients" must be an array' -- "$BIN" render blob --light shc.json --backend cpu --size 16x12 --out r.png
+printf '{"format":"iblkit.scene/1","name":"t","volume":{"min":[-1,0,-1],"max":[1,2,1]}}' > nosurf.json
+check msg-scene-prefix fail '^iblkit: error: [^ ]*nosurf.json: surfaces: missing' -- "$BIN" lab capture nosurf.json --probe 0,1,0 --size 8 --out c
+printf '{"format":"iblkit.scene/1","name":"t","proxy":3,"surfaces":[]}' > sproxy.json
+check msg-scene-proxy fail 'sproxy.json: proxy: expected a file name' -- "$BIN" lab capture sproxy.json --probe 0,1,0 --size 8 --out c
+check msg-sanitize-hint fail "; --sanitize replaces such values" -- "$BIN" info huge.pfm
+check msg-unknown-subcommand fail "unknown subcommand 'bogus' of iblkit \(see iblkit --help\)" -- "$BIN" bogus
+check msg-unknown-group-subcommand fail "unknown subcommand 'bogus' of iblkit lab" -- "$BIN" lab bogus
+for f in arr.json seqmap.json tc/dead.json lm.json ls.json shc.json sproxy.json; do
+  if nojson "$BIN" render blob --light "$f" --backend cpu --size 16x12 --out r.png && nojson "$BIN" ilf build "$f" --out q.shgrid &&
+     nojson "$BIN" fuse "$f" --at 0,1.5,1 --out f.exr && nojson "$BIN" lab capture "$f" --probe 0,1,0 --size 8 --out c; then
+    pass=$((pass+1))
+  else echo "FAIL msg-raw-json $f: a message shows nlohmann's raw text"; fail=$((fail+1)); fi
+done
+
 echo "$pass passed, $fail failed, $skip skipped"
 [ $fail -eq 0 ]

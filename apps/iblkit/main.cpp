@@ -33,10 +33,12 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
+    const std::string unknown = iblcli::unknown_subcommand(app, argc, argv);
+    if (!unknown.empty()) return std::fprintf(stderr, "iblkit: error: %s\n", unknown.c_str()), 1;
     return app.exit(e);
   } catch (const ibl::Error& e) {
     iblcli::progress_done();
-    std::fprintf(stderr, "iblkit: error: %s\n", e.what());
+    std::fprintf(stderr, "iblkit: error: %s\n", iblcli::for_command(app, e.what()).c_str());
     return 1;
   } catch (const std::exception& e) {
     iblcli::progress_done();

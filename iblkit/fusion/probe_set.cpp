@@ -209,7 +209,7 @@ ProbeSet load_probe_set(const std::string& manifest, const LoadDesc& desc) {
     if (!k) fail(ErrorKind::Format, "{}: unknown mapping \"{}\"", manifest, j["mapping"].get<std::string>());
     rd.mapping = *k;
   }
-  rd.dead_angle_deg = j.value("dead_angle_deg", 0.0);
+  rd.dead_angle_deg = opt_field(j, manifest, "dead_angle_deg", 0.0);
   std::vector<bool> write_cache;
   size_t n = j["probes"].size();
   for (size_t k = 0; k < n; ++k) {

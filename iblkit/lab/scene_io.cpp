@@ -119,12 +119,12 @@ int wall_axis(const std::string& w, bool* at_max, const Ctx& c) {
 
 Surface surface(const json& j, const Ctx& c) {
   Surface s;
-  std::string type = j.value("type", "");
-  s.name = j.value("name", type);
+  std::string type = opt_field(j, c.file + ": " + c.where, "type", "");
+  s.name = opt_field(j, c.file + ": " + c.where, "name", type);
   s.albedo = texture(j, c);
   s.emission = vec3(j, "emission", c, Vec3{});
   nonneg(s.emission, "emission", c);
-  s.proxy = j.value("proxy", true);
+  s.proxy = opt_field(j, c.file + ": " + c.where, "proxy", true);
   if (type == "room" || type == "box") {
     geometry::RoomDesc r;
     r.lo = vec3(j, "min", c);
@@ -132,7 +132,7 @@ Surface surface(const json& j, const Ctx& c) {
     if (j.contains("openings"))
       for (const json& o : j["openings"]) {
         geometry::Opening op;
-        op.axis = wall_axis(o.value("wall", ""), &op.at_max, c);
+        op.axis = wall_axis(opt_field(o, c.file + ": " + c.where, "wall", ""), &op.at_max, c);
         op.lo = vec2(o, "min", c);
         op.hi = vec2(o, "max", c);
         r.openings.push_back(op);
@@ -153,15 +153,15 @@ Surface surface(const json& j, const Ctx& c) {
                                  count(j, "segments", c, 64, 3, 1000000));
   } else if (type == "sphere") {
     s.mesh = geometry::make_sphere(vec3(j, "center", c), num(j, "radius", c), count(j, "rings", c, 32, 2, 1000000),
-                                   count(j, "segments", c, 64, 3, 1000000), j.value("inward", false));
+                                   count(j, "segments", c, 64, 3, 1000000), opt_field(j, c.file + ": " + c.where, "inward", false));
   } else if (type == "cylinder") {
     s.mesh = geometry::make_cylinder(vec3(j, "base", c), vec3(j, "axis", c), num(j, "radius", c),
-                                     count(j, "segments", c, 48, 3, 1000000), j.value("caps", true));
+                                     count(j, "segments", c, 48, 3, 1000000), opt_field(j, c.file + ": " + c.where, "caps", true));
   } else if (type == "mesh") {
     if (!j.contains("file")) c.bad("file", "missing");
     s.mesh = geometry::read_mesh(c.rel(j["file"].get<std::string>()));
     s.mesh.transform(rotation_deg(j, c), num(j, "scale", c, 1.0), vec3(j, "translate", c, Vec3{}));
-    if (j.value("flip", false)) s.mesh.flip();
+    if (opt_field(j, c.file + ": " + c.where, "flip", false)) s.mesh.flip();
   } else {
     c.bad("type", "unknown surface type \"" + type + "\" (room, box, quad, disc, sphere, cylinder, mesh)");
   }
@@ -178,11 +178,11 @@ Pattern pattern(const std::string& p, const Ctx& c) {
 
 Emitter emitter(const json& j, const Ctx& c) {
   Emitter e;
-  std::string type = j.value("type", "");
-  e.name = j.value("name", type);
+  std::string type = opt_field(j, c.file + ": " + c.where, "type", "");
+  e.name = opt_field(j, c.file + ": " + c.where, "name", type);
   if (type == "area") {
     e.type = EmitterType::Area;
-    std::string shape = j.value("shape", "quad");
+    std::string shape = opt_field(j, c.file + ": " + c.where, "shape", "quad");
     if (shape != "quad" && shape != "disc") c.bad("shape", "expected quad or disc");
     e.disc = shape == "disc";
     e.center = vec3(j, "center", c);
@@ -265,11 +265,11 @@ Scene load_scene(const std::string& name_or_path, bool build) {
   std::string path = resolve_scene_path(name_or_path);
   const json j = read_json_file(path);
   Ctx c{path, fs::path(path).parent_path(), ""};
-  if (j.value("format", "") != "iblkit.scene/1") c.bad("format", "expected \"iblkit.scene/1\"");
+  if (!j.is_object() || !j.contains("format") || j["format"] != "iblkit.scene/1") c.bad("format", "expected \"iblkit.scene/1\"");
   Scene s;
   s.source = path;
-  s.name = j.value("name", fs::path(path).stem().string());
-  s.description = j.value("description", "");
+  s.name = opt_field(j, path, "name", fs::path(path).stem().string());
+  s.description = opt_field(j, path, "description", "");
   try {
     if (j.contains("volume")) {
       c.where = "volume";
