@@ -117,5 +117,17 @@ for f in arr.json seqmap.json tc/dead.json lm.json ls.json shc.json sproxy.json;
   else echo "FAIL msg-raw-json $f: a message shows nlohmann's raw text"; fail=$((fail+1)); fi
 done
 
+# The ilf, lab and nearfield group examples as their --help writes them, and the README's Fig. 9
+# example (the camera now looks at --at; only the frame size is made smaller here).
+mkdir -p ex && cd ex
+for g in ilf lab nearfield; do
+  while IFS= read -r line; do
+    read -ra words <<<"${line#*iblkit }"
+    check "example-$g: ${line#*iblkit }" ok "" -- "$BIN" "${words[@]}"
+  done < <("$BIN" "$g" --help | sed -n '/^Examples:/,$p' | grep '^  iblkit ')
+done
+check readme-fig9 ok "object relative L1" -- "$BIN" render blob --light room.shgrid --at 0,0.85,0 --object-size 0.35 --truth low-scene2 --size 160x120 --out fig9.png
+cd ..
+
 echo "$pass passed, $fail failed, $skip skipped"
 [ $fail -eq 0 ]

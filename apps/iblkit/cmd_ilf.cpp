@@ -313,6 +313,9 @@ void setup_synth(CLI::App& app) {
 
 void setup(CLI::App& app) {
   app.require_subcommand(1);
+  app.footer("Examples:\n  iblkit lab capture low-scene2 --grid 4,4,4 --mapping mirrorball --size 64 --out cap\n"
+             "  iblkit ilf build cap/sequence.json --grid 16 --bands 5 --out room.shgrid\n"
+             "  iblkit ilf query room.shgrid --at 0,1,0");
   setup_build(*app.add_subcommand("build", "Resample a probe sequence into an SH grid (.shgrid)"));
   setup_query(*app.add_subcommand("query", "SH, irradiance, radiance and glossy response at a point of a grid"));
   setup_slice(*app.add_subcommand("slice", "Irradiance on a plane through the grid, as a picture"));
