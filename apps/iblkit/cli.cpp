@@ -1,5 +1,6 @@
 #include "cli.h"
 
+#include <cmath>
 #include <unistd.h>
 
 #include <algorithm>
@@ -108,6 +109,8 @@ ibl::Vec3 parse_vec3(const std::string& s, const std::string& what) {
   }
   if (i != 3 || std::getline(ss, part, ','))
     ibl::fail(ibl::ErrorKind::Value, "{} '{}': expected three numbers x,y,z", what, s);
+  if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
+    ibl::fail(ibl::ErrorKind::Value, "{} '{}': the numbers must be finite", what, s);
   return v;
 }
 
@@ -150,6 +153,55 @@ std::string default_probe() {
     if (fs::exists(c)) return c;
   ibl::fail(ibl::ErrorKind::Io,
             "no built-in probe found: install Debian's blender-data (scripts/install-deps) or pass a probe file");
+}
+
+std::string unknown_subcommand(CLI::App& app, int argc, char** argv) {
+  CLI::App* cur = &app;
+  std::string path = "iblkit";
+  for (int i = 1; i < argc; ++i) {
+    std::string a = argv[i];
+    if (a.empty() || a[0] == '-') continue;
+    if (cur->get_subcommands({}).empty()) return "";  // a leaf: the rest are its arguments
+    CLI::App* sub = nullptr;
+    for (CLI::App* s : cur->get_subcommands({}))
+      if (s->get_name() == a) sub = s;
+    if (!sub) return fmt::format("unknown subcommand '{}' of {} (see {} --help)", a, path, path);
+    cur = sub;
+    path += " " + a;
+  }
+  return "";
+}
+
+namespace {
+// The subcommand that ran: the deepest parsed one.
+CLI::App* ran(CLI::App& app) {
+  CLI::App* cur = &app;
+  for (bool more = true; more;) {
+    more = false;
+    for (CLI::App* s : cur->get_subcommands()) {
+      cur = s;
+      more = true;
+      break;
+    }
+  }
+  return cur;
+}
+void replace_all(std::string& s, const std::string& from, const std::string& to) {
+  for (size_t k = s.find(from); k != std::string::npos; k = s.find(from, k + to.size())) s.replace(k, from.size(), to);
+}
+}  // namespace
+
+std::string for_command(CLI::App& app, const std::string& message) {
+  std::string m = message;
+  const bool has_sanitize = ran(app)->get_option_no_throw("--sanitize") != nullptr;
+  if (has_sanitize) {
+    replace_all(m, "with sanitize replaces", "with --sanitize replaces");
+    replace_all(m, "; sanitize replaces", "; --sanitize replaces");
+  } else {
+    replace_all(m, " (reading it with sanitize replaces such values by 0)", "");
+    replace_all(m, "; sanitize replaces such values by 0", "");
+  }
+  return m;
 }
 
 }  // namespace iblcli

@@ -69,6 +69,14 @@ std::vector<int> parse_int_list(const std::string& s, const std::string& what); 
 // Adds --mapping, --dead-angle, --sanitize to an app and returns the read settings they fill.
 ibl::io::EnvReadDesc& add_probe_read_options(CLI::App& app);
 
+// When argv names a subcommand that does not exist ("iblkit bogus", "iblkit lab bogus"), the message
+// "unknown subcommand 'bogus' of iblkit lab (see iblkit lab --help)"; else "".
+std::string unknown_subcommand(CLI::App& app, int argc, char** argv);
+// A library message as the user of this command line should read it: the library's parameter hints
+// ("sanitize replaces such values by 0") become the flag the command that ran has ("--sanitize …"),
+// or are dropped where it has none.
+std::string for_command(CLI::App& app, const std::string& message);
+
 // Path of a real probe to use when none is given: blender-data's, else shared/probes.
 std::string default_probe();
 

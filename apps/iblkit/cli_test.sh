@@ -6,7 +6,7 @@ set -u
 source "$(dirname "$0")/cli_check.sh" "$1"
 
 check help ok "Subcommands" -- "$BIN" --help
-subcommands() { "$@" --help | awk '/^Subcommands:/{f=1;next} f&&NF{print $1}'; }
+subcommands() { "$@" --help | awk '/^Subcommands:/{f=1;next} f&&/^[^ ]/{f=0} f&&NF{print $1}'; }  # up to "Examples:"
 for sub in $(subcommands "$BIN"); do
   nested=$(subcommands "$BIN" "$sub")
   if [ -z "$nested" ]; then

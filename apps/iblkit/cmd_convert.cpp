@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include "cli.h"
+#include "iblkit/core/check.h"
 #include "iblkit/core/error.h"
 #include "iblkit/io/envmap_io.h"
 #include "iblkit/sphere/envmap.h"
@@ -56,6 +57,9 @@ void setup(CLI::App& app) {
       size = std::max(1, static_cast<int>(std::sqrt(pixels / per)));
     }
     auto dst = output_mapping(k, size);
+    // the resampled image, the map's copy of it and its solid angles
+    ibl::require_allocation(fmt::format("--size {}: a {} map of {}x{} pixels", size, ibl::sphere::mapping_name(k), dst.width(), dst.height()),
+                            double(dst.width()) * dst.height(), 3 * 3 * sizeof(float) + sizeof(double), "choose a smaller --size");
     ibl::sphere::EnvMap out(ibl::sphere::resample(src, dst), dst);
     if (o->faces) {
       ibl::io::write_cube_faces(o->out, out);

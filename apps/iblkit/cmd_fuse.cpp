@@ -116,6 +116,9 @@ void run_at(const FuseOpts& o, const std::string& probes, const std::string& at,
   ibl::lights::LightSet ls;
   if (nlights > 0) {
     ls = fu::localize_lights(ll, {nlights});
+    if (static_cast<int>(ls.lights.size()) < nlights)
+      iblcli::info(fmt::format("warning: --lights {}: the {}x{} map gives only {} lights (median cut cannot split further)", nlights,
+                               ll.radiance.image.width(), ll.radiance.image.height(), ls.lights.size()));
     ibl::lights::write_lights(base.string() + "_lights.json", ls);
     j["lights"] = base.string() + "_lights.json";
   }

@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "cli.h"
+#include "iblkit/core/check.h"
 #include "iblkit/core/error.h"
 #include "iblkit/ilf/analytic.h"
 #include "iblkit/ilf/build.h"
@@ -97,7 +98,8 @@ void setup_build(CLI::App& app) {
     std::string grid = bd.nx == bd.ny && bd.ny == bd.nz ? std::to_string(bd.nx) : fmt::format("{},{},{}", bd.nx, bd.ny, bd.nz);
     std::string repair = ilf::repair_name(bd.project.repair), memory = format_bytes(bd.buckets.memory_bytes);
     std::string directions = directions_name(bd.buckets.octahedral);
-    double subsample = -1, subsample_dist = ilf::SubsampleDesc{}.max_distance;  // subsample < 0: off
+    double subsample = -1, subsample_dist = ilf::SubsampleDesc{}.max_distance;  // off unless given
+    CLI::Option* subsample_opt = nullptr;
     bool no_reuse = !bd.buckets.reuse;
   };
   auto* o = new Opts();
@@ -114,7 +116,7 @@ void setup_build(CLI::App& app) {
   app.add_option("--memory", o->memory, "peak memory budget (e.g. 2G, 512M)")->capture_default_str();
   app.add_option("--buckets", o->buckets, "folder for the direction buckets (default: OUT.buckets; reused by re-runs)");
   app.add_option("--directions", o->directions, "direction buckets: auto, pixel (one per probe pixel, the paper's) or N (N×N octahedral cells)")->capture_default_str();
-  app.add_option("--subsample", o->subsample, "drop probes whose difference energy to both neighbours is below this (e.g. 0.05)");
+  o->subsample_opt = app.add_option("--subsample", o->subsample, "drop probes whose difference energy to both neighbours is below this (e.g. 0.05)");
   app.add_option("--subsample-distance", o->subsample_dist, "… and whose neighbours lie within this many metres")->capture_default_str();
   app.add_option("--vdb", o->vdb, "also write the grid as OpenVDB (one Vec3f grid per coefficient)");
   app.add_flag("--skip-bad", bd0.buckets.skip_bad, "skip bad probes (missing/unreadable frames, wrong size, NaN, outside the volume, duplicates) and report how many");
@@ -138,7 +140,7 @@ void setup_build(CLI::App& app) {
       if (v.size() != 1 || v[0] < 2 || v[0] > 1024) fail(ErrorKind::Value, "--directions: expected auto, pixel or N in [2, 1024]");
       bd.buckets.octahedral = v[0];
     }
-    if (o->subsample >= 0) bd.subsample = ilf::SubsampleDesc{o->subsample, o->subsample_dist};
+    if (o->subsample_opt->count() > 0) bd.subsample = ilf::SubsampleDesc{o->subsample, o->subsample_dist};
     ilf::SequenceReadDesc rd;
     rd.skip_bad = bd.buckets.skip_bad;
     ilf::SequenceReport srep;
@@ -180,6 +182,7 @@ void setup_query(CLI::App& app) {
   app.callback([o] {
     auto g = ilf::read_shgrid(o->grid);
     Vec3 p = iblcli::parse_vec3(o->at, "--at"), n = o->normal.empty() ? Vec3{0, 1, 0} : iblcli::parse_vec3(o->normal, "--normal");
+    require_point("--at", p);
     if (!g.grid().volume.contains(p)) iblcli::info("note: the point lies outside the grid volume; values are clamped to its boundary");
     auto c = g.coeffs_at(p);
     Vec3 e = g.irradiance(p, n);
@@ -210,7 +213,7 @@ Image irradiance_slice(const ilf::SHGrid& g, int axis, double value, int size, d
   const auto& v = g.grid().volume;
   int a1 = axis == 0 ? 2 : 0, a2 = axis == 1 ? 2 : 1;  // image x, y axes
   Vec3 ext = v.size();
-  int w = size, h = std::max(1, int(std::lround(size * ext[a2] / ext[a1])));
+  int w = size, h = int(std::clamp(std::lround(size * ext[a2] / ext[a1]), 1L, 16384L));
   Image img(w, h, 3);
   Vec3 n{0, 0, 0};
   n[axis] = normal_sign;
@@ -245,6 +248,9 @@ void setup_slice(CLI::App& app) {
     try { val = std::stod(o->plane.substr(eq + 1)); } catch (const std::exception&) {
       fail(ErrorKind::Value, "--plane: \"{}\" is not a number", o->plane.substr(eq + 1));
     }
+    if (!std::isfinite(val) || std::abs(val) > kMaxCoordinate)
+      fail(ErrorKind::Value, "--plane: {} must be a finite coordinate within ±{:g} m", o->plane, kMaxCoordinate);
+    if (o->size < 1 || o->size > 16384) fail(ErrorKind::Value, "--size {}: expected 1 to 16384 pixels", o->size);
     Image img = irradiance_slice(g, axis, val, o->size, o->down ? -1 : 1);
     std::string ext = fs::path(o->out).extension().string();
     if (ext == ".png" || ext == ".jpg") io::write_image(o->out, io::tonemap(img));
@@ -307,6 +313,9 @@ void setup_synth(CLI::App& app) {
 
 void setup(CLI::App& app) {
   app.require_subcommand(1);
+  app.footer("Examples:\n  iblkit lab capture low-scene2 --grid 4,4,4 --mapping mirrorball --size 64 --out cap\n"
+             "  iblkit ilf build cap/sequence.json --grid 16 --bands 5 --out room.shgrid\n"
+             "  iblkit ilf query room.shgrid --at 0,1,0");
   setup_build(*app.add_subcommand("build", "Resample a probe sequence into an SH grid (.shgrid)"));
   setup_query(*app.add_subcommand("query", "SH, irradiance, radiance and glossy response at a point of a grid"));
   setup_slice(*app.add_subcommand("slice", "Irradiance on a plane through the grid, as a picture"));

@@ -233,6 +233,8 @@ void run_photograph(const PhotoOpts& o) {
 
 void setup(CLI::App& app) {
   app.require_subcommand(1);
+  app.footer("Examples:\n  iblkit lab capture low-scene1 --probe 0,1,0 --size 128 --out cap\n"
+             "  iblkit lab truth low-scene1 --at 0,1,0 --out truth");
   auto* c = app.add_subcommand("capture", "Capture a probe, a probe sequence (iblkit.sequence/1) or a fusion probe set (iblkit.probes/1)");
   auto* co = new CaptureOpts();
   c->add_option("scene", co->scene, "scene file (iblkit.scene/1) or built-in name: low-scene1, low-scene2, t-corridor, crypt")->required();

@@ -331,6 +331,8 @@ void run_irradiance(const IrrOpts& o) {
 
 void setup(CLI::App& app) {
   app.require_subcommand(1);
+  app.footer("Examples:\n  iblkit nearfield simulate flashlight --grid 3x3 --resolution 16 --out nf/nf.json\n"
+             "  iblkit nearfield render nf/nf.json --out nf.png");
   auto* so = new SimOpts();
   auto* s = app.add_subcommand("simulate", "Simulate the acquisition of a lab luminaire: a dataset of filter positions (iblkit.nearfield/1)");
   s->add_option("luminaire", so->luminaire, "flashlight or bikelight")->capture_default_str();

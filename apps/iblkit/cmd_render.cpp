@@ -40,7 +40,7 @@ struct Opts {
   std::vector<std::string> lights;
   render::ObjectDesc object;             // scene, --object-size, --triangles (and --at)
   render::LightingReadDesc lighting;     // --bands, --shadows (and the probe read options, --luminaire…)
-  std::string out = "frame.png", backend = "auto", size = "1024x768", eye = "0,0.5,1.6", target = "0,0,0", at = "0,0,0";
+  std::string out = "frame.png", backend = "auto", size = "1024x768", eye, target, at = "0,0,0";  // eye, target empty: from --at
   int frames = 1, sh_table = 0;
   iblcli::ShadowMapOptions shadow_maps;
   double gloss = 0, exponent = 20;
@@ -108,9 +108,9 @@ void add_options(CLI::App& app, Opts* o) {
   app.add_option("--luminaire", o->luminaire, "a near-field dataset's luminaire: centre of its sampling plane, x,y,z")
       ->capture_default_str();
   app.add_option("--luminaire-dir", o->luminaire_dir, "the direction the luminaire shines, x,y,z")->capture_default_str();
-  app.add_option("--eye", o->eye, "camera position x,y,z")->capture_default_str();
+  app.add_option("--eye", o->eye, "camera position x,y,z (default: --at + (0, 0.5, 1.6), looking at the object)");
   app.add_option("--fov", o->fov, "vertical field of view, degrees")->check(CLI::Range(1.0, 170.0))->capture_default_str();
-  app.add_option("--target", o->target, "camera target x,y,z")->capture_default_str();
+  app.add_option("--target", o->target, "camera target x,y,z (default: --at)");
   app.footer("Examples:\n  iblkit render blob --light probe.exr --out blob.png --backend cpu --size 400x300\n"
              "  iblkit render blob --light lights.json --backend gl --frames 100 --out blob.exr\n"
              "  iblkit render blob --light grid.shgrid --at 0.5,0.3,0.5 --object-size 0.3 --eye 0.5,0.6,1.6 --target 0.5,0.3,0.5");
@@ -131,11 +131,12 @@ void make_scene(const Opts& o, Scene* s) {
   d.camera.width = w;
   d.camera.height = h;
   o.shadow_maps.apply(&d);
-  d.camera.eye = iblcli::parse_vec3(o.eye, "--eye");
-  d.camera.target = iblcli::parse_vec3(o.target, "--target");
-  d.camera.fov_y_deg = o.fov;
   render::ObjectDesc od = o.object;
   od.at = iblcli::parse_vec3(o.at, "--at");
+  // The camera looks at the object wherever --at puts it, unless --eye/--target say otherwise.
+  d.camera.target = o.target.empty() ? od.at : iblcli::parse_vec3(o.target, "--target");
+  d.camera.eye = o.eye.empty() ? od.at + Vec3{0, 0.5, 1.6} : iblcli::parse_vec3(o.eye, "--eye");
+  d.camera.fov_y_deg = o.fov;
   if (!(od.size > 0) && (od.scene == "blob" || od.scene == "sphere")) fail(ErrorKind::Value, "--object-size must be > 0 for the {}", od.scene);
   s->object = render::make_object(od);
   Vec3 lo, hi;

@@ -75,9 +75,9 @@ void load_for(const Subcommand& s) {
       if (p) ibl::plugin::load(p);
 }
 
-int report(const std::exception& e) {
+int report(const std::string& what) {
   iblcli::progress_done();
-  std::fprintf(stderr, "iblkit: error: %s\n", e.what());
+  std::fprintf(stderr, "iblkit: error: %s\n", what.c_str());
   return 1;
 }
 
@@ -103,7 +103,7 @@ int main(int argc, char** argv) {
   try {
     if (chosen) load_for(*chosen);
   } catch (const ibl::Error& e) {
-    return report(e);
+    return report(e.what());
   }
   const auto& reg = iblcli::command_registry();
   for (const auto& c : reg)
@@ -126,9 +126,13 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
+    const std::string unknown = e.get_exit_code() != 0 ? iblcli::unknown_subcommand(app, argc, argv) : "";  // not for --help
+    if (!unknown.empty()) return std::fprintf(stderr, "iblkit: error: %s\n", unknown.c_str()), 1;
     return app.exit(e);
+  } catch (const ibl::Error& e) {
+    return report(iblcli::for_command(app, e.what()));  // the library's parameter hints as this command's flags
   } catch (const std::exception& e) {
-    return report(e);
+    return report(e.what());
   }
   return 0;
 }

@@ -13,6 +13,7 @@ using namespace ibl;
 
 LabPhotograph photograph_frame(const std::string& scene_path, const render::FrameDesc& d, int samples, int bounces,
                                const ProgressFn& progress) {
+  geometry::require_camera(d.camera);
   lab::Scene scene = lab::load_scene(scene_path, false);
   LabPhotograph p;
   for (size_t i = 0; i < d.objects.size(); ++i)

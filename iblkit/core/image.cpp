@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "iblkit/core/check.h"
 #include "iblkit/core/error.h"
 
 namespace ibl {
@@ -11,6 +12,8 @@ Image::Image(int width, int height, int channels, float fill)
     : width_(width), height_(height), channels_(channels) {
   if (width < 0 || height < 0 || channels < 1 || channels > 64)
     fail(ErrorKind::Value, "image size {}x{}x{} is invalid", width, height, channels);
+  require_allocation(fmt::format("an image of {}x{} pixels, {} channels,", width, height, channels), double(width) * height * channels,
+                     sizeof(float), "choose a smaller image size");
   data_.assign(static_cast<size_t>(width) * height * channels, fill);
 }
 

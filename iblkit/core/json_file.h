@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <type_traits>
 
 #include <nlohmann/json.hpp>
 
@@ -27,9 +28,58 @@ inline nlohmann::json read_json_file(const std::string& path) {
   }
 }
 
+// nlohmann's message without its "[json.exception.type_error.302] " tag, for messages that name the
+// file and the field themselves: "type must be number, but is string".
+inline std::string json_error_text(const nlohmann::json::exception& e) {
+  std::string s = e.what();
+  if (s.rfind("[json.exception.", 0) == 0) {
+    auto k = s.find("] ");
+    if (k != std::string::npos) s = s.substr(k + 2);
+  }
+  return s;
+}
+
+namespace detail {
+template <typename T>
+constexpr const char* json_kind() {
+  if constexpr (std::is_same_v<T, bool>) return "true or false";
+  else if constexpr (std::is_same_v<T, std::string>) return "a string";
+  else if constexpr (std::is_integral_v<T>) return "a whole number";
+  else return "a number";
+}
+template <typename T>
+bool json_is(const nlohmann::json& v) {
+  if constexpr (std::is_same_v<T, bool>) return v.is_boolean();
+  else if constexpr (std::is_same_v<T, std::string>) return v.is_string();
+  else if constexpr (std::is_integral_v<T>) return v.is_number_integer();
+  else return v.is_number();
+}
+}  // namespace detail
+
+// Field `key` of the object j as T (bool, a whole number, double, std::string); `def` when j has no
+// such field. ErrorKind::Format "WHERE: field \"key\" must be a number, got \"x\"" when it has another
+// type, and "WHERE: expected a JSON object" when j is not one (WHERE: the file, or "file: probes[2]").
+template <typename T>
+T opt_field(const nlohmann::json& j, const std::string& where, const char* key, T def) {
+  if (!j.is_object()) fail(ErrorKind::Format, "{}: expected a JSON object, got {}", where, j.type_name());
+  auto it = j.find(key);
+  if (it == j.end()) return def;
+  if (!detail::json_is<T>(*it)) fail(ErrorKind::Format, "{}: field \"{}\" must be {}, got {}", where, key, detail::json_kind<T>(), it->dump());
+  return it->template get<T>();
+}
+inline std::string opt_field(const nlohmann::json& j, const std::string& where, const char* key, const char* def) {
+  return opt_field<std::string>(j, where, key, std::string(def));
+}
+// The same for a field that must be present: "WHERE: field \"key\" is missing".
+template <typename T>
+T req_field(const nlohmann::json& j, const std::string& where, const char* key) {
+  if (j.is_object() && !j.contains(key)) fail(ErrorKind::Format, "{}: field \"{}\" is missing", where, key);
+  return opt_field<T>(j, where, key, T{});
+}
+
 // Fails (ErrorKind::Format) unless j is an object whose "format" is `format`, e.g. "iblkit.probes/1".
 inline void require_format(const nlohmann::json& j, const std::string& path, const std::string& format) {
-  if (!j.is_object() || j.value("format", "") != format)
+  if (!j.is_object() || !j.contains("format") || j["format"] != format)
     fail(ErrorKind::Format, "{}: not an {} file (\"format\" is missing or different)", path, format);
 }
 

@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "iblkit/core/check.h"
 #include "iblkit/core/error.h"
 #include "iblkit/lights/evaluate.h"
 #include "iblkit/sphere/pointset.h"
@@ -26,10 +27,9 @@ double image_rmse(const sphere::EnvMap& est, const sphere::EnvMap& truth) {
 }
 
 geometry::Camera view_camera(Vec3 x, Vec3 forward) {
-  if (!(length(forward) > 0) || !std::isfinite(length(forward)))
-    fail(ErrorKind::Value, "view direction ({}, {}, {}) must be finite and non-zero", forward.x, forward.y, forward.z);
+  require_point("view position", x);
+  const Vec3 f = require_direction("view direction", forward);
   geometry::Camera c;
-  const Vec3 f = normalize(forward);
   c.eye = x;
   c.target = x + f;
   c.up = std::abs(f.y) > 0.99 ? Vec3{0, 0, 1} : Vec3{0, 1, 0};
@@ -59,6 +59,7 @@ Image view_image(const geometry::Camera& c, const std::vector<Vec3>& L) {
 PointEval evaluate_point(const ProbeSet& set, Vec3 x, const Reference& ref, const EvalDesc& desc) {
   if (!ref.radiance_map) fail(ErrorKind::Value, "fusion evaluation: the reference has no radiance map");
   if (desc.view && !ref.radiance_along) fail(ErrorKind::Value, "fusion evaluation: a view needs the reference's radiance along rays");
+  require_point("evaluation point", x);
   static const std::vector<Vec3> normals = sphere::icosphere_face_centres(5);  // 20480 (Madsen & Laursen)
   PointEval pe;
   pe.truth = ref.radiance_map(x, desc.fuse.size);

@@ -3,6 +3,7 @@
 #include <atomic>
 #include <cmath>
 
+#include "iblkit/core/check.h"
 #include "iblkit/core/enum_names.h"
 #include "iblkit/core/error.h"
 #include "iblkit/core/fastmath.h"
@@ -273,7 +274,6 @@ class Fuser {
 };
 
 void check_x(const ProbeSet& set, Vec3 x) {
-  if (!std::isfinite(x.x) || !std::isfinite(x.y) || !std::isfinite(x.z)) fail(ErrorKind::Value, "fuse: the point is not finite");
   PointCheck c = check_point(set, x);
   if (c.backface > 0.5)
     fail(ErrorKind::Value,
@@ -285,6 +285,7 @@ void check_x(const ProbeSet& set, Vec3 x) {
 
 std::vector<Vec3> fuse_rays(const ProbeSet& set, Vec3 x, const std::vector<Vec3>& dirs, const FuseDesc& desc,
                             std::vector<PixelStatus>* status) {
+  require_point("fuse: the point", x);
   Fuser f(set, desc);
   std::vector<Vec3> out(dirs.size());
   if (status) status->assign(dirs.size(), PixelStatus::NoData);
@@ -297,13 +298,16 @@ std::vector<Vec3> fuse_rays(const ProbeSet& set, Vec3 x, const std::vector<Vec3>
 }
 
 Vec3 fuse_ray(const ProbeSet& set, Vec3 x, Vec3 omega, const FuseDesc& desc, PixelStatus* status) {
+  require_point("fuse: the point", x);
+  omega = require_direction("fuse: the direction", omega);
   Fuser f(set, desc);
-  RayOut r = f.shade(x, normalize(omega));
+  RayOut r = f.shade(x, omega);
   if (status) *status = r.status;
   return r.L;
 }
 
 LocalMap fuse(const ProbeSet& set, Vec3 x, const FuseDesc& desc) {
+  require_point("fuse: the point", x);
   sphere::Mapping m = output_mapping(desc.mapping, desc.size);
   Fuser fuser(set, desc);
   if (desc.check_point) check_x(set, x);

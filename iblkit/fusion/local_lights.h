@@ -21,9 +21,11 @@
 //
 //  [1] Pedersen, "Fusing environment maps for IBL in large scenes", MSc thesis, Aalborg 2008.
 #pragma once
+#include <cmath>
 #include <string>
 #include <vector>
 
+#include "iblkit/core/error.h"
 #include "iblkit/fusion/fuse.h"
 #include "iblkit/lights/light_set.h"
 
@@ -55,7 +57,10 @@ struct TrackDesc {
 // Frame-to-frame light tracking and filtering.
 class LightTracker {
  public:
-  explicit LightTracker(const TrackDesc& desc = {}) : desc_(desc) {}
+  explicit LightTracker(const TrackDesc& desc = {}) : desc_(desc) {
+    if (!(desc.time_constant > 0) || !std::isfinite(desc.time_constant))
+      fail(ErrorKind::Value, "light tracker: time constant {} must be a finite number > 0", desc.time_constant);
+  }
   // Takes frame k's raw lights (dt: time since the previous frame) and returns the filtered set, in the
   // raw set's order, with ids()[j] the track of light j (tracks keep their id for their whole life).
   lights::LightSet update(const lights::LightSet& raw, double dt);

@@ -2,6 +2,7 @@
 
 #include <chrono>
 
+#include "iblkit/core/check.h"
 #include "iblkit/core/error.h"
 
 namespace ibl::fusion {
@@ -13,6 +14,10 @@ PathResult fuse_path(const ProbeSet& set, const std::vector<PathPoint>& path, co
     fail(ErrorKind::Value, "fuse_path: the maps must be lat-long (the lights are cut from them), not {}",
          sphere::mapping_name(desc.fuse.mapping));
   if (desc.lights < 1) fail(ErrorKind::Value, "fuse_path: lights = {} must be at least 1", desc.lights);
+  for (size_t k = 0; k < path.size(); ++k) {
+    require_point(fmt::format("fuse_path: point {}", k + 1), path[k].position);
+    if (!std::isfinite(path[k].time)) fail(ErrorKind::Value, "fuse_path: point {} has time {}, not a finite number", k + 1, path[k].time);
+  }
   FuseDesc fd = desc.fuse;
   fd.progress = {};
   LightTracker raw_tr({false, desc.track.time_constant}), filt_tr(desc.track);

@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "iblkit/core/check.h"
 #include "iblkit/core/error.h"
 #include "iblkit/core/json_file.h"
 #include "iblkit/core/parallel.h"
@@ -102,6 +103,7 @@ Image trace_depth(const geometry::RayTracer& tracer, const sphere::Mapping& m, V
 
 PointCheck check_point(const ProbeSet& set, Vec3 x, int rays) {
   if (!set.tracer) fail(ErrorKind::Internal, "check_point: the probe set is not prepared");
+  require_point("the point", x);
   auto dirs = sphere::fibonacci_sphere(rays);
   int back = 0, hit = 0;
   for (Vec3 d : dirs) {
@@ -207,7 +209,7 @@ ProbeSet load_probe_set(const std::string& manifest, const LoadDesc& desc) {
     if (!k) fail(ErrorKind::Format, "{}: unknown mapping \"{}\"", manifest, j["mapping"].get<std::string>());
     rd.mapping = *k;
   }
-  rd.dead_angle_deg = j.value("dead_angle_deg", 0.0);
+  rd.dead_angle_deg = opt_field(j, manifest, "dead_angle_deg", 0.0);
   std::vector<bool> write_cache;
   size_t n = j["probes"].size();
   for (size_t k = 0; k < n; ++k) {
@@ -219,6 +221,7 @@ ProbeSet load_probe_set(const std::string& manifest, const LoadDesc& desc) {
     Probe p;
     p.image = (base / pj["image"].get<std::string>()).string();
     p.position = vec3_field(pj["position"], where + ": field \"position\"");
+    require_point(where + ": field \"position\"", p.position);
     if (pj.contains("rotation")) p.rotation = rotation_field(pj["rotation"], where + ": field \"rotation\"");
     p.radiance = io::read_envmap(p.image, rd);
     bool trace = desc.force_depth;

@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 
+#include "iblkit/core/check.h"
 #include "iblkit/core/vec.h"
 
 namespace ibl::geometry {
@@ -64,5 +65,20 @@ struct Camera {
     return m;
   }
 };
+
+// Fails (ErrorKind::Value) unless the camera's eye and target are points within the supported range
+// (core/check.h), distinct, its up direction is not parallel to the view and its field of view lies in
+// (0°, 180°). Every renderer calls this before it casts a ray.
+inline void require_camera(const Camera& c) {
+  require_point("camera eye", c.eye);
+  require_point("camera target", c.target);
+  Vec3 f = c.target - c.eye;
+  if (!(length(f) > 1e-9))
+    fail(ErrorKind::Value, "camera: eye and target are the same point ({}, {}, {})", c.eye.x, c.eye.y, c.eye.z);
+  Vec3 up = require_direction("camera up", c.up);
+  if (length(cross(normalize(f), up)) < 1e-9)
+    fail(ErrorKind::Value, "camera: up ({}, {}, {}) is parallel to the view direction", c.up.x, c.up.y, c.up.z);
+  if (!(c.fov_y_deg > 0 && c.fov_y_deg < 180)) fail(ErrorKind::Value, "camera: field of view {}° outside (0°, 180°)", c.fov_y_deg);
+}
 
 }  // namespace ibl::geometry

@@ -119,6 +119,27 @@ TEST(GeometryMesh, RenderObjectsCarryTheirNormals) {
   EXPECT_TRUE(floor.has_uvs());
 }
 
+// Issue 19: Embree aborts on a ray that is not finite or beyond 1.8e18; the ray tracer refuses it first.
+TEST(GeometryRayTracer, NonFiniteOrHugeRaysAreErrorsNotAborts) {
+  RayTracer rt;
+  rt.add(make_box({-1, -1, -1}, {1, 1, 1}, true));
+  rt.commit();
+  const double nan = std::nan("");
+  EXPECT_THROW(rt.intersect({nan, 0, 0}, {0, 1, 0}), Error);
+  EXPECT_THROW(rt.intersect({0, 0, 0}, {0, nan, 0}), Error);
+  EXPECT_THROW(rt.intersect({1e30, 0, 0}, {0, 1, 0}), Error);
+  EXPECT_THROW(rt.occluded({0, 0, 0}, {0, 1, 0}, nan, 1), Error);
+  EXPECT_THROW(rt.occluded({0, 0, 0}, {0, 1, 0}, 0, nan), Error);
+  EXPECT_TRUE(rt.intersect({0, 0, 0}, {0, 1, 0}).hit);
+}
+
+// A sphere of 1e5 × 1e5 quads is refused before anything is allocated.
+TEST(GeometryMesh, GeneratedMeshesAreBoundedBeforeAllocating) {
+  EXPECT_THROW(make_sphere({0, 0, 0}, 1, 100000, 100000), Error);
+  EXPECT_THROW(make_blob(2000000000), Error);
+  EXPECT_NO_THROW(make_sphere({0, 0, 0}, 1, 8, 16));
+}
+
 TEST(GeometryRayTracer, DistancesInsideABoxAreAnalytic) {
   Vec3 lo{-1, 0, -2}, hi{2, 3, 1}, o{0.3, 1.1, -0.4};
   RayTracer rt;

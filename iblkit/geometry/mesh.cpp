@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "iblkit/core/check.h"
 #include "iblkit/core/error.h"
 
 namespace ibl::geometry {
@@ -147,6 +148,16 @@ void add_rect(TriMesh& m, Vec3 p0, Vec3 eu, Vec3 ev, Vec2 uv0, Vec2 uv1, Vec3 fa
 
 Vec3 axis_vec(int k) { return {k == 0 ? 1.0 : 0.0, k == 1 ? 1.0 : 0.0, k == 2 ? 1.0 : 0.0}; }
 
+// A generated mesh of about `triangles` triangles: at most kMaxGeneratedTriangles, and within memory
+// (about 64 bytes a triangle with its vertices, normals, UVs and the ray tracer's copy).
+constexpr double kMaxGeneratedTriangles = 1e8;
+void check_triangles(double triangles, const std::string& what, const char* hint) {
+  if (triangles > kMaxGeneratedTriangles)
+    fail(ErrorKind::Value, "{}: {:.3g} triangles exceed the {:g} supported (about {:.3g} GB); {}", what, triangles,
+         kMaxGeneratedTriangles, triangles * 64 / 1e9, hint);
+  require_allocation(what, triangles, 64, hint);
+}
+
 void check_positive(double v, const char* what) {
   if (!(v > 0) || !std::isfinite(v)) fail(ErrorKind::Value, "{} must be positive and finite, got {}", what, v);
 }
@@ -169,6 +180,7 @@ TriMesh make_quad(Vec3 center, Vec3 normal, Vec3 up, double w, double h) {
 
 TriMesh make_disc(Vec3 center, Vec3 normal, double radius, int segments) {
   check_positive(radius, "disc radius");
+  check_triangles(segments, fmt::format("a disc of {} segments", segments), "choose fewer segments");
   Vec3 n = normalize(normal);
   if (length(n) == 0) fail(ErrorKind::Value, "disc normal is zero");
   Frame f = Frame::from_normal(n);
@@ -188,6 +200,7 @@ TriMesh make_disc(Vec3 center, Vec3 normal, double radius, int segments) {
 TriMesh make_sphere(Vec3 center, double radius, int rings, int segments, bool inward) {
   check_positive(radius, "sphere radius");
   if (rings < 2 || segments < 3) fail(ErrorKind::Value, "sphere needs ≥ 2 rings and ≥ 3 segments ({} and {} given)", rings, segments);
+  check_triangles(2.0 * rings * segments, fmt::format("a sphere of {} rings and {} segments", rings, segments), "choose fewer rings or segments");
   TriMesh m;
   for (int r = 0; r <= rings; ++r) {
     double th = kPi * r / rings;
@@ -217,6 +230,7 @@ TriMesh make_sphere(Vec3 center, double radius, int rings, int segments, bool in
 }
 
 TriMesh make_blob(int triangles, double size) {
+  check_triangles(triangles, fmt::format("a blob of {} triangles", triangles), "choose fewer triangles");
   // rings × segments × 2 ≈ triangles with segments = 2 rings.
   int rings = std::max(4, static_cast<int>(std::sqrt(triangles / 4.0)));
   int segments = 2 * rings;
@@ -243,6 +257,7 @@ TriMesh make_floor(double size, double height) {
 
 TriMesh make_cylinder(Vec3 base, Vec3 axis, double radius, int segments, bool caps) {
   check_positive(radius, "cylinder radius");
+  check_triangles(4.0 * segments, fmt::format("a cylinder of {} segments", segments), "choose fewer segments");
   check_positive(length(axis), "cylinder height");
   Vec3 a = normalize(axis);
   Frame f = Frame::from_normal(a);

@@ -2,6 +2,7 @@
 
 #include <embree3/rtcore.h>
 
+#include "iblkit/core/check.h"
 #include "iblkit/core/error.h"
 
 namespace ibl::geometry {
@@ -56,7 +57,14 @@ void RayTracer::commit() {
 uint32_t RayTracer::mesh_count() const { return impl_->count; }
 
 namespace {
+// Embree asserts (and aborts) on a ray whose origin or direction is not finite or beyond 1.844e18
+// (its FLT_LARGE): such a ray is an error here, before Embree sees it. The library's entry points
+// keep points within ±kMaxCoordinate (core/check.h), so this only fires on a bug.
 void fill_ray(RTCRay& r, Vec3 o, Vec3 d, double tnear, double tfar) {
+  constexpr double kEmbreeLarge = 1e18;
+  if (!in_range(o, kEmbreeLarge) || !in_range(d, kEmbreeLarge) || !(tnear >= 0 && tnear < 3.0e38) || !(tfar >= tnear))
+    fail(ErrorKind::Value, "ray tracer: ray from ({}, {}, {}) along ({}, {}, {}), t in ({}, {}), is not finite or out of range",
+         o.x, o.y, o.z, d.x, d.y, d.z, tnear, tfar);
   r.org_x = static_cast<float>(o.x);
   r.org_y = static_cast<float>(o.y);
   r.org_z = static_cast<float>(o.z);

@@ -6,6 +6,7 @@
 #include <atomic>
 #include <chrono>
 
+#include "iblkit/core/check.h"
 #include "iblkit/core/error.h"
 #include "iblkit/core/parallel.h"
 #include "iblkit/io/image_io.h"
@@ -55,8 +56,17 @@ SHGrid build_shgrid(const Sequence& seq_in, const BuildDesc& desc, const Progres
     fail(ErrorKind::Value, "bands {} outside [{}, {}]", desc.bands, kMinBuildBands, kMaxBuildBands);
   if (!(desc.project.kernel_cells > 0))
     fail(ErrorKind::Value, "kernel_cells {} must be > 0 (the kernel's support in grid cells)", desc.project.kernel_cells);
+  if (!std::isfinite(desc.project.kernel_cells))
+    fail(ErrorKind::Value, "kernel_cells {} must be a finite number of grid cells", desc.project.kernel_cells);
   GridDesc grid{desc.nx, desc.ny, desc.nz, desc.volume ? *desc.volume : seq_in.volume};
   SHGrid out(grid, desc.bands);  // validates resolution, bands and volume
+  {  // project_bucket's raster per thread: the projected volume plus the kernel's support, at Δ = raster_cells·h
+    Vec3 sp = grid.spacing();
+    double h = std::max({sp.x, sp.y, sp.z}), R = desc.project.kernel_cells * h / 2, delta = std::max(desc.project.raster_cells, 0.05) * h;
+    double side = (length(grid.volume.size()) + 2 * (R + delta)) / delta + 1;
+    require_allocation(fmt::format("a kernel of {:g} grid cells (kernel_cells)", desc.project.kernel_cells), side * side, 16,
+                       "choose a smaller kernel_cells");
+  }
   rep.probes_in = int(seq_in.probes.size());
   Sequence seq = seq_in;
   if (desc.subsample) {

@@ -35,7 +35,7 @@ Sequence read_sequence(const std::string& path, const SequenceReadDesc& desc, Se
   require_format(j, path, "iblkit.sequence/1");
   Sequence seq;
   seq.manifest = path;
-  std::string mapping = j.value("mapping", "mirrorball");
+  std::string mapping = opt_field(j, path, "mapping", "mirrorball");
   auto kind = sphere::find_mapping(mapping);
   if (!kind) fail(ErrorKind::Format, "{}: field \"mapping\": unknown mapping \"{}\"", path, mapping);
   seq.mapping = *kind;

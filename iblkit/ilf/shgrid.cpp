@@ -2,10 +2,12 @@
 
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 
 #include <nlohmann/json.hpp>
 
+#include "iblkit/core/check.h"
 #include "iblkit/core/error.h"
 #include "iblkit/core/atomic_file.h"
 #include "iblkit/sh/basis.h"
@@ -19,20 +21,26 @@ SHGrid::SHGrid(const GridDesc& grid, int bands) : grid_(grid), bands_(bands) {
   if (bands < 1 || bands > 16) fail(ErrorKind::Value, "SH grid: bands = {} outside [1, 16]", bands);
   for (int a = 0; a < 3; ++a)
     if (!(grid.volume.max[a] > grid.volume.min[a])) fail(ErrorKind::Value, "SH grid: volume max must exceed min on axis {}", "xyz"[a]);
+  require_box("SH grid: volume", grid.volume.min, grid.volume.max, true);
+  require_allocation(fmt::format("SH grid: {}x{}x{} points of {} bands", grid.nx, grid.ny, grid.nz, bands),
+                     double(grid.count()) * bands * bands * 3, sizeof(float), "choose a coarser grid or fewer bands");
   data_.assign(size_t(grid.count()) * coeff_count() * 3, 0.0f);
 }
 
 sh::Coeffs SHGrid::coeffs_at(Vec3 p) const {
   int K = coeff_count();
+  if (!is_finite(p)) fail(ErrorKind::Value, "SH grid lookup: the point ({}, {}, {}) is not finite", p.x, p.y, p.z);
   sh::Coeffs out;
   out.bands = bands_;
   out.c.assign(size_t(K), Vec3{0, 0, 0});
+  if (data_.empty()) return out;  // a default-constructed grid: no coefficients
   Vec3 s = grid_.volume.size();
   double f[3] = {(p.x - grid_.volume.min.x) / s.x * (grid_.nx - 1), (p.y - grid_.volume.min.y) / s.y * (grid_.ny - 1),
                  (p.z - grid_.volume.min.z) / s.z * (grid_.nz - 1)};
   int n[3] = {grid_.nx, grid_.ny, grid_.nz}, i0[3];
   double t[3];
   for (int a = 0; a < 3; ++a) {
+    if (std::isnan(f[a])) f[a] = 0;  // unreachable for grids within the checked range; keeps the index defined
     f[a] = std::clamp(f[a], 0.0, double(n[a] - 1));
     i0[a] = std::min(int(f[a]), n[a] - 2);
     t[a] = f[a] - i0[a];
@@ -127,9 +135,23 @@ SHGrid read_shgrid(const std::string& path) {
   } catch (const json::exception& e) {
     fail(ErrorKind::Format, "{}: header field of the wrong type ({})", path, e.what());
   }
-  SHGrid g(gd, bands);
   size_t off = magic.size() + 1 + header.size() + 1;
   if (off % 64 != 0) fail(ErrorKind::Format, "{}: data does not start at a multiple of 64 bytes", path);
+  if (gd.nx < 2 || gd.ny < 2 || gd.nz < 2)
+    fail(ErrorKind::Format, "{}: header field \"resolution\" {}x{}x{} must be at least 2 per axis", path, gd.nx, gd.ny, gd.nz);
+  if (bands < 1 || bands > 16) fail(ErrorKind::Format, "{}: header field \"bands\" = {} outside [1, 16]", path, bands);
+  if (!is_finite(gd.volume.min) || !is_finite(gd.volume.max) || !in_range(gd.volume.min) || !in_range(gd.volume.max))
+    fail(ErrorKind::Format, "{}: header fields \"min\", \"max\" ({}, {}, {})–({}, {}, {}) must be finite and within ±{:g} m", path,
+         gd.volume.min.x, gd.volume.min.y, gd.volume.min.z, gd.volume.max.x, gd.volume.max.y, gd.volume.max.z, kMaxCoordinate);
+  {  // the declared size against the file's, before anything is allocated
+    std::error_code ec;
+    const double file_bytes = double(std::filesystem::file_size(path, ec));
+    const double want = double(gd.count()) * bands * bands * 3 * 4;
+    if (!ec && want > file_bytes - double(off))
+      fail(ErrorKind::Format, "{}: truncated: the header declares {}x{}x{} points of {} bands ({:.0f} data bytes), the file holds {:.0f}",
+           path, gd.nx, gd.ny, gd.nz, bands, want, std::max(0.0, file_bytes - double(off)));
+  }
+  SHGrid g(gd, bands);
   size_t n = g.data().size();
   in.read(reinterpret_cast<char*>(g.data().data()), std::streamsize(n * 4));
   if (size_t(in.gcount()) != n * 4) fail(ErrorKind::Format, "{}: truncated: {} of {} data bytes", path, in.gcount(), n * 4);

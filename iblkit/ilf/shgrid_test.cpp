@@ -162,5 +162,52 @@ TEST(IlfAccumulate, BlockProductMatchesNaiveSum) {
     }
 }
 
+// Issue 19: the lookup is defined for any input, and a header cannot make the reader allocate what
+// the file does not hold or accept a volume beyond the supported range.
+TEST(SHGrid, LookupOfANonFinitePointIsAnErrorAndFarPointsClamp) {
+  SHGrid g(small_grid(), 2);
+  g.at(3, 2, 4)[0] = 7.0f;
+  EXPECT_THROW(g.coeffs_at({std::nan(""), 0.2, 3}), Error);
+  EXPECT_THROW(g.irradiance({0, std::nan(""), 3}, {0, 1, 0}), Error);
+  EXPECT_THROW(g.coeffs_at({0, 0.2, INFINITY}), Error);
+  EXPECT_FLOAT_EQ(float(g.coeffs_at({1e300, 1e300, 1e300}).c[0].x), 7.0f);  // clamped to the far corner
+  EXPECT_EQ(g.coeffs_at({-1e300, -1e300, -1e300}).c[0].x, 0.0);
+}
+
+void write_header(const std::string& path, const std::string& json_header, size_t data_bytes) {
+  std::string h = "IBLKIT-SHGRID 1\n" + json_header;
+  size_t total = ((h.size() + 1 + 63) / 64) * 64;
+  h.append(total - h.size() - 1, ' ');
+  h.push_back('\n');
+  std::ofstream o(path, std::ios::binary);
+  o << h << std::string(data_bytes, '\0');
+}
+
+TEST(SHGrid, HeaderSizesAndVolumesAreCheckedBeforeAllocating) {
+  const std::string path = (fs::temp_directory_path() / "iblkit_shgrid_header_test.shgrid").string();
+  const std::string tail = R"(, "dtype": "float32", "layout": "z,y,x,coefficient,channel"})";
+  auto message = [&] {
+    try {
+      read_shgrid(path);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  // 200³ points of 5 bands declared (2.4 GB), 100 bytes present: refused from the file's length.
+  write_header(path, R"({"bands": 5, "resolution": [200, 200, 200], "min": [0, 0, 0], "max": [1, 1, 1])" + tail, 100);
+  EXPECT_NE(message().find("truncated: the header declares 200x200x200 points of 5 bands (2400000000 data bytes), the file holds 100"),
+            std::string::npos) << message();
+  // min/max ±1e308: the volume's size overflows; refused.
+  write_header(path, R"({"bands": 1, "resolution": [2, 2, 2], "min": [-1e308, -1e308, -1e308], "max": [1e308, 1e308, 1e308])" + tail,
+               8 * 3 * 4);
+  EXPECT_NE(message().find("\"min\", \"max\""), std::string::npos) << message();
+  write_header(path, R"({"bands": 0, "resolution": [2, 2, 2], "min": [0, 0, 0], "max": [1, 1, 1])" + tail, 0);
+  EXPECT_NE(message().find("\"bands\" = 0"), std::string::npos) << message();
+  write_header(path, R"({"bands": 1, "resolution": [1, 2, 2], "min": [0, 0, 0], "max": [1, 1, 1])" + tail, 0);
+  EXPECT_NE(message().find("\"resolution\" 1x2x2"), std::string::npos) << message();
+  fs::remove(path);
+}
+
 }  // namespace
 }  // namespace ibl::ilf

@@ -26,6 +26,10 @@ double difference_energy(const Image& a, const Image& b, const sphere::Mapping& 
 
 std::vector<int> subsample(const Sequence& seq, const SubsampleDesc& desc, const ProgressFn& progress,
                            SubsampleReport* report) {
+  if (!(desc.threshold >= 0) || !std::isfinite(desc.threshold))
+    fail(ErrorKind::Value, "subsample: threshold {} must be a finite number ≥ 0", desc.threshold);
+  if (!(desc.max_distance >= 0) || !std::isfinite(desc.max_distance))
+    fail(ErrorKind::Value, "subsample: neighbour distance {} must be a finite number ≥ 0 metres", desc.max_distance);
   int n = int(seq.probes.size());
   std::vector<int> keep;
   if (n <= 2) {

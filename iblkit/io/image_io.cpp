@@ -31,23 +31,25 @@ int check_pixels(Image& img, const std::string& what, bool sanitize) {
   // hold down to −3.4% of their mean, from filtering during their making); they become 0 silently.
   // Anything more negative is bad data.
   constexpr double kNoise = 0.05;
+  // Values above 1e20 (the sun is about 1e9 W/(sr·m²)) are not radiance: their sums overflow float.
+  constexpr float kMaxPixel = 1e20f;
   double mean_abs = 0;
   size_t finite = 0;
   for (size_t i = 0; i < img.size(); ++i)
-    if (std::isfinite(d[i])) { mean_abs += std::abs(d[i]); ++finite; }
+    if (std::isfinite(d[i]) && std::abs(d[i]) <= kMaxPixel) { mean_abs += std::abs(d[i]); ++finite; }
   float noise = static_cast<float>(finite ? kNoise * mean_abs / finite : 0.0);
   int bad = 0;
   for (size_t i = 0; i < img.size(); ++i) {
     float v = d[i];
-    if (std::isfinite(v) && v >= 0.0f) continue;
-    if (std::isfinite(v) && v >= -noise) {
+    if (std::isfinite(v) && v >= 0.0f && v <= kMaxPixel) continue;
+    if (std::isfinite(v) && v < 0.0f && v >= -noise) {
       d[i] = 0.0f;
       continue;
     }
     if (!sanitize) {
       size_t p = i / nc;
       int x = static_cast<int>(p % img.width()), y = static_cast<int>(p / img.width());
-      const char* kind = std::isnan(v) ? "NaN" : (std::isinf(v) ? "Inf" : "negative");
+      const char* kind = std::isnan(v) ? "NaN" : (std::isinf(v) ? "Inf" : (v > kMaxPixel ? "above 1e20" : "negative"));
       fail(ErrorKind::Value, "{}: pixel ({}, {}) channel {} is {} ({}); sanitize replaces such values by 0",
            what, x, y, static_cast<int>(i % nc), kind, v);
     }

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <vector>
 
+#include "iblkit/core/check.h"
 #include "iblkit/core/parallel.h"
 
 namespace ibl::io {
@@ -31,6 +32,8 @@ inline double aces(double x) {
 }  // namespace
 
 Image tonemap(const Image& img, const ToneMapDesc& desc) {
+  require_number("tone map: exposure (stops)", desc.exposure_stops, -64, 64);
+  if (!(desc.key > 0) || !std::isfinite(desc.key)) fail(ErrorKind::Value, "tone map: key {} must be a finite number > 0", desc.key);
   double scale = (desc.auto_exposure ? auto_exposure_scale(img, desc.key) : 1.0) * std::exp2(desc.exposure_stops);
   Image out(img.width(), img.height(), 3);
   parallel_for(0, img.height(), [&](int64_t y) {

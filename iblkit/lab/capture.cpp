@@ -5,6 +5,7 @@
 #include <cmath>
 #include <vector>
 
+#include "iblkit/core/check.h"
 #include "iblkit/core/error.h"
 #include "iblkit/core/parallel.h"
 #include "iblkit/lab/radiance.h"
@@ -112,6 +113,7 @@ void add_aperture(const Scene& scene, const Emitter& e, int rings, Vec3 o, const
 Capture capture_probe(const Scene& scene, Vec3 position, const CaptureDesc& desc, uint64_t probe_index,
                       const ProgressFn& progress) {
   if (!scene.built()) fail(ErrorKind::Internal, "capture_probe: scene {} is not built", scene.name);
+  require_point("capture position", position);
   if (desc.samples < 1 || desc.samples > 64) fail(ErrorKind::Value, "samples per pixel axis {} is out of range [1, 64]", desc.samples);
   bool ball = desc.camera == Camera::MirrorBall;
   if (ball && desc.mapping != MappingKind::MirrorBall)

@@ -9,6 +9,7 @@
 #include "iblkit/geometry/mesh.h"
 #include "iblkit/lab/capture.h"
 #include "iblkit/lab/radiance.h"
+#include "iblkit/lab/sequence.h"
 #include "iblkit/lab/truth.h"
 #include "iblkit/sphere/envmap.h"
 
@@ -76,6 +77,27 @@ Scene disc_light(double R, double h, Vec3 L) {
   s.emitters.push_back(e);
   s.build();
   return s;
+}
+
+// Issue 19: positions entering the lab are checked before any ray reaches Embree.
+TEST(LabCapture, NonFiniteOrFarPositionsAreErrors) {
+  Scene s = uniform_sky({1, 1, 1});
+  CaptureDesc d;
+  d.size = 8;
+  const double nan = std::nan("");
+  EXPECT_THROW(capture_probe(s, {nan, 1, 0}, d), Error);
+  EXPECT_THROW(capture_probe(s, {1e30, 1, 0}, d), Error);
+  TruthDesc td;
+  td.size = 8;
+  EXPECT_THROW(ground_truth(s, {0, INFINITY, 0}, td), Error);
+  EXPECT_THROW(radiance_along(s, {1e30, 0, 0}, {{0, 1, 0}}, s.render, 1), Error);
+  EXPECT_THROW(path_positions({{0, 1, 0}, {nan, 1, 1}}, 3), Error);
+  EXPECT_THROW(grid_positions({0, 0, 0}, {INFINITY, 1, 1}, 2, 2, 2), Error);
+  EXPECT_THROW(random_positions({nan, 0, 0}, {1, 1, 1}, 3, 1), Error);
+  // Counts are bounded before the positions are allocated.
+  EXPECT_THROW(grid_positions({0, 0, 0}, {1, 1, 1}, 100000, 100000, 100000), Error);
+  EXPECT_THROW(random_positions({0, 0, 0}, {1, 1, 1}, 1000000000, 1), Error);
+  EXPECT_EQ(grid_positions({0, 0, 0}, {1, 1, 1}, 2, 2, 2).size(), 8u);
 }
 
 TEST(LabCapture, ClosedEmittingSphereIsUniformEverywhereInside) {

@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "iblkit/core/check.h"
 #include "iblkit/core/error.h"
 #include "iblkit/core/json_file.h"
 #include "iblkit/geometry/mesh_io.h"
@@ -27,6 +28,7 @@ struct Ctx {
   std::string where; // "surfaces[2]"
   std::string rel(const std::string& p) const { return fs::path(p).is_absolute() ? p : (dir / p).string(); }
   [[noreturn]] void bad(const std::string& field, const std::string& why) const {
+    if (where.empty()) fail(ErrorKind::Format, "{}: {}: {}", file, field, why);
     fail(ErrorKind::Format, "{}: {}.{}: {}", file, where, field, why);
   }
 };
@@ -40,6 +42,13 @@ double num(const json& j, const char* f, const Ctx& c, std::optional<double> def
   double v = j[f].get<double>();
   if (!std::isfinite(v)) c.bad(f, "not finite");
   return v;
+}
+
+// A whole number in [lo, hi] (a count: segments, rings, samples).
+int count(const json& j, const char* f, const Ctx& c, int def, int lo, int hi) {
+  double v = num(j, f, c, double(def));
+  if (v != std::floor(v) || v < lo || v > hi) c.bad(f, fmt::format("expected a whole number from {} to {}, got {}", lo, hi, v));
+  return static_cast<int>(v);
 }
 
 Vec3 vec3(const json& j, const char* f, const Ctx& c, std::optional<Vec3> def = std::nullopt) {
@@ -110,12 +119,12 @@ int wall_axis(const std::string& w, bool* at_max, const Ctx& c) {
 
 Surface surface(const json& j, const Ctx& c) {
   Surface s;
-  std::string type = j.value("type", "");
-  s.name = j.value("name", type);
+  std::string type = opt_field(j, c.file + ": " + c.where, "type", "");
+  s.name = opt_field(j, c.file + ": " + c.where, "name", type);
   s.albedo = texture(j, c);
   s.emission = vec3(j, "emission", c, Vec3{});
   nonneg(s.emission, "emission", c);
-  s.proxy = j.value("proxy", true);
+  s.proxy = opt_field(j, c.file + ": " + c.where, "proxy", true);
   if (type == "room" || type == "box") {
     geometry::RoomDesc r;
     r.lo = vec3(j, "min", c);
@@ -123,7 +132,7 @@ Surface surface(const json& j, const Ctx& c) {
     if (j.contains("openings"))
       for (const json& o : j["openings"]) {
         geometry::Opening op;
-        op.axis = wall_axis(o.value("wall", ""), &op.at_max, c);
+        op.axis = wall_axis(opt_field(o, c.file + ": " + c.where, "wall", ""), &op.at_max, c);
         op.lo = vec2(o, "min", c);
         op.hi = vec2(o, "max", c);
         r.openings.push_back(op);
@@ -141,18 +150,18 @@ Surface surface(const json& j, const Ctx& c) {
                                  vec2(j, "size", c).x, vec2(j, "size", c).y);
   } else if (type == "disc") {
     s.mesh = geometry::make_disc(vec3(j, "center", c), vec3(j, "normal", c), num(j, "radius", c),
-                                 static_cast<int>(num(j, "segments", c, 64)));
+                                 count(j, "segments", c, 64, 3, 1000000));
   } else if (type == "sphere") {
-    s.mesh = geometry::make_sphere(vec3(j, "center", c), num(j, "radius", c), static_cast<int>(num(j, "rings", c, 32)),
-                                   static_cast<int>(num(j, "segments", c, 64)), j.value("inward", false));
+    s.mesh = geometry::make_sphere(vec3(j, "center", c), num(j, "radius", c), count(j, "rings", c, 32, 2, 1000000),
+                                   count(j, "segments", c, 64, 3, 1000000), opt_field(j, c.file + ": " + c.where, "inward", false));
   } else if (type == "cylinder") {
     s.mesh = geometry::make_cylinder(vec3(j, "base", c), vec3(j, "axis", c), num(j, "radius", c),
-                                     static_cast<int>(num(j, "segments", c, 48)), j.value("caps", true));
+                                     count(j, "segments", c, 48, 3, 1000000), opt_field(j, c.file + ": " + c.where, "caps", true));
   } else if (type == "mesh") {
     if (!j.contains("file")) c.bad("file", "missing");
     s.mesh = geometry::read_mesh(c.rel(j["file"].get<std::string>()));
     s.mesh.transform(rotation_deg(j, c), num(j, "scale", c, 1.0), vec3(j, "translate", c, Vec3{}));
-    if (j.value("flip", false)) s.mesh.flip();
+    if (opt_field(j, c.file + ": " + c.where, "flip", false)) s.mesh.flip();
   } else {
     c.bad("type", "unknown surface type \"" + type + "\" (room, box, quad, disc, sphere, cylinder, mesh)");
   }
@@ -169,11 +178,11 @@ Pattern pattern(const std::string& p, const Ctx& c) {
 
 Emitter emitter(const json& j, const Ctx& c) {
   Emitter e;
-  std::string type = j.value("type", "");
-  e.name = j.value("name", type);
+  std::string type = opt_field(j, c.file + ": " + c.where, "type", "");
+  e.name = opt_field(j, c.file + ": " + c.where, "name", type);
   if (type == "area") {
     e.type = EmitterType::Area;
-    std::string shape = j.value("shape", "quad");
+    std::string shape = opt_field(j, c.file + ": " + c.where, "shape", "quad");
     if (shape != "quad" && shape != "disc") c.bad("shape", "expected quad or disc");
     e.disc = shape == "disc";
     e.center = vec3(j, "center", c);
@@ -255,12 +264,12 @@ std::string resolve_scene_path(const std::string& name) {
 Scene load_scene(const std::string& name_or_path, bool build) {
   std::string path = resolve_scene_path(name_or_path);
   const json j = read_json_file(path);
-  Ctx c{path, fs::path(path).parent_path(), "scene"};
-  if (j.value("format", "") != "iblkit.scene/1") c.bad("format", "expected \"iblkit.scene/1\"");
+  Ctx c{path, fs::path(path).parent_path(), ""};
+  if (!j.is_object() || !j.contains("format") || j["format"] != "iblkit.scene/1") c.bad("format", "expected \"iblkit.scene/1\"");
   Scene s;
   s.source = path;
-  s.name = j.value("name", fs::path(path).stem().string());
-  s.description = j.value("description", "");
+  s.name = opt_field(j, path, "name", fs::path(path).stem().string());
+  s.description = opt_field(j, path, "description", "");
   try {
     if (j.contains("volume")) {
       c.where = "volume";
@@ -268,18 +277,26 @@ Scene load_scene(const std::string& name_or_path, bool build) {
       s.volume_max = vec3(j["volume"], "max", c);
       for (int k = 0; k < 3; ++k)
         if (!(s.volume_max[k] > s.volume_min[k])) c.bad("max", "must exceed min on every axis");
+      if (!in_range(s.volume_min) || !in_range(s.volume_max)) c.bad("min", fmt::format("the corners must lie within ±{:g} m", kMaxCoordinate));
     }
     if (j.contains("settings")) {
       c.where = "settings";
       const json& st = j["settings"];
-      s.render.area_samples = static_cast<int>(num(st, "area_samples", c, s.render.area_samples));
-      s.render.env_samples = static_cast<int>(num(st, "env_samples", c, s.render.env_samples));
-      s.render.bounces = static_cast<int>(num(st, "bounces", c, s.render.bounces));
-      s.render.seed = static_cast<uint64_t>(num(st, "seed", c, static_cast<double>(s.render.seed)));
+      s.render.area_samples = count(st, "area_samples", c, s.render.area_samples, 1, 1000000);
+      s.render.env_samples = count(st, "env_samples", c, s.render.env_samples, 1, 1000000);
+      s.render.bounces = count(st, "bounces", c, s.render.bounces, 0, 64);
+      const double seed = num(st, "seed", c, static_cast<double>(s.render.seed));
+      if (seed < 0 || seed > 9007199254740992.0 || seed != std::floor(seed)) c.bad("seed", fmt::format("expected a whole number ≥ 0, got {}", seed));
+      s.render.seed = static_cast<uint64_t>(seed);
       if (s.render.area_samples < 1 || s.render.env_samples < 1 || s.render.bounces < 0)
         c.bad("area_samples", "need area_samples ≥ 1, env_samples ≥ 1, bounces ≥ 0");
     }
-    if (j.contains("proxy")) s.proxy_file = c.rel(j["proxy"].get<std::string>());
+    c.where.clear();
+    if (j.contains("proxy")) {
+      if (!j["proxy"].is_string()) c.bad("proxy", "expected a file name");
+      s.proxy_file = c.rel(j["proxy"].get<std::string>());
+    }
+    if (j.contains("emitters") && !j["emitters"].is_array()) c.bad("emitters", "expected a list");
     if (!j.contains("surfaces") || !j["surfaces"].is_array()) c.bad("surfaces", "missing (a list)");
     for (size_t i = 0; i < j["surfaces"].size(); ++i) {
       c.where = fmt::format("surfaces[{}]", i);
@@ -291,10 +308,10 @@ Scene load_scene(const std::string& name_or_path, bool build) {
         s.emitters.push_back(emitter(j["emitters"][i], c));
       }
   } catch (const json::exception& e) {
-    fail(ErrorKind::Format, "{}: {}: {}", path, c.where, e.what());
+    fail(ErrorKind::Format, "{}: {}{}{}", path, c.where, c.where.empty() ? "" : ": ", json_error_text(e));
   } catch (const Error& e) {
     if (std::string(e.what()).find(path) != std::string::npos) throw;
-    fail(e.kind(), "{}: {}: {}", path, c.where, e.what());
+    fail(e.kind(), "{}: {}{}{}", path, c.where, c.where.empty() ? "" : ": ", e.what());
   }
   if (build) s.build();
   return s;

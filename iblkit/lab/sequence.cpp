@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "iblkit/core/check.h"
 #include "iblkit/core/error.h"
 #include "iblkit/core/json_file.h"
 #include "iblkit/geometry/mesh_io.h"
@@ -22,8 +23,19 @@ namespace ibl::lab {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
+// A capture holds every position (and the manifest every entry) in memory and renders each probe:
+// at most kMaxProbes of them.
+constexpr double kMaxProbes = 1e6;
+static void require_probe_count(const std::string& what, double n, const char* hint) {
+  if (n > kMaxProbes)
+    fail(ErrorKind::Value, "{} of {:.4g} probes exceeds the {:g} a capture supports ({:.3g} GB for the positions alone); {}", what, n,
+         kMaxProbes, n * sizeof(Vec3) / 1e9, hint);
+}
+
 std::vector<Vec3> grid_positions(Vec3 lo, Vec3 hi, int nx, int ny, int nz) {
   if (nx < 1 || ny < 1 || nz < 1) fail(ErrorKind::Value, "grid counts {}x{}x{} must be ≥ 1", nx, ny, nz);
+  require_box("grid volume", lo, hi);
+  require_probe_count(fmt::format("a grid of {}x{}x{}", nx, ny, nz), double(nx) * ny * nz, "choose fewer grid points per axis");
   auto at = [](double a, double b, int i, int n) { return n == 1 ? 0.5 * (a + b) : a + (b - a) * i / (n - 1); };
   std::vector<Vec3> p;
   for (int k = 0; k < nz; ++k)
@@ -35,6 +47,8 @@ std::vector<Vec3> grid_positions(Vec3 lo, Vec3 hi, int nx, int ny, int nz) {
 std::vector<Vec3> path_positions(const std::vector<Vec3>& pts, int count) {
   if (pts.empty()) fail(ErrorKind::Value, "a path needs at least one point");
   if (count < 1) fail(ErrorKind::Value, "path probe count {} must be ≥ 1", count);
+  for (size_t i = 0; i < pts.size(); ++i) require_point(fmt::format("path point {}", i + 1), pts[i]);
+  require_probe_count("a path", count, "choose a smaller probe count");
   std::vector<double> acc{0};
   for (size_t i = 1; i < pts.size(); ++i) acc.push_back(acc.back() + length(pts[i] - pts[i - 1]));
   std::vector<Vec3> out;
@@ -51,6 +65,8 @@ std::vector<Vec3> path_positions(const std::vector<Vec3>& pts, int count) {
 
 std::vector<Vec3> random_positions(Vec3 lo, Vec3 hi, int count, uint64_t seed) {
   if (count < 1) fail(ErrorKind::Value, "random probe count {} must be ≥ 1", count);
+  require_box("random volume", lo, hi);
+  require_probe_count("a random capture", count, "choose a smaller random probe count");
   std::vector<Vec3> p;
   Rng rng(stream_key(seed, ~0ull, 0, 0));
   for (int i = 0; i < count; ++i) {
@@ -118,6 +134,7 @@ std::string describe(const Scene& scene, const SequenceDesc& d) {
 
 SequenceResult write_sequence(const Scene& scene, const std::vector<Vec3>& positions, const SequenceDesc& desc,
                               const ProgressFn& progress) {
+  for (size_t i = 0; i < positions.size(); ++i) require_point(fmt::format("probe position {}", i + 1), positions[i]);
   auto t0 = std::chrono::steady_clock::now();
   fs::path out(desc.out_dir);
   make_dir(out / "frames");
@@ -157,6 +174,7 @@ SequenceResult write_sequence(const Scene& scene, const std::vector<Vec3>& posit
 
 SequenceResult write_probe_set(const Scene& scene, const std::vector<Vec3>& positions, const SequenceDesc& desc,
                                const ProgressFn& progress) {
+  for (size_t i = 0; i < positions.size(); ++i) require_point(fmt::format("probe position {}", i + 1), positions[i]);
   auto t0 = std::chrono::steady_clock::now();
   fs::path out(desc.out_dir);
   make_dir(out / "probes");

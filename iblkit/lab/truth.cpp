@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 
+#include "iblkit/core/check.h"
 #include "iblkit/core/error.h"
 #include "iblkit/core/parallel.h"
 #include "iblkit/lab/capture.h"
@@ -40,6 +41,7 @@ Vec3 irradiance(const sphere::EnvMap& map, Vec3 n) {
 }
 
 Truth ground_truth(const Scene& scene, Vec3 position, const TruthDesc& desc, const ProgressFn& progress) {
+  require_point("ground-truth position", position);
   if (desc.area_samples < 1) fail(ErrorKind::Value, "area samples {} must be ≥ 1", desc.area_samples);
   CaptureDesc cd;
   cd.mapping = sphere::MappingKind::LatLong;
@@ -77,6 +79,7 @@ Truth ground_truth(const Scene& scene, Vec3 position, const TruthDesc& desc, con
 std::vector<Vec3> radiance_along(const Scene& scene, Vec3 position, const std::vector<Vec3>& directions,
                                  const RenderDesc& desc, int streams) {
   if (streams < 1) fail(ErrorKind::Value, "radiance along rays: {} random streams per ray (need ≥ 1)", streams);
+  require_point("radiance position", position);
   std::vector<Vec3> out(directions.size());
   parallel_for(0, static_cast<int64_t>(directions.size()), [&](int64_t i) {
     Vec3 s;

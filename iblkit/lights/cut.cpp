@@ -166,7 +166,7 @@ LightSet finish(const LatLongGrid& g, const CutDesc& desc, const std::string& me
 
 void check_count(const LatLongGrid& g, const CutDesc& desc) {
   if (desc.count < 1) fail(ErrorKind::Value, "light count must be at least 1 (got {})", desc.count);
-  if (desc.min_separation_deg < 0 || desc.min_separation_deg >= 180)
+  if (!(desc.min_separation_deg >= 0 && desc.min_separation_deg < 180))
     fail(ErrorKind::Value, "minimum separation must be in [0, 180) degrees (got {})", desc.min_separation_deg);
   if (g.width < 1 || g.height < 1) fail(ErrorKind::Value, "the probe is empty");
 }

@@ -39,6 +39,8 @@ void check_method(const std::string& method) {
 Extraction extract(const sphere::EnvMap& env, const ExtractDesc& desc, const std::vector<Vec3>& normals_in,
                    const std::vector<Vec3>& gt_in) {
   check_method(desc.method);
+  if (!(desc.min_separation_deg >= 0 && desc.min_separation_deg < 180))
+    fail(ErrorKind::Value, "minimum separation must be in [0, 180) degrees (got {})", desc.min_separation_deg);
   Extraction ex;
   std::vector<Vec3> normals_own, gt_own;
   const std::vector<Vec3>* normals = &normals_in;

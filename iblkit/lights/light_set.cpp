@@ -207,7 +207,7 @@ LightSet from_json(const nlohmann::json& j, const std::string& what) {
   if (!j.contains("lights") || !j["lights"].is_array())
     fail(ErrorKind::Format, "{}: \"lights\" must be an array", what);
   LightSet set;
-  set.method = j.value("method", "file");
+  set.method = opt_field(j, what, "method", "file");
   int i = 0;
   for (const auto& l : j["lights"]) {
     std::string where = what + ": lights[" + std::to_string(i++) + "]";
@@ -218,7 +218,7 @@ LightSet from_json(const nlohmann::json& j, const std::string& what) {
     light.irradiance = vec3_field(l, "irradiance", where);
     if (light.irradiance.x < 0 || light.irradiance.y < 0 || light.irradiance.z < 0)
       fail(ErrorKind::Format, "{}: \"irradiance\" is negative", where);
-    light.solid_angle = l.value("solid_angle", 0.0);
+    light.solid_angle = opt_field(l, where, "solid_angle", 0.0);
     if (!(light.solid_angle >= 0) || light.solid_angle > kFourPi + 1e-9)
       fail(ErrorKind::Format, "{}: \"solid_angle\" must be in [0, 4π]", where);
     if (l.contains("position")) light.position = vec3_field(l, "position", where);

@@ -89,9 +89,9 @@ Dataset read_dataset(const std::string& path) {
   const json j = read_json_file(path);
   require_format(j, path, "iblkit.nearfield/1");
   Dataset ds;
-  ds.name = j.value("name", fs::path(path).stem().string());
-  ds.luminaire = j.value("luminaire", "");
-  ds.basis = parse_basis(j.value("basis", ""), path + ": basis");
+  ds.name = opt_field(j, path, "name", fs::path(path).stem().string());
+  ds.luminaire = opt_field(j, path, "luminaire", "");
+  ds.basis = parse_basis(opt_field(j, path, "basis", ""), path + ": basis");
   ds.spacing = number(j, "spacing", path);
   ds.filter_width = number(j, "filter_width", path);
   ds.distance = number(j, "distance", path);
@@ -104,8 +104,8 @@ Dataset read_dataset(const std::string& path) {
   if (!j.contains("m_extent") || !j["m_extent"].is_object()) fail(ErrorKind::Format, "{}: 'm_extent' {{min, max}} missing", path);
   ds.m_min = vec2(j["m_extent"].value("min", json()), path + ": m_extent.min");
   ds.m_max = vec2(j["m_extent"].value("max", json()), path + ": m_extent.max");
-  ds.m_basis = parse_basis(j.value("m_basis", "bilinear"), path + ": m_basis");
-  ds.filter_gain = j.value("filter_gain", 1.0);
+  ds.m_basis = parse_basis(opt_field(j, path, "m_basis", "bilinear"), path + ": m_basis");
+  ds.filter_gain = opt_field(j, path, "filter_gain", 1.0);
   if (!j.contains("measurements") || !j["measurements"].is_array()) fail(ErrorKind::Format, "{}: 'measurements' array missing", path);
   const size_t n = static_cast<size_t>(ds.count());
   ds.positive.assign(n, Image());

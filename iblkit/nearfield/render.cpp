@@ -111,6 +111,7 @@ bool SceneView::blocked(Vec3 p, Vec3 q) const { return tracer_.occluded(p, q - p
 namespace {
 
 void check_view(const geometry::Camera& v) {
+  geometry::require_camera(v);
   if (v.width < 1 || v.height < 1 || v.width > 16384 || v.height > 16384 || !(v.fov_y_deg > 0 && v.fov_y_deg < 179))
     fail(ErrorKind::Value, "view: {}x{} pixels, field of view {}°: out of range", v.width, v.height, v.fov_y_deg);
 }

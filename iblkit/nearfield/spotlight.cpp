@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "iblkit/core/check.h"
 #include "iblkit/core/error.h"
 
 namespace ibl::nearfield {
@@ -89,7 +90,9 @@ std::vector<Image> build_mips(const Image& img) {
 }
 
 Frame Placement::frame() const {
-  const Vec3 f = normalize(forward);
+  require_point("luminaire position", position);
+  const Vec3 f = require_direction("luminaire forward", forward);
+  require_direction("luminaire up", up_hint);
   const Vec3 r = cross(up_hint, f);
   if (length(f) == 0 || length(r) < 1e-9)
     fail(ErrorKind::Value, "luminaire placement: forward ({}, {}, {}) is zero or parallel to up ({}, {}, {})", forward.x,

@@ -28,8 +28,9 @@ struct FrameDesc {
   double shadow_bias = 2e-3;   // offset along the normal before shadow tests, metres
 };
 
-// Throws ibl::Error unless every object has a mesh with one normal per vertex (both renderers call
-// it; a mesh without UVs, or with too few, reads its texture at (0,0)).
+// Throws ibl::Error unless the camera passes geometry::require_camera and every object has a mesh
+// with one normal per vertex (both renderers call it; a mesh without UVs, or with too few, reads its
+// texture at (0,0)).
 void check_objects(const FrameDesc& d);
 
 // Per-pixel result: RGB radiance (linear HDR) and coverage.

@@ -60,7 +60,8 @@ void read_lighting(const std::string& path, const LightingReadDesc& desc, Lighti
     what = fmt::format("SH grid {}x{}x{}, {} bands", g.grid().nx, g.grid().ny, g.grid().nz, g.bands());
   } else if (ext == ".json") {
     const nlohmann::json j = read_json_file(path);
-    const std::string format = j.value("format", "");
+    if (!j.is_object()) fail(ErrorKind::Format, "{}: expected a JSON object (an iblkit.lights/1, iblkit.sh/1 or iblkit.nearfield/1 file), got {}", path, j.type_name());
+    const std::string format = opt_field(j, path, "format", "");
     if (format == "iblkit.lights/1") {
       what = read_light_set(j, path, desc.shadows, L);
     } else if (format == "iblkit.nearfield/1") {

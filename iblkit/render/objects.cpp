@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "iblkit/core/check.h"
 #include "iblkit/core/error.h"
 #include "iblkit/geometry/mesh_io.h"
 
@@ -11,6 +12,8 @@ geometry::TriMesh make_object(const ObjectDesc& desc) {
   const std::string& scene = desc.scene;
   const double size = desc.size;
   if (!(size > 0) && (scene == "blob" || scene == "sphere")) fail(ErrorKind::Value, "object size {} must be > 0 for the {}", size, scene);
+  require_point("object position", desc.at);
+  require_number("object size", size, 0, kMaxCoordinate);
   geometry::TriMesh object;
   if (scene == "blob") {
     object = geometry::make_blob(desc.triangles, size);

@@ -108,7 +108,7 @@ double disc_g(double x) {
 double rect_disc_area(double x0, double x1, double y0, double y1) {
   std::vector<double> xs = {x0, x1};
   for (double y : {y0, y1})
-    if (std::abs(y) < 1) {
+    if (std::abs(y) <= 1) {  // ≤: an edge on y = ±1 touches the disc at x = 0 (a 1×1 ball had area 4)
       double c = std::sqrt(1 - y * y);
       xs.push_back(c);
       xs.push_back(-c);

@@ -78,6 +78,18 @@ TEST(Mapping, RoundTripEveryMapping) {
     }
 }
 
+// Issue 19: odd-sized mirror balls, whose middle column touches the disc at its top and bottom
+// edge, once summed to more than 4π (a 1×1 ball to 16 sr).
+TEST(Mapping, OddMirrorBallsSumToFourPi) {
+  for (int n : {1, 3, 5, 9}) {
+    Mapping m(MappingKind::MirrorBall, n, n);
+    double sum = 0;
+    for (int y = 0; y < n; ++y)
+      for (int x = 0; x < n; ++x) sum += m.solid_angle(x, y);
+    EXPECT_NEAR(sum, 4 * kPi, 1e-9) << n << "×" << n;
+  }
+}
+
 TEST(Mapping, SolidAnglesSumToFourPi) {
   for (const Mapping& m : all_mappings()) {
     double sum = 0;
