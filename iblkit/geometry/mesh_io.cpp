@@ -6,7 +6,9 @@
 #include <assimp/Importer.hpp>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <memory>
+#include <string>
 
 #include "iblkit/core/error.h"
 #include "iblkit/core/atomic_file.h"
@@ -35,10 +37,26 @@ void gather(const aiScene* sc, const aiNode* node, const aiMatrix4x4& parent, Tr
   }
   for (unsigned c = 0; c < node->mNumChildren; ++c) gather(sc, node->mChildren[c], m, out, all_uv);
 }
+// assimp's PLY reader (5.2) loops forever on a header without its "end_header" line: a file that
+// starts with "ply" must have that line within its first 64 KiB (found by fuzz/mesh_fuzz.cpp).
+void check_ply_header(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string head(64 * 1024, '\0');
+  in.read(head.data(), std::streamsize(head.size()));
+  head.resize(static_cast<size_t>(in.gcount()));
+  if (head.rfind("ply", 0) != 0) return;
+  for (size_t at = head.find("end_header"); at != std::string::npos; at = head.find("end_header", at + 1)) {
+    const bool starts_line = at > 0 && head[at - 1] == '\n';
+    const size_t after = at + 10;
+    if (starts_line && (after >= head.size() || head[after] == '\n' || head[after] == '\r' || head[after] == ' ')) return;
+  }
+  fail(ErrorKind::Format, "{}: PLY header has no \"end_header\" line (within the first 64 KiB)", path);
+}
 }  // namespace
 
 TriMesh read_mesh(const std::string& path) {
   if (!std::filesystem::exists(path)) fail(ErrorKind::Io, "{}: no such mesh file", path);
+  check_ply_header(path);
   Assimp::Importer imp;
   const aiScene* sc = imp.ReadFile(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
                                              aiProcess_SortByPType | aiProcess_PreTransformVertices);

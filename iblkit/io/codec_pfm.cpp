@@ -82,6 +82,17 @@ Decoded read_pfm(const std::string& path) {
   PfmHeader h = parse_header(in, path);
   if (static_cast<int64_t>(h.width) * h.height > (int64_t(1) << 30))
     fail(ErrorKind::Value, "{}: image {}x{} is too large", path, h.width, h.height);
+  // The pixels must be in the file before they are allocated (a 28-byte header may declare 12.9 GB).
+  {
+    const std::streamoff here = in.tellg();
+    in.seekg(0, std::ios::end);
+    const std::streamoff left = in.tellg() - here;
+    in.seekg(here);
+    const int64_t need = int64_t(h.width) * h.height * h.channels * int64_t(sizeof(float));
+    if (left < need)
+      fail(ErrorKind::Format, "{}: corrupt or truncated image data (the header declares {}x{}x{}: {} bytes, the file holds {})",
+           path, h.width, h.height, h.channels, need, static_cast<int64_t>(left));
+  }
   Decoded d;
   d.format = "pnm";
   d.image = Image(h.width, h.height, h.channels);

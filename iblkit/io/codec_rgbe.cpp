@@ -187,6 +187,17 @@ std::optional<Decoded> read_rgbe(const std::string& path) {
   int w = 0, h = 0;
   if (!read_header(f.get(), path, w, h)) return std::nullopt;
   if (static_cast<int64_t>(w) * h > (int64_t(1) << 30)) fail(ErrorKind::Value, "{}: image {}x{} is too large", path, w, h);
+  // Every scanline takes at least 4 bytes in any RGBE encoding: check the file can hold the rows the
+  // header declares before allocating them (a 60-byte header may declare 10.8 GB).
+  {
+    const long here = std::ftell(f.get());
+    std::fseek(f.get(), 0, SEEK_END);
+    const long left = std::ftell(f.get()) - here;
+    std::fseek(f.get(), here, SEEK_SET);
+    if (here < 0 || left < 4L * h)
+      fail(ErrorKind::Format, "{}: corrupt or truncated image data (the header declares {} rows, the file holds {} bytes of pixels)",
+           path, h, left);
+  }
   Decoded d;
   d.format = "hdr";
   d.image = Image(w, h, 3);

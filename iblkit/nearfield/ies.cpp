@@ -88,11 +88,13 @@ IesProfile parse_ies(const std::string& text, const std::string& what) {
   p.source = what;
   p.lumens = nums[1];
   const double mult = nums[2];
+  // Counts and the type are checked as numbers before they become ints (a cast of 1e30 is undefined).
+  if (!(nums[3] >= 1 && nums[4] >= 1 && nums[3] <= 10000 && nums[4] <= 10000))
+    fail(ErrorKind::Value, "{}: {} vertical and {} horizontal angles", what, nums[3], nums[4]);
   const int nv = static_cast<int>(nums[3]), nh = static_cast<int>(nums[4]);
-  p.photometric_type = static_cast<int>(nums[5]);
+  if (std::trunc(nums[5]) != 1) fail(ErrorKind::Unsupported, "{}: photometric type {} (only type C = 1)", what, nums[5]);
+  p.photometric_type = 1;
   const double ballast = nums[10];
-  if (nv < 1 || nh < 1 || nv > 10000 || nh > 10000) fail(ErrorKind::Value, "{}: {} vertical and {} horizontal angles", what, nv, nh);
-  if (p.photometric_type != 1) fail(ErrorKind::Unsupported, "{}: photometric type {} (only type C = 1)", what, p.photometric_type);
   const size_t need = 13 + static_cast<size_t>(nv) + nh + static_cast<size_t>(nv) * nh;
   if (nums.size() < need) fail(ErrorKind::Format, "{}: truncated: {} numbers, {} needed for {}x{} angles", what, nums.size(), need, nv, nh);
   size_t k = 13;
