@@ -60,6 +60,9 @@ printf '{"format":"iblkit.scene/1","name":"t","surfaces":[{"type":"sphere","name
 check sphere-rings-1e20 fail "surfaces\[0\]\.rings: expected a whole number" -- "$BIN" lab capture bigsphere2.json --probe 0,1,0 --size 8 --out c
 
 # Values that once passed and should not.
+cp "$T/tc/probes/p0.exr" same.exr
+check convert-onto-input fail "the output is the input file" -- "$BIN" convert same.exr ./same.exr --mapping mirrorball --size 16
+cmp -s same.exr "$T/tc/probes/p0.exr" || { echo "FAIL convert-onto-input: the input changed"; fail=$((fail + 1)); }
 check convert-size-16384 fail "would allocate .* GB.*choose a smaller --size" -- "$BIN" convert "$T/tc/probes/p0.exr" x.exr --mapping hcross --size 16384
 check ilf-kernel-1e9 fail "kernel.*would allocate.*kernel_cells" -- "$BIN" ilf build cap/sequence.json --grid 4 --bands 3 --kernel 1e9 --out k.shgrid
 check preview-exposure-nan fail "exposure" -- "$BIN" preview tc/probes/p0.exr p.png --exposure nan

@@ -46,6 +46,9 @@ void setup(CLI::App& app) {
   app.footer("Examples:\n  iblkit convert probe.exr probe_cross.exr --mapping hcross --size 256\n"
              "  iblkit convert ../shared/probes/debevec/grace_cube grace.exr --mapping latlong --size 512");
   app.callback([o, &rd] {
+    std::error_code ec;  // the output would replace the probe it is made from: refuse
+    if (std::filesystem::exists(o->out, ec) && std::filesystem::equivalent(o->in, o->out, ec))
+      ibl::fail(ibl::ErrorKind::Value, "{}: the output is the input file; write the conversion to another path", o->out);
     ibl::io::ReadReport rep;
     auto src = ibl::io::read_envmap(o->in, rd, &rep);
     if (rep.sanitized) iblcli::info(fmt::format("sanitized {} NaN/Inf/negative values", rep.sanitized));
