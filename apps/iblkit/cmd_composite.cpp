@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "cli.h"
+#include "render_setup.h"
 #include "iblkit/augment/camera_io.h"
 #include "iblkit/augment/composite.h"
 #include "iblkit/augment/load.h"
@@ -55,12 +56,7 @@ void run(const Opts& o, const ibl::io::EnvReadDesc& read) {
   cam.width = photo.width();
   cam.height = photo.height();
   ibl::augment::validate_camera(cam, o.camera.empty() ? "the camera" : o.camera);
-  ibl::augment::ObjectDesc od;
-  od.kind = o.object;
-  od.size = o.object_size;
-  od.triangles = o.triangles;
-  od.at = iblcli::parse_vec3(o.at, "--at");
-  od.albedo = iblcli::parse_vec3(o.albedo, "--albedo");
+  const ibl::augment::ObjectDesc od = iblcli::inserted_object(o.object, o.object_size, o.triangles, o.at, o.albedo);
   ibl::geometry::TriMesh object = ibl::augment::make_object(od);
   Vec3 lo, hi;
   object.bounds(&lo, &hi);

@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 
 #include "cli.h"
+#include "render_setup.h"
 #include "iblkit/core/error.h"
 #include "iblkit/core/json_file.h"
 #include "iblkit/io/image_io.h"
@@ -187,12 +188,7 @@ void run_photograph(const PhotoOpts& o) {
   ibl::augment::validate_camera(cam, o.camera.empty() ? "the camera" : o.camera);
   int object = -1;
   if (!o.object.empty()) {
-    ibl::augment::ObjectDesc od;
-    od.kind = o.object;
-    od.size = o.object_size;
-    od.triangles = o.triangles;
-    od.at = iblcli::parse_vec3(o.at, "--at");
-    od.albedo = iblcli::parse_vec3(o.albedo, "--albedo");
+    const ibl::augment::ObjectDesc od = iblcli::inserted_object(o.object, o.object_size, o.triangles, o.at, o.albedo);
     object = ibl::lab::add_object(scene, "object", ibl::augment::make_object(od), od.albedo);
   }
   scene.build();

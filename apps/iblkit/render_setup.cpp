@@ -1,4 +1,6 @@
 #include "render_setup.h"
+
+#include "cli.h"
 #ifdef IBLKIT_HAVE_GEOMETRY
 #include <fmt/format.h>
 
@@ -29,6 +31,17 @@ std::string grid_bounds_warning(const ibl::render::Lighting& L, const ibl::geome
                      "({:.3g}, {:.3g}, {:.3g})..({:.3g}, {:.3g}, {:.3g}): lookups there clamp to the grid's faces "
                      "(move it with --at, shrink it with --object-size)",
                      lo.x, lo.y, lo.z, hi.x, hi.y, hi.z, gmin.x, gmin.y, gmin.z, gmax.x, gmax.y, gmax.z);
+}
+
+ibl::augment::ObjectDesc inserted_object(const std::string& kind, double size, int triangles, const std::string& at,
+                                         const std::string& albedo) {
+  ibl::augment::ObjectDesc od;
+  od.kind = kind;
+  od.size = size;
+  od.triangles = triangles;
+  od.at = parse_vec3(at, "--at");
+  od.albedo = parse_vec3(albedo, "--albedo");
+  return od;
 }
 
 }  // namespace iblcli

@@ -7,6 +7,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "iblkit/augment/object.h"
 #include "iblkit/geometry/mesh.h"
 #include "iblkit/render/frame.h"
 #include "iblkit/render/shading.h"
@@ -30,6 +31,11 @@ void add_shadow_map_options(CLI::App& app, ShadowMapOptions* o);
 // A warning when the object reaches outside an SH grid's volume (lookups there clamp to the grid's
 // faces), naming both boxes and the flags that move and shrink the object; else an empty string.
 std::string grid_bounds_warning(const ibl::render::Lighting& L, const ibl::geometry::TriMesh& object);
+
+// The inserted object of `composite` and `lab photograph` from their --object, --object-size,
+// --triangles, --at and --albedo values.
+ibl::augment::ObjectDesc inserted_object(const std::string& kind, double size, int triangles, const std::string& at,
+                                         const std::string& albedo);
 
 }  // namespace iblcli
 #endif

@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "iblkit/core/error.h"
+#include "iblkit/core/testing.h"
 #include "iblkit/fusion/fuse.h"
 #include "iblkit/fusion/local_lights.h"
 #include "iblkit/fusion/path.h"
@@ -23,6 +24,8 @@
 #include "iblkit/geometry/mesh_io.h"
 #include "iblkit/io/image_io.h"
 #include "iblkit/lights/evaluate.h"
+
+using ibl::test_util::expect_error;
 
 namespace ibl::fusion {
 namespace {
@@ -261,15 +264,6 @@ std::string write_set(const fs::path& dir, const geometry::TriMesh& mesh, const 
   nlohmann::json j = {{"format", "iblkit.probes/1"}, {"proxy", "proxy.obj"}, {"probes", probes}};
   std::ofstream((dir / "probes.json").string()) << j.dump(1);
   return (dir / "probes.json").string();
-}
-
-void expect_error(const std::function<void()>& f, const std::string& needle) {
-  try {
-    f();
-    ADD_FAILURE() << "no error; expected one containing \"" << needle << "\"";
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-  }
 }
 
 TEST(FusionProbeSet, DepthIsTracedOnceAndCachedBesideTheProbe) {

@@ -7,9 +7,12 @@
 #include <fstream>
 
 #include "iblkit/core/error.h"
+#include "iblkit/core/testing.h"
 #include "iblkit/ilf/analytic.h"
 #include "iblkit/ilf/build.h"
 #include "iblkit/io/image_io.h"
+
+using ibl::test_util::expect_error;
 
 namespace ibl::ilf {
 namespace {
@@ -23,17 +26,6 @@ std::string temp_dir(const std::string& name) {
 }
 
 void write_text(const std::string& path, const std::string& s) { std::ofstream(path) << s; }
-
-// Expects an ibl::Error whose message contains every one of `parts`.
-template <typename F>
-void expect_error(F&& f, std::initializer_list<const char*> parts) {
-  try {
-    f();
-    ADD_FAILURE() << "no error";
-  } catch (const Error& e) {
-    for (const char* p : parts) EXPECT_NE(std::string(e.what()).find(p), std::string::npos) << e.what() << " lacks " << p;
-  }
-}
 
 // A 16×16 sequence of `n` probes along x in the unit cube.
 std::string tiny_sequence(const std::string& dir, int n, int size = 16) {

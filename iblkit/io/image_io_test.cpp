@@ -1,4 +1,5 @@
 #include "iblkit/io/image_io.h"
+#include "iblkit/core/testing.h"
 
 #include <gtest/gtest.h>
 
@@ -10,6 +11,8 @@
 #include "iblkit/core/error.h"
 #include "iblkit/io/envmap_io.h"
 #include "iblkit/io/tonemap.h"
+
+using ibl::test_util::expect_error;
 
 namespace ibl::io {
 namespace {
@@ -28,18 +31,6 @@ Image gradient(int w, int h, int c) {
     for (int x = 0; x < w; ++x)
       for (int k = 0; k < c; ++k) img.at(x, y, k) = 0.01f * x + 0.1f * y + 3.0f * k + 0.5f;
   return img;
-}
-
-// Expects an ibl::Error of `kind` whose message contains every fragment.
-template <typename F>
-void expect_error(F&& f, ErrorKind kind, std::initializer_list<std::string> fragments) {
-  try {
-    f();
-    FAIL() << "no error thrown";
-  } catch (const Error& e) {
-    EXPECT_EQ(static_cast<int>(e.kind()), static_cast<int>(kind)) << e.what();
-    for (const auto& frag : fragments) EXPECT_NE(std::string(e.what()).find(frag), std::string::npos) << e.what();
-  }
 }
 
 TEST(ImageIo, FloatFormatsRoundTripExactly) {

@@ -383,6 +383,23 @@ TEST(LabTruth, UniformEnvironmentGivesPiLIrradiance) {
 namespace ibl::lab {
 namespace {
 
+
+// A 4 m white floor (albedo 1) at y = 0 under a constant sky of radiance L: E = πL on the floor, so
+// it reflects exactly L.
+Scene sky_over_white_floor(Vec3 L) {
+  Scene f;
+  Surface floor;
+  floor.mesh = geometry::make_quad({0, 0, 0}, {0, 1, 0}, {0, 0, 1}, 4, 4);
+  floor.albedo.constant = {1, 1, 1};
+  f.surfaces.push_back(floor);
+  Emitter sky;
+  sky.type = EmitterType::Environment;
+  sky.radiance = L;
+  f.emitters.push_back(sky);
+  f.build();
+  return f;
+}
+
 TEST(LabCapture, EnvironmentIsSeenDirectlyAndLightsAWhiteFloorExactly) {
   constexpr double kFloatTol = 1e-5;  // relative: float images, bilinear lookups at pixel centres
   // A lat-long environment with a different value in every pixel, seen from a point of an empty
@@ -403,16 +420,7 @@ TEST(LabCapture, EnvironmentIsSeenDirectlyAndLightsAWhiteFloorExactly) {
     for (int x = 0; x < 64; ++x)
       for (int k = 0; k < 3; ++k) ASSERT_NEAR(c.radiance.rgb(x, y)[k], img.rgb(x, y)[k], kFloatTol * img.rgb(x, y)[k]);
   // A constant sky L over a white floor: E = πL, so the floor reflects exactly L.
-  Scene f;
-  Surface floor;
-  floor.mesh = geometry::make_quad({0, 0, 0}, {0, 1, 0}, {0, 0, 1}, 4, 4);
-  floor.albedo.constant = {1, 1, 1};
-  f.surfaces.push_back(floor);
-  Emitter sky;
-  sky.type = EmitterType::Environment;
-  sky.radiance = {0.7, 0.7, 0.7};
-  f.emitters.push_back(sky);
-  f.build();
+  Scene f = sky_over_white_floor({0.7, 0.7, 0.7});
   Rng rng(1);
   RenderDesc rd;
   EXPECT_NEAR(radiance(f, {0.1, 1, 0.2}, {0, -1, 0}, rng, rd).x, 0.7, kFloatTol);
@@ -448,16 +456,7 @@ TEST(LabCapture, BallParallaxStartsRaysOnTheBall) {
 TEST(LabTruth, RadianceAlongRaysUnderASkyOverAWhiteFloor) {
   constexpr double kFloatTol = 1e-5;  // as EnvironmentIsSeenDirectlyAndLightsAWhiteFloorExactly
   // A constant sky L over a white floor (E = πL): the floor and the sky both send L.
-  Scene f;
-  Surface floor;
-  floor.mesh = geometry::make_quad({0, 0, 0}, {0, 1, 0}, {0, 0, 1}, 4, 4);
-  floor.albedo.constant = {1, 1, 1};
-  f.surfaces.push_back(floor);
-  Emitter sky;
-  sky.type = EmitterType::Environment;
-  sky.radiance = {0.7, 0.7, 0.7};
-  f.emitters.push_back(sky);
-  f.build();
+  Scene f = sky_over_white_floor({0.7, 0.7, 0.7});
   const std::vector<Vec3> dirs = {{0, -1, 0}, {0, 1, 0}, normalize(Vec3{1, -1, 0.5})};
   const auto L = radiance_along(f, {0.1, 1, 0.2}, dirs, RenderDesc{}, 2);
   ASSERT_EQ(L.size(), 3u);

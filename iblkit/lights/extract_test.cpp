@@ -1,4 +1,5 @@
 #include "iblkit/lights/extract.h"
+#include "iblkit/core/testing.h"
 
 #include <filesystem>
 #include <fstream>
@@ -12,6 +13,8 @@
 #include "iblkit/lights/cut.h"
 #include "iblkit/lights/test_probes.h"
 #include "iblkit/sphere/pointset.h"
+
+using ibl::test_util::expect_error;
 
 namespace ibl::lights {
 namespace {
@@ -32,15 +35,6 @@ void expect_same_lights(const LightSet& a, const LightSet& b) {
       EXPECT_EQ(a.lights[i].irradiance[c], b.lights[i].irradiance[c]) << i;
     }
     EXPECT_EQ(a.lights[i].solid_angle, b.lights[i].solid_angle) << i;
-  }
-}
-
-void expect_error(const std::function<void()>& f, const std::string& needle) {
-  try {
-    f();
-    ADD_FAILURE() << "no error; expected one containing \"" << needle << "\"";
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
   }
 }
 
