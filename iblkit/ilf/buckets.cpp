@@ -86,12 +86,12 @@ DirectionTable make_direction_table(const Sequence& seq, int width, int height, 
   return t;
 }
 
-namespace {
-
-std::string block_path(const std::string& dir, int k) { return (fs::path(dir) / fmt::format("block_{:05d}.bin", k)).string(); }
+std::string BucketStore::block_path(const std::string& dir, int k) {
+  return (fs::path(dir) / fmt::format("block_{:05d}.bin", k)).string();
+}
 
 // FNV-1a over the inputs that determine the block files' contents.
-std::string cache_key(const Sequence& seq, const BucketDesc& desc, int w, int h) {
+std::string bucket_cache_key(const Sequence& seq, const BucketDesc& desc, int w, int h) {
   uint64_t hsh = 1469598103934665603ull;
   auto mix = [&](const std::string& s) {
     for (unsigned char c : s) { hsh ^= c; hsh *= 1099511628211ull; }
@@ -108,7 +108,68 @@ std::string cache_key(const Sequence& seq, const BucketDesc& desc, int w, int h)
   return fmt::format("{:016x}-{}", hsh, seq.probes.size());
 }
 
-}  // namespace
+void sequence_frame_size(const Sequence& seq, bool skip_bad, int* width, int* height) {
+  int w = 0, h = 0;
+  for (size_t i = 0; i < seq.probes.size() && w == 0; ++i) {
+    try {
+      auto spec = io::read_image_spec(seq.probes[i].image);
+      w = spec.width;
+      h = spec.height;
+    } catch (const Error& e) {
+      if (!skip_bad) fail(e.kind(), "probe {}: field \"image\": {}", i, e.what());
+    }
+  }
+  if (w == 0) fail(ErrorKind::Io, "{}: no probe frame could be read", seq.manifest);
+  *width = w;
+  *height = h;
+}
+
+std::string read_probe_samples(const Sequence& seq, int p, const DirectionTable& t, const BucketDesc& desc,
+                               std::vector<float>& rgb) {
+  const auto& pe = seq.probes[p];
+  std::string bad;
+  Image img;
+  try {
+    img = io::read_image(pe.image, {desc.sanitize, 3});
+    if (img.width() != t.width || img.height() != t.height)
+      bad = fmt::format("field \"image\": {} is {}x{}, the sequence's frames are {}x{}", pe.image, img.width(), img.height(), t.width, t.height);
+  } catch (const Error& e) {
+    bad = fmt::format("field \"image\": {}", e.what());
+  }
+  rgb.assign(size_t(t.slots()) * 3, 0.0f);
+  if (bad.empty()) {
+    double sum = 0;
+    for (int64_t s = 0; s < t.slots(); ++s) {
+      const float* px = img.data() + size_t(t.pixel[s]) * img.channels();
+      for (int ch = 0; ch < 3; ++ch) rgb[s * 3 + ch] = img.channels() >= 3 ? px[ch] : px[0];
+      sum += rgb[s * 3] + rgb[s * 3 + 1] + rgb[s * 3 + 2];
+    }
+    if (!(sum > 0)) bad = fmt::format("field \"image\": {} is all black inside the mapping", pe.image);
+  }
+  if (bad.empty()) return "";
+  std::fill(rgb.begin(), rgb.end(), 0.0f);
+  return fmt::format("{}: probe {}: {}", seq.manifest, p, bad);
+}
+
+void scatter_probe_samples(const DirectionTable& t, const float* rgb, int pc, int i, uint16_t* chunk) {
+  for (int b = 0; b < t.buckets(); ++b) {
+    int64_t s0 = t.bucket_begin[b], nb = t.bucket_begin[b + 1] - s0;
+    floats_to_halves(rgb + s0 * 3, chunk + (size_t(pc) * s0 + size_t(i) * nb) * 3, size_t(nb) * 3);
+  }
+}
+
+BucketStore BucketStore::open(const std::string& dir, DirectionTable table, int probe_count, int chunk,
+                              std::vector<uint8_t> valid) {
+  if (probe_count < 1 || chunk < 1 || int(valid.size()) != probe_count)
+    fail(ErrorKind::Internal, "{}: bucket store of {} probes in chunks of {} with {} flags", dir, probe_count, chunk, valid.size());
+  BucketStore st;
+  st.dir_ = dir;
+  st.table_ = std::move(table);
+  st.probe_count_ = probe_count;
+  st.chunk_ = chunk;
+  st.valid_ = std::move(valid);
+  return st;
+}
 
 void BucketStore::load_block(int k, std::vector<uint16_t>& buf) const {
   const auto& t = table_;
@@ -142,16 +203,7 @@ BucketStore BucketStore::sort(const Sequence& seq, const BucketDesc& desc, const
   BucketReport& rep = report ? *report : local;
   // The first frame with a readable header fixes the size (its pixels are checked with the others').
   int w = 0, h = 0;
-  for (size_t i = 0; i < seq.probes.size() && w == 0; ++i) {
-    try {
-      auto spec = io::read_image_spec(seq.probes[i].image);
-      w = spec.width;
-      h = spec.height;
-    } catch (const Error& e) {
-      if (!desc.skip_bad) fail(e.kind(), "probe {}: field \"image\": {}", i, e.what());
-    }
-  }
-  if (w == 0) fail(ErrorKind::Io, "{}: no probe frame could be read", seq.manifest);
+  sequence_frame_size(seq, desc.skip_bad, &w, &h);
   BucketStore st;
   st.dir_ = desc.dir;
   st.probe_count_ = int(seq.probes.size());
@@ -159,7 +211,7 @@ BucketStore BucketStore::sort(const Sequence& seq, const BucketDesc& desc, const
   const auto& t = st.table_;
   size_t per_probe = size_t(t.slots()) * 3 * 2;
   st.chunk_ = int(std::clamp<size_t>(desc.memory_bytes / 4 / per_probe, 1, size_t(st.probe_count_)));
-  std::string key = cache_key(seq, desc, w, h);
+  std::string key = bucket_cache_key(seq, desc, w, h);
   fs::path index = fs::path(desc.dir) / "index.json";
   if (desc.reuse && fs::exists(index)) {
     try {
@@ -198,40 +250,16 @@ BucketStore BucketStore::sort(const Sequence& seq, const BucketDesc& desc, const
     auto t0 = std::chrono::steady_clock::now();
     parallel_for(0, pc, [&](int64_t i) {
       int p = c0 + int(i);
-      const auto& pe = seq.probes[p];
-      std::string bad;
-      Image img;
-      try {
-        img = io::read_image(pe.image, {desc.sanitize, 3});
-        if (img.width() != w || img.height() != h)
-          bad = fmt::format("field \"image\": {} is {}x{}, the sequence's frames are {}x{}", pe.image, img.width(), img.height(), w, h);
-      } catch (const Error& e) {
-        bad = fmt::format("field \"image\": {}", e.what());
-      }
-      std::vector<float> rgb(size_t(t.slots()) * 3);
-      if (bad.empty()) {
-        double sum = 0;
-        for (int64_t s = 0; s < t.slots(); ++s) {
-          const float* px = img.data() + size_t(t.pixel[s]) * img.channels();
-          for (int ch = 0; ch < 3; ++ch) rgb[s * 3 + ch] = img.channels() >= 3 ? px[ch] : px[0];
-          sum += rgb[s * 3] + rgb[s * 3 + 1] + rgb[s * 3 + 2];
-        }
-        if (!(sum > 0)) bad = fmt::format("field \"image\": {} is all black inside the mapping", pe.image);
-      }
-      if (!bad.empty()) {
-        std::string msg = fmt::format("{}: probe {}: {}", seq.manifest, p, bad);
+      std::vector<float> rgb;
+      std::string msg = read_probe_samples(seq, p, t, desc, rgb);
+      if (!msg.empty()) {
         if (!desc.skip_bad) fail(ErrorKind::Value, "{} (skip_bad skips such probes)", msg);
-        std::fill(rgb.begin(), rgb.end(), 0.0f);
         std::lock_guard lk(mu);
         st.valid_[p] = 0;
         ++rep.skipped;
         rep.reasons.push_back(msg);
       }
-      // Scatter into the chunk buffer: bucket b's region holds [probe in chunk][sample][rgb].
-      for (int b = 0; b < t.buckets(); ++b) {
-        int64_t s0 = t.bucket_begin[b], nb = t.bucket_begin[b + 1] - s0;
-        floats_to_halves(rgb.data() + s0 * 3, chunk.data() + (size_t(pc) * s0 + size_t(i) * nb) * 3, size_t(nb) * 3);
-      }
+      scatter_probe_samples(t, rgb.data(), pc, int(i), chunk.data());
       ibl::report(progress, "sort", 0.9 * double(++done) / st.probe_count_);
     });
     read_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

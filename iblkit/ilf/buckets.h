@@ -69,6 +69,12 @@ class BucketStore {
 
   static BucketStore sort(const Sequence& seq, const BucketDesc& desc, const ProgressFn& progress = {},
                           BucketReport* report = nullptr);
+  // A store over block files that another driver wrote in this layout with `chunk` probes per segment
+  // (ilf/mpi/ writes each rank's blocks so); valid as above.
+  static BucketStore open(const std::string& dir, DirectionTable table, int probe_count, int chunk,
+                          std::vector<uint8_t> valid);
+  // The file of block k in folder dir.
+  static std::string block_path(const std::string& dir, int k);
 
  private:
   std::string dir_;
@@ -76,6 +82,20 @@ class BucketStore {
   int probe_count_ = 0, chunk_ = 0;
   std::vector<uint8_t> valid_;
 };
+
+// The pieces of BucketStore::sort, for drivers that split the frames between processes (ilf/mpi/):
+// The frame size every probe must have: the first probe whose header reads. Throws the sort's error
+// when that fails for a probe and skip_bad is off, or when no header reads.
+void sequence_frame_size(const Sequence& seq, bool skip_bad, int* width, int* height);
+// Reads probe p's frame into rgb (3 floats per slot of t). Returns "" for a good frame, else the line
+// the sort fails with or reports ("MANIFEST: probe P: field \"image\": …"); rgb is then zeros.
+std::string read_probe_samples(const Sequence& seq, int p, const DirectionTable& t, const BucketDesc& desc,
+                               std::vector<float>& rgb);
+// Writes probe i's rgb as halves into a chunk buffer of pc probes laid out as a block file's segment:
+// bucket b's region starts at pc·bucket_begin[b]·3 and holds [probe in chunk][sample][rgb].
+void scatter_probe_samples(const DirectionTable& t, const float* rgb, int pc, int i, uint16_t* chunk);
+// The key of index.json: the frames (path, size, modification time), mapping and settings.
+std::string bucket_cache_key(const Sequence& seq, const BucketDesc& desc, int width, int height);
 
 // Half-float conversion helpers (IEEE binary16).
 void halves_to_floats(const uint16_t* in, float* out, size_t n);

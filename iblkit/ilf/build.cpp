@@ -5,6 +5,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <mutex>
 
 #include "iblkit/core/check.h"
 #include "iblkit/core/error.h"
@@ -48,18 +49,15 @@ std::vector<float> bucket_basis(const DirectionTable& t, int b0, int b1, int ban
   return B;
 }
 
-SHGrid build_shgrid(const Sequence& seq_in, const BuildDesc& desc, const ProgressFn& progress, BuildReport* report) {
-  auto t_all = Clock::now();
-  BuildReport local;
-  BuildReport& rep = report ? *report : local;
+GridDesc build_grid(const Sequence& seq, const BuildDesc& desc) {
   if (desc.bands < kMinBuildBands || desc.bands > kMaxBuildBands)
     fail(ErrorKind::Value, "bands {} outside [{}, {}]", desc.bands, kMinBuildBands, kMaxBuildBands);
   if (!(desc.project.kernel_cells > 0))
     fail(ErrorKind::Value, "kernel_cells {} must be > 0 (the kernel's support in grid cells)", desc.project.kernel_cells);
   if (!std::isfinite(desc.project.kernel_cells))
     fail(ErrorKind::Value, "kernel_cells {} must be a finite number of grid cells", desc.project.kernel_cells);
-  GridDesc grid{desc.nx, desc.ny, desc.nz, desc.volume ? *desc.volume : seq_in.volume};
-  SHGrid out(grid, desc.bands);  // validates resolution, bands and volume
+  GridDesc grid{desc.nx, desc.ny, desc.nz, desc.volume ? *desc.volume : seq.volume};
+  SHGrid check(grid, 1);  // validates resolution and volume
   {  // project_bucket's raster per thread: the projected volume plus the kernel's support, at Δ = raster_cells·h
     Vec3 sp = grid.spacing();
     double h = std::max({sp.x, sp.y, sp.z}), R = desc.project.kernel_cells * h / 2, delta = std::max(desc.project.raster_cells, 0.05) * h;
@@ -67,20 +65,10 @@ SHGrid build_shgrid(const Sequence& seq_in, const BuildDesc& desc, const Progres
     require_allocation(fmt::format("a kernel of {:g} grid cells (kernel_cells)", desc.project.kernel_cells), side * side, 16,
                        "choose a smaller kernel_cells");
   }
-  rep.probes_in = int(seq_in.probes.size());
-  Sequence seq = seq_in;
-  if (desc.subsample) {
-    auto t0 = Clock::now();
-    SubsampleDesc sd = *desc.subsample;
-    sd.skip_bad = sd.skip_bad || desc.buckets.skip_bad;
-    auto keep = subsample(seq_in, sd, progress);
-    seq.probes.clear();
-    for (int i : keep) seq.probes.push_back(seq_in.probes[i]);
-    rep.subsampled_out = int(seq_in.probes.size() - keep.size());
-    rep.t_subsample = since(t0);
-  }
-  // Sort.
-  auto t0 = Clock::now();
+  return grid;
+}
+
+BucketDesc resolve_directions(const Sequence& seq, const BuildDesc& desc) {
   BucketDesc bd = desc.buckets;
   if (bd.octahedral < 0) {
     // Auto: pixel buckets for small frames, else octahedral cells (see docs/ilf.md for the trade-off).
@@ -96,6 +84,83 @@ SHGrid build_shgrid(const Sequence& seq_in, const BuildDesc& desc, const Progres
     }
     bd.octahedral = pixels > desc.auto_pixel_buckets ? desc.auto_octahedral : 0;
   }
+  return bd;
+}
+
+BlockStats project_block(const BucketStore& store, int k, const std::vector<uint16_t>& buf, const GridDesc& grid,
+                         const ProjectDesc& desc, const std::vector<Vec3>& origins, float* R, BlockScratch& scratch) {
+  const DirectionTable& t = store.table();
+  int P = store.probe_count();
+  int64_t G = grid.count(), rows = 3 * G;
+  int b0 = t.block_begin[k], b1 = t.block_begin[k + 1], D = b1 - b0;
+  struct Ctx { const float* data; int64_t stride; };
+  std::atomic<int64_t> rays_n{0}, uncovered{0};
+  std::mutex mu;
+  BlockStats bs;
+  parallel_for(0, D, [&](int64_t j) {
+    auto tb = Clock::now();
+    int b = b0 + int(j);
+    int nb = int(t.bucket_begin[b + 1] - t.bucket_begin[b]);
+    std::vector<float> rad(size_t(P) * nb * 3);
+    for (int p = 0; p < P; ++p) halves_to_floats(store.samples(buf, k, b, p), rad.data() + size_t(p) * nb * 3, size_t(nb) * 3);
+    Ctx ctx{rad.data(), int64_t(nb) * 3};
+    BucketRays rays;
+    rays.dirs = t.dir.data() + t.bucket_begin[b] * 3;
+    rays.weights = t.weight.data() + t.bucket_begin[b];
+    rays.n_dirs = nb;
+    rays.origins = origins.data();
+    rays.valid = store.valid().data();
+    rays.n_probes = P;
+    rays.ctx = &ctx;
+    rays.radiance = [](const void* c, int p) {
+      auto* x = static_cast<const Ctx*>(c);
+      return x->data + p * x->stride;
+    };
+    auto st = project_bucket(grid, rays, desc, R + size_t(j) * rows, G, scratch.local());
+    rays_n += st.rays;
+    uncovered += st.uncovered;
+    double busy = since(tb);
+    std::lock_guard lk(mu);
+    bs.repair_seconds += st.repair_seconds;
+    bs.busy_seconds += busy;
+  });
+  bs.rays = rays_n;
+  bs.uncovered = uncovered;
+  return bs;
+}
+
+void store_coefficients(const float* C, SHGrid& out) {
+  // C(c·G + g, k) → data[(g·K + k)·3 + c].
+  int K = out.coeff_count();
+  int64_t G = out.grid().count(), rows = 3 * G;
+  auto& data = out.data();
+  parallel_for(0, G, [&](int64_t g) {
+    for (int kk = 0; kk < K; ++kk)
+      for (int c = 0; c < 3; ++c) data[(size_t(g) * K + kk) * 3 + c] = C[size_t(kk) * rows + size_t(c) * G + g];
+  }, 1024);
+}
+
+SHGrid build_shgrid(const Sequence& seq_in, const BuildDesc& desc, const ProgressFn& progress, BuildReport* report) {
+  auto t_all = Clock::now();
+  BuildReport local;
+  BuildReport& rep = report ? *report : local;
+  GridDesc grid = build_grid(seq_in, desc);
+  SHGrid out(grid, desc.bands);
+  rep.probes_in = int(seq_in.probes.size());
+  Sequence seq = seq_in;
+  if (desc.subsample) {
+    auto t0 = Clock::now();
+    SubsampleDesc sd = *desc.subsample;
+    sd.skip_bad = sd.skip_bad || desc.buckets.skip_bad;
+    auto keep = subsample(seq_in, sd, progress);
+    seq.probes.clear();
+    for (int i : keep) seq.probes.push_back(seq_in.probes[i]);
+    rep.subsampled_out = int(seq_in.probes.size() - keep.size());
+    rep.t_subsample = since(t0);
+  }
+  // Sort.
+  auto t0 = Clock::now();
+  BucketDesc bd = resolve_directions(seq, desc);
   BucketReport br;
   BucketStore store = BucketStore::sort(seq, bd, progress, &br);
   rep.t_sort = since(t0);
@@ -115,36 +180,18 @@ SHGrid build_shgrid(const Sequence& seq_in, const BuildDesc& desc, const Progres
   int64_t G = grid.count(), rows = 3 * G;
   std::vector<float> C(size_t(rows) * K, 0.0f), R;
   std::vector<uint16_t> buf;
-  tbb::enumerable_thread_specific<ProjectScratch> scratch;
-  struct Ctx { const float* data; int64_t stride; };
-  std::atomic<int64_t> samples{0}, uncovered{0};
+  BlockScratch scratch;
+  double repair_s = 0, busy_s = 0;
   for (int k = 0; k < t.blocks(); ++k) {
     auto tp = Clock::now();
     store.load_block(k, buf);
     int b0 = t.block_begin[k], b1 = t.block_begin[k + 1], D = b1 - b0;
     R.resize(size_t(rows) * D);  // no clearing: project_bucket writes every (point, channel) of its column
-    parallel_for(0, D, [&](int64_t j) {
-      int b = b0 + int(j);
-      int nb = int(t.bucket_begin[b + 1] - t.bucket_begin[b]);
-      std::vector<float> rad(size_t(P) * nb * 3);
-      for (int p = 0; p < P; ++p) halves_to_floats(store.samples(buf, k, b, p), rad.data() + size_t(p) * nb * 3, size_t(nb) * 3);
-      Ctx ctx{rad.data(), int64_t(nb) * 3};
-      BucketRays rays;
-      rays.dirs = t.dir.data() + t.bucket_begin[b] * 3;
-      rays.weights = t.weight.data() + t.bucket_begin[b];
-      rays.n_dirs = nb;
-      rays.origins = origins.data();
-      rays.valid = store.valid().data();
-      rays.n_probes = P;
-      rays.ctx = &ctx;
-      rays.radiance = [](const void* c, int p) {
-        auto* x = static_cast<const Ctx*>(c);
-        return x->data + p * x->stride;
-      };
-      auto st = project_bucket(grid, rays, desc.project, R.data() + size_t(j) * rows, G, scratch.local());
-      samples += st.rays;
-      uncovered += st.uncovered;
-    });
+    auto bs = project_block(store, k, buf, grid, desc.project, origins, R.data(), scratch);
+    rep.samples += bs.rays;
+    rep.uncovered += bs.uncovered;
+    repair_s += bs.repair_seconds;
+    busy_s += bs.busy_seconds;
     rep.t_project += since(tp);
     auto ta = Clock::now();
     auto B = bucket_basis(t, b0, b1, desc.bands);
@@ -152,15 +199,9 @@ SHGrid build_shgrid(const Sequence& seq_in, const BuildDesc& desc, const Progres
     rep.t_accumulate += since(ta);
     ibl::report(progress, "resample", double(k + 1) / t.blocks());
   }
-  // C(c·G + g, k) → data[(g·K + k)·3 + c].
-  auto& data = out.data();
-  parallel_for(0, G, [&](int64_t g) {
-    for (int kk = 0; kk < K; ++kk)
-      for (int c = 0; c < 3; ++c) data[(size_t(g) * K + kk) * 3 + c] = C[size_t(kk) * rows + size_t(c) * G + g];
-  }, 1024);
-  rep.samples = samples;
-  rep.uncovered = uncovered;
-  rep.fraction_uncovered = double(uncovered) / (double(G) * t.buckets());
+  store_coefficients(C.data(), out);
+  rep.t_repair = busy_s > 0 ? rep.t_project * repair_s / busy_s : 0.0;
+  rep.fraction_uncovered = double(rep.uncovered) / (double(G) * t.buckets());
   rep.t_total = since(t_all);
   return out;
 }

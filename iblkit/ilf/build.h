@@ -4,6 +4,8 @@
 // product (grid points × buckets)·(buckets × coefficients). A GPU backend or a distributed driver
 // replaces the per-block loop (project_block / accumulate_block) without touching the maths.
 #pragma once
+#include <tbb/enumerable_thread_specific.h>
+
 #include <optional>
 #include <string>
 
@@ -41,6 +43,7 @@ struct BuildReport {
   double fraction_uncovered = 0;       // uncovered / (grid points · buckets)
   bool buckets_reused = false;         // an earlier run's bucket files were reused
   double t_subsample = 0, t_sort = 0, t_project = 0, t_accumulate = 0, t_total = 0;  // seconds
+  double t_repair = 0;                 // the repair's share of t_project (its share of the buckets' thread time)
   double gemm_flops = 0;               // floating-point operations of the SH matrix products
 };
 
@@ -53,5 +56,23 @@ std::vector<float> bucket_basis(const DirectionTable& t, int b0, int b1, int ban
 
 SHGrid build_shgrid(const Sequence& seq, const BuildDesc& desc, const ProgressFn& progress = {},
                     BuildReport* report = nullptr);
+
+// The phases of build_shgrid, for drivers that split the work between processes (ilf/mpi/):
+// checks desc (bands, kernel and the size of its raster) and returns the grid it builds over seq;
+GridDesc build_grid(const Sequence& seq, const BuildDesc& desc);
+// desc.buckets with `auto` directions resolved from the first readable frame header;
+BucketDesc resolve_directions(const Sequence& seq, const BuildDesc& desc);
+// projects and repairs every bucket of block k (in buf, from store.load_block(k, buf)) onto the grid:
+// R is (3·G × D) column-major, D the block's buckets, bucket b0 + j in column j; origins[p] is probe
+// p's position. Sums the buckets' statistics (repair_seconds: thread seconds, with busy_seconds).
+struct BlockStats {
+  int64_t rays = 0, uncovered = 0;
+  double repair_seconds = 0, busy_seconds = 0;  // summed over threads
+};
+using BlockScratch = tbb::enumerable_thread_specific<ProjectScratch>;
+BlockStats project_block(const BucketStore& store, int k, const std::vector<uint16_t>& buf, const GridDesc& grid,
+                         const ProjectDesc& desc, const std::vector<Vec3>& origins, float* R, BlockScratch& scratch);
+// C (3·G × K, column-major, as accumulate_block leaves it) into the grid's coefficient layout.
+void store_coefficients(const float* C, SHGrid& out);
 
 }  // namespace ibl::ilf

@@ -1,6 +1,7 @@
 #include "iblkit/ilf/project.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <string>
 
@@ -174,7 +175,9 @@ ProjectStats project_bucket(const GridDesc& grid, const BucketRays& rays, const 
       w[i] = sc.den[i] > 0 ? 1.0f : 0.0f;
       for (int ch = 0; ch < 3; ++ch) sc.rad[i * 3 + ch] = sc.den[i] > 0 ? sc.num[i * 3 + ch] / sc.den[i] : 0.0f;
     }
+    auto t0 = std::chrono::steady_clock::now();
     pull_push(sc.rad, w, W, H, sc.tmp);
+    st.repair_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
   int64_t G = grid.count();
   sc.covered.assign(size_t(G), 0);
@@ -211,7 +214,11 @@ ProjectStats project_bucket(const GridDesc& grid, const BucketRays& rays, const 
         }
       }
     }
-  if (desc.repair == Repair::Mip && st.uncovered > 0) repair_mip(grid, out, out_stride, sc.covered.data());
+  if (desc.repair == Repair::Mip && st.uncovered > 0) {
+    auto t0 = std::chrono::steady_clock::now();
+    repair_mip(grid, out, out_stride, sc.covered.data());
+    st.repair_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
   return st;
 }
 

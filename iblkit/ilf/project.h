@@ -39,6 +39,7 @@ struct BucketRays {
 struct ProjectStats {
   int64_t rays = 0;       // rays splatted
   int64_t uncovered = 0;  // grid points no ray reached (repaired)
+  double repair_seconds = 0;  // time spent in the repair (pull–push or mip), this thread
 };
 
 // Per-thread scratch, reused across buckets.

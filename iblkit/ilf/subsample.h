@@ -29,4 +29,14 @@ double difference_energy(const Image& a, const Image& b, const sphere::Mapping& 
 std::vector<int> subsample(const Sequence& seq, const SubsampleDesc& desc, const ProgressFn& progress = {},
                            SubsampleReport* report = nullptr);
 
+// The pieces of subsample, for drivers that split the pairs between processes (ilf/mpi/):
+// checks desc's values (the error subsample gives);
+void check_subsample_desc(const SubsampleDesc& desc);
+// E(probe i, probe i+1) for the pairs i in [i0, i1), 1e300 where the two lie farther apart than
+// max_distance or a frame is skipped (progress from 0 to 1 over these pairs);
+std::vector<double> neighbour_energies(const Sequence& seq, const SubsampleDesc& desc, int i0, int i1,
+                                       const ProgressFn& progress = {});
+// the probes to keep of n, given E of every pair (n − 1 values).
+std::vector<int> keep_from_energies(int n, const std::vector<double>& e, double threshold);
+
 }  // namespace ibl::ilf
