@@ -7,6 +7,7 @@
 
 #include "cli.h"
 #include "render_setup.h"
+#include "iblkit/core/atomic_file.h"
 #include "iblkit/augment/camera_io.h"
 #include "iblkit/augment/composite.h"
 #include "iblkit/augment/load.h"
@@ -80,7 +81,7 @@ void run(const Opts& o, const ibl::io::EnvReadDesc& read) {
   else
     ibl::io::write_image(o.out, r.composite);
   if (!o.layers.empty()) {
-    fs::create_directories(o.layers);
+    ibl::make_output_folders(fs::path(o.layers).string());
     fs::path dir(o.layers);
     write_layer(dir, "mask", r.mask);
     write_layer(dir, "difference", r.difference);

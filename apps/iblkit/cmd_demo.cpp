@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "cli.h"
+#include "iblkit/core/atomic_file.h"
 #include "iblkit/core/error.h"
 #include "iblkit/core/json_file.h"
 #include "iblkit/io/draw.h"
@@ -24,7 +25,7 @@ using ibl::sphere::MappingKind;
 // Step 1: the probe in every mapping, with previews and the power kept by each conversion.
 void mappings_step(iblcli::DemoContext& ctx) {
   auto env = ibl::io::read_envmap(ctx.probe);
-  fs::create_directories(fs::path(ctx.out_dir) / "mappings");
+  ibl::make_output_folders(fs::path(fs::path(ctx.out_dir) / "mappings").string());
   struct Target {
     MappingKind kind;
     int w, h;
@@ -72,7 +73,7 @@ void setup(CLI::App& app) {
     iblcli::DemoContext ctx;
     ctx.out_dir = o->out;
     ctx.probe = o->probe.empty() ? iblcli::default_probe() : o->probe;
-    fs::create_directories(ctx.out_dir);
+    ibl::make_output_folders(fs::path(ctx.out_dir).string());
     auto& steps = iblcli::demo_registry();
     std::stable_sort(steps.begin(), steps.end(), [](const auto& a, const auto& b) { return a.order < b.order; });
     for (const auto& name : o->only)

@@ -12,6 +12,7 @@
 #include "cli.h"
 #include "fuse_cli.h"
 #include "fusion_pictures.h"
+#include "iblkit/core/atomic_file.h"
 #include "iblkit/core/error.h"
 #include "iblkit/core/json_file.h"
 #include "iblkit/fusion/local_lights.h"
@@ -79,7 +80,7 @@ void run_at(const FuseOpts& o, const std::string& probes, const std::string& at,
   progress_done();
   for (const auto& w : map.warnings) info("warning: " + w);
   fs::path base = fs::path(out).parent_path() / fs::path(out).stem();
-  if (!base.parent_path().empty()) fs::create_directories(base.parent_path());
+  if (!base.parent_path().empty()) ibl::make_output_folders(fs::path(base.parent_path()).string());
   std::string ext = fs::path(out).extension().string();
   if (ext.empty()) ext = ".exr";
   ibl::io::write_image(base.string() + ext, map.radiance.image);
@@ -151,8 +152,8 @@ void run_path(const FuseOpts& o, const std::string& probes, const std::string& p
   pd.track.filter = !no_filter;
   pd.track.time_constant = tau;
   fs::path dir(out);
-  fs::create_directories(dir / "frames");
-  fs::create_directories(dir / "lights");
+  ibl::make_output_folders(fs::path(dir / "frames").string());
+  ibl::make_output_folders(fs::path(dir / "lights").string());
   std::vector<std::pair<std::string, ibl::Image>> pics;
   size_t every = std::max<size_t>(1, path.size() / 8);
   auto write_frame = [&](const fu::PathFrame& f) {

@@ -13,6 +13,7 @@
 #include "cli.h"
 #include "fuse_cli.h"
 #include "fusion_pictures.h"
+#include "iblkit/core/atomic_file.h"
 #include "iblkit/core/error.h"
 #include "iblkit/fusion/evaluate.h"
 #include "iblkit/core/json_file.h"
@@ -68,7 +69,7 @@ std::string point_name(Vec3 x) { return fmt::format("({:g}, {:g}, {:g})", x.x, x
 std::vector<fu::EvalRow> evaluate(const fu::ProbeSet& set, const ibl::lab::Scene& scene, const std::vector<Vec3>& points,
                                   const FuseOpts& fo, int truth_samples, int area_samples, const fs::path& dir,
                                   std::vector<std::pair<std::string, std::string>>* pictures, const std::string& view) {
-  fs::create_directories(dir);
+  ibl::make_output_folders(fs::path(dir).string());
   const fu::Reference ref = lab_reference(scene, truth_samples, area_samples);
   fu::EvalDesc ed;
   ed.fuse = fuse_desc(fo);
@@ -172,7 +173,7 @@ namespace {
 // at a point in the stem; a few seconds.
 void demo_step(DemoContext& ctx) {
   fs::path dir = fs::path(ctx.out_dir) / "fusion";
-  fs::create_directories(dir);
+  ibl::make_output_folders(fs::path(dir).string());
   auto scene = ibl::lab::load_scene("t-corridor");
   ibl::lab::SequenceDesc sd;
   sd.capture.size = 128;

@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "cli.h"
+#include "iblkit/core/atomic_file.h"
 #include "iblkit/core/parallel.h"
 #include "iblkit/ilf/analytic.h"
 #include "iblkit/ilf/build.h"
@@ -43,7 +44,7 @@ Image slice(const ilf::Box& v, F&& irradiance_at) {
 
 void ilf_step(iblcli::DemoContext& ctx) {
   fs::path dir = fs::path(ctx.out_dir) / "ilf";
-  fs::create_directories(dir);
+  ibl::make_output_folders(fs::path(dir).string());
   std::string manifest;
   std::function<Vec3(Vec3)> truth;
   std::string scene_name;

@@ -11,6 +11,7 @@
 
 #include "cli.h"
 #include "render_setup.h"
+#include "iblkit/core/atomic_file.h"
 #include "iblkit/core/error.h"
 #include "iblkit/core/json_file.h"
 #include "iblkit/io/image_io.h"
@@ -143,7 +144,7 @@ void run_truth(const TruthOpts& o) {
   if (d.bands > 0) j["sh"] = ibl::sh::to_json(t.sh);
   if (!t.sh_visible.c.empty()) j["sh_visible"] = ibl::sh::to_json(t.sh_visible);
   if (!o.out.empty()) {
-    fs::create_directories(o.out);
+    ibl::make_output_folders(fs::path(o.out).string());
     fs::path out(o.out);
     ibl::io::write_image((out / "radiance.exr").string(), t.radiance.image);
     ibl::io::write_image((out / "radiance.png").string(), ibl::io::tonemap(t.radiance.image));
@@ -320,7 +321,7 @@ iblcli::Command reg("lab", setup);
 // camera and as a depth map, and the time one 250×250 mirror-ball probe of low-scene1 takes.
 void lab_step(iblcli::DemoContext& ctx) {
   fs::path dir = fs::path(ctx.out_dir) / "lab";
-  fs::create_directories(dir);
+  ibl::make_output_folders(fs::path(dir).string());
   nlohmann::json summary;
   for (const char* name : {"low-scene1", "low-scene2", "t-corridor", "crypt"}) {
     auto scene = ibl::lab::load_scene(name);

@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 
 #include "cli.h"
+#include "iblkit/core/atomic_file.h"
 #include "iblkit/io/image_io.h"
 #include "iblkit/lights/extract.h"
 #include "iblkit/lights/gltf.h"
@@ -238,7 +239,7 @@ iblcli::Command reg_eval("eval", setup_eval);
 
 void demo_step(iblcli::DemoContext& ctx) {
   auto env = ibl::io::read_envmap(ctx.probe);
-  fs::create_directories(fs::path(ctx.out_dir) / "lights");
+  ibl::make_output_folders(fs::path(fs::path(ctx.out_dir) / "lights").string());
   std::string base = (fs::path(ctx.out_dir) / "lights").string();
   MethodsEvalDesc ev;
   ev.counts = {1, 2, 4, 8, 16, 32, 64};

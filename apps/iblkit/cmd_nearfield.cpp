@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "cli.h"
+#include "iblkit/core/atomic_file.h"
 #include "iblkit/core/error.h"
 #include "iblkit/io/draw.h"
 #include "iblkit/io/image_io.h"
@@ -410,7 +411,7 @@ iblcli::Command reg("nearfield", setup);
 // and the crypt, each against the exact answer and the far field; Fig. 3.
 void nearfield_step(iblcli::DemoContext& ctx) {
   fs::path dir = fs::path(ctx.out_dir) / "nearfield";
-  fs::create_directories(dir);
+  ibl::make_output_folders(fs::path(dir).string());
   json summary;
   nf::Placement origin;
   origin.position = {0, 0, 0};

@@ -11,6 +11,7 @@
 #include "cli.h"
 #include "render_setup.h"
 #include "render_truth.h"
+#include "iblkit/core/atomic_file.h"
 #include "iblkit/io/draw.h"
 #include "iblkit/core/error.h"
 #include "iblkit/geometry/mesh.h"
@@ -339,7 +340,7 @@ void setup(CLI::App& app) {
 // Demo step: the blob lit by the demo probe's 5-band SH, on the CPU and (where GL exists) on GL,
 // with the per-pixel difference between the two.
 void demo_step(iblcli::DemoContext& ctx) {
-  fs::create_directories(fs::path(ctx.out_dir) / "render");
+  ibl::make_output_folders(fs::path(fs::path(ctx.out_dir) / "render").string());
   FrameDesc d;
   d.camera.width = 480;
   d.camera.height = 360;

@@ -114,7 +114,7 @@ iblcli::Command reg("sh", setup);
 void demo_step(iblcli::DemoContext& ctx) {
   sphere::EnvMap env = io::read_envmap(ctx.probe);
   fs::path dir = fs::path(ctx.out_dir) / "sh";
-  fs::create_directories(dir);
+  ibl::make_output_folders(fs::path(dir).string());
   auto t0 = std::chrono::steady_clock::now();
   sh::Coeffs c5 = sh::project(env, 5);
   double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();

@@ -124,7 +124,9 @@ int main(int argc, char** argv) {
     }
   }
   try {
+    ibl::OutputTransaction outputs;  // a command that fails leaves its outputs as they were (atomic_file.h)
     app.parse(argc, argv);
+    outputs.commit();
   } catch (const CLI::ParseError& e) {
     const std::string unknown = e.get_exit_code() != 0 ? iblcli::unknown_subcommand(app, argc, argv) : "";  // not for --help
     if (!unknown.empty()) return std::fprintf(stderr, "iblkit: error: %s\n", unknown.c_str()), 1;

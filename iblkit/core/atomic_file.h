@@ -45,8 +45,43 @@ void write_file_atomically(const std::string& path, std::string_view bytes);
 void remove_live_temp_files() noexcept;
 
 // For programs (the CLI calls it first thing; the library never does): on SIGINT, SIGTERM and
-// SIGHUP, remove_live_temp_files() and then die of the signal as without the handler. A signal the
-// process ignores (nohup, a shell's background job) stays ignored.
+// SIGHUP, remove_live_temp_files(), roll back the open OutputTransaction, and then die of the signal
+// as without the handler. A signal the process ignores (nohup, a shell's background job) stays ignored.
 void remove_temp_files_on_signals();
+
+// A command's outputs as one (issue 19: "a command that fails after writing one of several outputs
+// removes what it wrote"). While a transaction is open, AtomicFile::commit() still renames each file
+// into place at once (so the command can read back what it wrote: a capture's frames, cached depth
+// maps), but first keeps the file it replaces as a hard link beside it ("<stem>.bak-<pid>-<n><ext>"),
+// and make_output_folders() notes the folders it creates. commit() drops the kept files. Destroying
+// an uncommitted transaction (the command threw), or a signal while it is open, puts every replaced
+// file back, removes every new file, and removes the folders it created once they are empty: the
+// outputs are as before the command. One transaction at a time per process (the CLI opens one
+// around each subcommand; the library never opens one).
+//
+//   OutputTransaction tx;        // AtomicFile commits from now on are provisional
+//   run_the_command();           // throws → ~OutputTransaction rolls everything back
+//   tx.commit();                 // keep every output
+class OutputTransaction {
+ public:
+  OutputTransaction();   // ErrorKind::Internal if one is open already
+  ~OutputTransaction();  // rolls back unless committed
+  OutputTransaction(const OutputTransaction&) = delete;
+  OutputTransaction& operator=(const OutputTransaction&) = delete;
+  void commit();
+  // Files renamed into place so far (for tests and messages).
+  size_t files() const;
+
+  struct State;
+
+ private:
+  State* state_;
+};
+
+// Creates `dir` and its missing parents (like mkdir -p), noting each folder it creates in the open
+// OutputTransaction. The one rule for output folders (docs/cli.md, "Outputs"): every command creates
+// the missing folders of its outputs, files and folders alike, and removes them again when it fails.
+// ErrorKind::Io "DIR: cannot create folder (reason)"; "DIR: cannot create folder (P is not a folder)".
+void make_output_folders(const std::string& dir);
 
 }  // namespace ibl

@@ -1,3 +1,4 @@
+#include "iblkit/core/atomic_file.h"
 #include "iblkit/ilf/analytic.h"
 
 #include <atomic>
@@ -109,7 +110,7 @@ std::vector<sh::Coeffs> AnalyticField::exact_sh(const std::vector<Vec3>& xs, int
 
 std::string write_synthetic_sequence(const AnalyticField& f, const SynthDesc& d, const ProgressFn& progress) {
   if (d.probes < 1 || d.size < 8) fail(ErrorKind::Value, "synthetic sequence: need ≥ 1 probe of ≥ 8 pixels");
-  fs::create_directories(fs::path(d.out_dir) / "frames");
+  ibl::make_output_folders(fs::path(fs::path(d.out_dir) / "frames").string());
   Sequence seq;
   seq.mapping = sphere::MappingKind::MirrorBall;
   seq.dead_angle_deg = d.dead_angle_deg;

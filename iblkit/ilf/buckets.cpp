@@ -1,3 +1,4 @@
+#include "iblkit/core/atomic_file.h"
 #include "iblkit/ilf/buckets.h"
 
 #include <Imath/half.h>
@@ -196,9 +197,7 @@ const uint16_t* BucketStore::samples(const std::vector<uint16_t>& buf, int k, in
 BucketStore BucketStore::sort(const Sequence& seq, const BucketDesc& desc, const ProgressFn& progress,
                               BucketReport* report) {
   if (desc.dir.empty()) fail(ErrorKind::Value, "direction buckets: no folder given for the block files");
-  std::error_code ec;
-  fs::create_directories(desc.dir, ec);
-  if (ec) fail(ErrorKind::Io, "{}: cannot create the bucket folder ({})", desc.dir, ec.message());
+  ibl::make_output_folders(desc.dir);
   BucketReport local;
   BucketReport& rep = report ? *report : local;
   // The first frame with a readable header fixes the size (its pixels are checked with the others').
@@ -234,6 +233,7 @@ BucketStore BucketStore::sort(const Sequence& seq, const BucketDesc& desc, const
       // An unreadable index means the files are rebuilt.
     }
   }
+  std::error_code ec;
   fs::remove(index, ec);
   for (int k = 0; k < t.blocks(); ++k) {
     FILE* f = std::fopen(block_path(desc.dir, k).c_str(), "wb");

@@ -1,3 +1,4 @@
+#include "iblkit/core/atomic_file.h"
 #include "iblkit/io/envmap_io.h"
 
 #include <array>
@@ -63,7 +64,7 @@ void write_cube_faces(const std::string& dir, const EnvMap& cube, const std::str
   MappingKind k = cube.mapping.kind();
   if (k != MappingKind::CubeHCross && k != MappingKind::CubeVCross && k != MappingKind::CubeStrip)
     fail(ErrorKind::Value, "write_cube_faces needs a cube layout, got {}", sphere::mapping_name(k));
-  fs::create_directories(dir);
+  ibl::make_output_folders(fs::path(dir).string());
   int n = cube.mapping.face_size();
   for (int f = 0; f < 6; ++f) {
     Image face(n, n, cube.image.channels());

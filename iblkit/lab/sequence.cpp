@@ -1,3 +1,4 @@
+#include "iblkit/core/atomic_file.h"
 #include "iblkit/lab/sequence.h"
 
 #include <chrono>
@@ -87,9 +88,7 @@ json rotation_json(const Mat3& m) {
 }
 
 void make_dir(const fs::path& p) {
-  std::error_code ec;
-  fs::create_directories(p, ec);
-  if (ec) fail(ErrorKind::Io, "{}: cannot create folder ({})", p.string(), ec.message());
+  ibl::make_output_folders(p.string());
 }
 
 // Captures every probe and hands it to `sink(k, capture)` on a writer thread while the next one

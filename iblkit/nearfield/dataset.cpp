@@ -1,3 +1,4 @@
+#include "iblkit/core/atomic_file.h"
 #include "iblkit/nearfield/dataset.h"
 
 #include <cmath>
@@ -145,9 +146,7 @@ void write_dataset(const std::string& path, const Dataset& ds) {
   const fs::path dir = fs::path(path).parent_path();
   // Images go to STEM_images/ so that two manifests in one folder never share (and overwrite) images.
   const std::string sub = fs::path(path).stem().string() + "_images";
-  std::error_code ec;
-  fs::create_directories(dir / sub, ec);
-  if (ec) fail(ErrorKind::Io, "{}: cannot create {}: {}", path, (dir / sub).string(), ec.message());
+  ibl::make_output_folders((dir / sub).string());
   json ms = json::array();
   for (int j = 0; j < ds.ny; ++j)
     for (int i = 0; i < ds.nx; ++i) {
