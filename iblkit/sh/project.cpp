@@ -76,8 +76,7 @@ void row_dots(const float* ch, const float* tab, int n, int ld, double* out) {
     for (int j = 0; j < G; ++j) out[c * ld + j] = hsum(acc[c][j]);
 }
 
-Coeffs project_latlong(const sphere::EnvMap& env, int bands, const ProgressFn& progress) {
-  const Image& img = env.image;
+Coeffs project_latlong(const ImageView& img, int bands, const ProgressFn& progress) {
   const int W = img.width(), H = img.height(), C = img.channels(), K = coeff_count(bands);
   const int Wp = (W + kLanes - 1) / kLanes * kLanes;
   const int J = 2 * bands - 1;            // tables: cos 0, then (Re, Im) w^m for m = 1..L
@@ -211,10 +210,8 @@ bool pixel_basis(const sphere::Mapping& m, int bands, int x, int y, double* out,
 
 }  // namespace
 
-Coeffs project_generic(const sphere::EnvMap& env, int bands, const ProgressFn& progress) {
+Coeffs project_generic(const ImageView& img, const sphere::Mapping& m, int bands, const ProgressFn& progress) {
   check_bands(bands);
-  const Image& img = env.image;
-  const sphere::Mapping& m = env.mapping;
   const int W = img.width(), H = img.height(), C = img.channels(), K = coeff_count(bands);
   std::atomic<int> rows_done{0};
   Partial total = parallel_reduce_fixed<Partial>(
@@ -246,11 +243,21 @@ Coeffs project_generic(const sphere::EnvMap& env, int bands, const ProgressFn& p
   return out;
 }
 
-Coeffs project(const sphere::EnvMap& env, int bands, const ProgressFn& progress) {
+Coeffs project_generic(const sphere::EnvMap& env, int bands, const ProgressFn& progress) {
+  return project_generic(env.image.view(), env.mapping, bands, progress);
+}
+
+Coeffs project(const ImageView& img, const sphere::Mapping& m, int bands, const ProgressFn& progress) {
   check_bands(bands);
-  if (env.image.empty()) fail(ErrorKind::Value, "cannot project an empty image onto SH");
-  if (env.mapping.kind() == MappingKind::LatLong) return project_latlong(env, bands, progress);
-  return project_generic(env, bands, progress);
+  if (img.width() == 0 || img.height() == 0) fail(ErrorKind::Value, "cannot project an empty image onto SH");
+  if (img.width() != m.width() || img.height() != m.height())
+    fail(ErrorKind::Value, "SH projection: the image is {}x{} but its mapping {}x{}", img.width(), img.height(), m.width(), m.height());
+  if (m.kind() == MappingKind::LatLong) return project_latlong(img, bands, progress);
+  return project_generic(img, m, bands, progress);
+}
+
+Coeffs project(const sphere::EnvMap& env, int bands, const ProgressFn& progress) {
+  return project(env.image.view(), env.mapping, bands, progress);
 }
 
 Coeffs project_function(const std::function<Vec3(Vec3)>& f, int bands, int degree) {

@@ -17,8 +17,12 @@ namespace ibl::sh {
 // i.e. the exact projection of the piecewise-constant image. Other mappings evaluate the basis at
 // pixel centres (project_generic). Throws ibl::Error for bands outside 1..kMaxBands.
 Coeffs project(const sphere::EnvMap& env, int bands, const ProgressFn& progress = {});
+// The same on a view of pixels in mapping m (view and mapping of one size; rows may have any stride):
+// the Python module projects numpy arrays with it without copying them.
+Coeffs project(const ImageView& img, const sphere::Mapping& m, int bands, const ProgressFn& progress = {});
 // The per-pixel path for any mapping (also the reference the lat-long path is tested against).
 Coeffs project_generic(const sphere::EnvMap& env, int bands, const ProgressFn& progress = {});
+Coeffs project_generic(const ImageView& img, const sphere::Mapping& m, int bands, const ProgressFn& progress = {});
 
 // Projection of an analytic function f(d) → RGB with a quadrature exact for band-limited f of
 // up to `degree` (default 2·(bands−1) + 8: exact for products with polynomials of degree ≤ 8).
