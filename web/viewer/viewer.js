@@ -15,6 +15,7 @@ const params = new URLSearchParams(location.search);
 const num = (k, d) => (params.has(k) ? Number(params.get(k)) : d);
 const vec = (k, d) => (params.has(k) ? params.get(k).split(',').map(Number) : d);
 const testMode = params.get('ui') === '0';
+if (testMode) document.getElementById('info').style.display = 'none';  // pictures without captions
 
 const state = {
   mode: params.get('mode') || 'sh',          // sh | specular | lights | grid
@@ -253,6 +254,7 @@ const patchTarget = new THREE.WebGLRenderTarget(4, 4, { type: THREE.FloatType })
 function gridIrradiance(gi, samples) {
   if (!gridsLoaded[gi]) throw new Error(`grid ${gi} is not loaded`);
   const { grid } = gridsLoaded[gi];
+  const parent = grid.parent;  // an object has one parent: borrow the grid from the main scene
   patchScene.add(grid);
   const cam = new THREE.OrthographicCamera(-4e-4, 4e-4, 4e-4, -4e-4, 1e-4, 1);
   const px = new Float32Array(4 * 4 * 4), out = [];
@@ -273,6 +275,7 @@ function gridIrradiance(gi, samples) {
   renderer.setRenderTarget(saveTarget);
   renderer.toneMapping = saveTone;
   patchScene.remove(grid);
+  if (parent) parent.add(grid);
   return out;
 }
 
