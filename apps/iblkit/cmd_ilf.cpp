@@ -9,6 +9,7 @@
 #include "iblkit/core/error.h"
 #include "iblkit/ilf/analytic.h"
 #include "iblkit/ilf/build.h"
+#include "iblkit/ilf/threejs_grid.h"
 #include "iblkit/io/image_io.h"
 #include "iblkit/io/tonemap.h"
 
@@ -311,6 +312,29 @@ void setup_synth(CLI::App& app) {
   });
 }
 
+// The grid as three.js r187's LightProbeGridWebGL loads it (ilf/threejs_grid.h, docs/web.md).
+void setup_export_threejs(CLI::App& app) {
+  struct Opts { std::string grid, out, name = "grid"; };
+  auto* o = new Opts();
+  app.add_option("grid", o->grid, ".shgrid file")->required();
+  app.add_option("-o,--out", o->out, "output folder (NAME.json and NAME_atlas.bin)")->required();
+  app.add_option("--name", o->name, "base name of the two files")->capture_default_str();
+  app.footer("Example:\n  iblkit ilf export-threejs room.shgrid --out web-grid");
+  app.callback([o] {
+    if (o->name.empty() || o->name.find_first_of("/\\") != std::string::npos)
+      fail(ErrorKind::Value, "--name \"{}\": expected a plain file name", o->name);
+    auto g = ilf::read_shgrid(o->grid);
+    std::string json = ilf::write_threejs_grid(g, o->out, o->name);
+    const auto& gd = g.grid();
+    iblcli::emit({{"grid", o->grid}, {"out", json}, {"resolution", {gd.nx, gd.ny, gd.nz}}, {"bands_kept", std::min(g.bands(), 3)},
+                  {"bands", g.bands()}},
+                 [&] {
+                   fmt::print("wrote {} and its atlas: {}x{}x{} probes, 3 of {} bands, atlas {}x{}x{} RGBA float32\n", json, gd.nx, gd.ny,
+                              gd.nz, g.bands(), gd.nx, gd.ny, ilf::kThreeAtlasVolumes * (gd.nz + 2 * ilf::kThreeAtlasPadding));
+                 });
+  });
+}
+
 void setup(CLI::App& app) {
   app.require_subcommand(1);
   app.footer("Examples:\n  iblkit lab capture low-scene2 --grid 4,4,4 --mapping mirrorball --size 64 --out cap\n"
@@ -321,6 +345,7 @@ void setup(CLI::App& app) {
   setup_slice(*app.add_subcommand("slice", "Irradiance on a plane through the grid, as a picture"));
   setup_info(*app.add_subcommand("info", "Describe an .shgrid"));
   setup_synth(*app.add_subcommand("synth", "Write a synthetic probe sequence of a closed-form light field"));
+  setup_export_threejs(*app.add_subcommand("export-threejs", "Write the grid as three.js LightProbeGridWebGL loads it (atlas + JSON)"));
 }
 
 iblcli::Command reg("ilf", setup);

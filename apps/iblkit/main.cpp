@@ -45,6 +45,8 @@ constexpr Subcommand kSubcommands[] = {
 #if defined(IBLKIT_HAVE_GL) && defined(IBLKIT_HAVE_GLFW)
     {"view", "Interactive viewer (GLFW window): orbit, move the object, switch lightings", "view"},
 #endif
+    {"web", "Write the three.js viewer folder with probes, light sets and SH grids to open in a browser", nullptr},
+    {"serve", "Serve a web viewer folder (iblkit demo writes one) to a browser on this machine", nullptr},
     {"demo", "Run the built-in demo: a real probe through every module, pictures and numbers", nullptr},
 };
 
