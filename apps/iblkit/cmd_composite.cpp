@@ -10,6 +10,10 @@
 #include "iblkit/core/atomic_file.h"
 #include "iblkit/augment/camera_io.h"
 #include "iblkit/augment/composite.h"
+#ifdef IBLKIT_HAVE_GL
+#include "iblkit/augment/gl/compositor.h"
+#include "iblkit/render/gl/context.h"
+#endif
 #include "iblkit/augment/load.h"
 #include "iblkit/augment/measure.h"
 #include "iblkit/augment/object.h"
@@ -29,6 +33,9 @@ struct Opts {
   double fov = 40, object_size = 0.3;
   int triangles = 20000, median_cut = 0;
   ibl::augment::CompositeDesc desc;
+#ifdef IBLKIT_HAVE_GL
+  ibl::augment::gl::GlCompositeDesc gl;
+#endif
 };
 
 void write_layer(const fs::path& dir, const std::string& name, const ibl::Image& img) {
@@ -36,8 +43,19 @@ void write_layer(const fs::path& dir, const std::string& name, const ibl::Image&
 }
 
 void run(const Opts& o, const ibl::io::EnvReadDesc& read) {
-  if (o.backend != "cpu" && o.backend != "auto")
-    ibl::fail(ibl::ErrorKind::Value, "--backend {}: only the CPU reference (cpu) composites for now", o.backend);
+  if (o.backend != "cpu" && o.backend != "gl" && o.backend != "auto")
+    ibl::fail(ibl::ErrorKind::Value, "--backend {}: expected cpu, gl or auto", o.backend);
+  std::string backend = o.backend;
+#ifdef IBLKIT_HAVE_GL
+  if (backend == "auto") {
+    std::string why;
+    backend = ibl::render::gl::available(&why) ? "gl" : "cpu";
+    if (backend == "cpu") iblcli::info("--backend auto: no OpenGL context (" + why + "): the CPU reference composites");
+  }
+#else
+  if (backend == "gl") ibl::fail(ibl::ErrorKind::Unsupported, "--backend gl: iblkit was built without OpenGL (IBLKIT_WITH_GL)");
+  if (backend == "auto") backend = "cpu";
+#endif
   if (o.light.size() > 1) ibl::fail(ibl::ErrorKind::Value, "--light: give one light file");
   ibl::Image photo = ibl::io::read_image(o.photo);
   ibl::geometry::Camera cam;
@@ -73,7 +91,18 @@ void run(const Opts& o, const ibl::io::EnvReadDesc& read) {
   if (o.median_cut > 0) L.light = ibl::augment::as_median_cut(L.light, o.median_cut);
   ibl::augment::CompositeDesc d = o.desc;
   d.progress = iblcli::progress_bar();
-  auto r = ibl::augment::composite(photo, cam, L.proxy, L.light, object, od.albedo, d);
+  ibl::augment::CompositeResult r;
+#ifdef IBLKIT_HAVE_GL
+  if (backend == "gl") {
+    ibl::augment::gl::GlCompositeDesc g = o.gl;
+    g.albedo_samples = d.light_samples;
+    g.seed = d.seed;
+    g.shadows = d.shadows;
+    g.bounce = d.bounce_samples > 0;
+    r = ibl::augment::gl::composite(photo, cam, L.proxy, L.light, object, od.albedo, g);
+  }
+#endif
+  if (backend == "cpu") r = ibl::augment::composite(photo, cam, L.proxy, L.light, object, od.albedo, d);
   iblcli::progress_done();
   for (const auto& w : r.warnings) iblcli::info("warning: " + w);
   if (fs::path(o.out).extension() == ".png")
@@ -92,6 +121,7 @@ void run(const Opts& o, const ibl::io::EnvReadDesc& read) {
   const auto& s = r.stats;
   nlohmann::json j = {{"out", o.out},
                       {"light", L.light.source},
+                      {"backend", backend},
                       {"seconds", s.seconds},
                       {"proxy_pixels", s.proxy_pixels},
                       {"object_pixels", s.object_pixels},
@@ -108,8 +138,8 @@ void run(const Opts& o, const ibl::io::EnvReadDesc& read) {
                    {"brightened_pixels", e.brightened_pixels}, {"shadow_signal", e.shadow_signal}};
   }
   iblcli::emit(j, [&] {
-    fmt::print("composited the object into {} ({}x{}, light: {}) in {:.2f} s: {}\n", o.photo, cam.width, cam.height, L.light.source,
-               s.seconds, o.out);
+    fmt::print("composited the object into {} ({}x{}, light: {}, backend {}) in {:.2f} s: {}\n", o.photo, cam.width, cam.height,
+               L.light.source, backend, s.seconds, o.out);
     fmt::print("  {} object pixels, {} proxy pixels changed by its shadow and light\n", s.object_pixels, s.changed_pixels);
     if (!o.layers.empty()) fmt::print("  layers: {}/mask, difference, albedo, render_with, render_without (.exr)\n", o.layers);
     if (!o.truth.empty())
@@ -148,7 +178,15 @@ void setup(CLI::App& app) {
   app.add_option("--median-cut", o->median_cut, "baseline: the light cut into N median-cut lights (shadows and shading from those only)")
       ->check(CLI::Range(1, 4096));
   app.add_flag("--no-shadows", [o](int64_t) { o->desc.shadows = false; }, "baseline: the object pasted without its shadow and light on the scene");
-  app.add_option("--backend", o->backend, "cpu (the ray-traced reference; auto means cpu for now)")->capture_default_str();
+  app.add_option("--backend", o->backend, "cpu (the ray-traced reference), gl (OpenGL: shadow maps and a soft sphere term), auto (gl "
+                 "when a GL context can be made)")->capture_default_str();
+#ifdef IBLKIT_HAVE_GL
+  app.add_option("--gl-lights", o->gl.split.lights, "gl: most hard lights with shadow maps")->check(CLI::Range(0, 16))->capture_default_str();
+  app.add_option("--gl-threshold", o->gl.split.threshold, "gl: a texel brighter than this x the mean radiance is a hard light's")
+      ->check(CLI::Range(0.0, 1e6))->capture_default_str();
+  app.add_option("--shadow-map-size", o->gl.shadow_map_size, "gl: texels per side of each light's shadow maps")->check(CLI::Range(16, 8192))
+      ->capture_default_str();
+#endif
   app.add_option("-o,--out", o->out, "the composite (.exr linear, .png tone mapped)")->capture_default_str();
   app.add_option("--layers", o->layers, "folder for mask, difference, albedo, render_with, render_without (.exr)");
   app.add_option("--truth", o->truth, "a photograph with the object really there (iblkit lab photograph): print the errors");

@@ -1,0 +1,84 @@
+// Differential rendering on the GPU (OpenGL 4.5, headless EGL or a window's context): the real-time twin
+// of augment/composite.h. What it computes per frame, for a photograph pixel that sees the proxy at y:
+//
+//   ΔE(y) = − Σ_l E_l(y) · B_l(y)                                hard lights (split_light.h) the object blocks,
+//                                                               B_l from the object's shadow map (PCF) where
+//                                                               the proxy's own map says the light reaches y
+//           + Ω_cos(y) · (ρ_obj/π · E_face − L_soft(behind))    the soft term: the object's equivalent sphere
+//                                                               (sphere_occlusion.h) hides the soft light
+//                                                               behind it and reflects its own (one bounce)
+//   composite = photo + min(ρ, 1)/π · ΔE,    ρ from estimate_albedo (albedo.h, computed once on the CPU)
+//
+// E_with − E_without is evaluated as the sum of these terms, the only inputs that differ between the two
+// renders, so ΔE is exactly 0 (the pixel is the photograph, bit for bit) where no shadow-map tap sees the
+// object and the sphere's cosine-weighted share is below the cut-off. The object is drawn with 4× MSAA
+// against the proxy's depth (occluded where the proxy is in front), lit by the soft irradiance (SH, 3
+// bands: the proxy's light as the probe saw it) and the hard lights through both maps.
+//
+// Interreflection kept: proxy → object as captured (in the soft map, not darkened by the object's own
+// shadow), object → proxy through the sphere (its face towards y lit by the soft irradiance and the hard
+// lights, unshadowed). Not kept: the object's light on itself, glossy objects.
+#pragma once
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "iblkit/augment/composite.h"
+#include "iblkit/augment/split_light.h"
+#include "iblkit/augment/sphere_occlusion.h"
+
+namespace ibl::augment::gl {
+
+struct GlCompositeDesc {
+  SplitDesc split;             // hard lights (≤ 16) and their threshold
+  int shadow_map_size = 512;   // texels per side of each light's two maps (fitted to the object's bounding sphere)
+  int pcf = 1;                 // (2·pcf + 1)² taps per shadow lookup
+  int msaa = 4;                // samples per pixel of the object pass (its coverage at edges)
+  double cut = 1e-3;           // the soft term is 0 where the sphere's cosine-weighted share is below this
+  bool shadows = true;         // false: the object pasted without shadow or reflection (a baseline)
+  bool bounce = true;          // the object's light on the proxy
+  int albedo_samples = 64;     // composite(): light samples per pixel of the albedo estimate
+  uint64_t seed = 1;
+};
+
+struct GlFrameTiming {
+  double gpu_ms = 0;   // GL_TIME_ELAPSED over the frame (shadow maps, proxy pass, object pass, blend)
+  double wall_ms = 0;  // CPU wall clock until glFinish (the figure that means something on llvmpipe)
+};
+
+// The scene that stays while the object moves. Needs a current OpenGL 4.5 context that outlives it.
+class Compositor {
+ public:
+  Compositor(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy, const SplitLight& light,
+             const Image& albedo, const GlCompositeDesc& desc = {});
+  ~Compositor();
+  Compositor(const Compositor&) = delete;
+  Compositor& operator=(const Compositor&) = delete;
+
+  // The object (world space, at its place) and its Lambertian albedo; uploaded once.
+  void set_object(const geometry::TriMesh& object, Vec3 albedo);
+  // One frame with the object moved by `offset` (world metres). gl_rows: the colour texture in GL's row
+  // order (bottom up, for a window's Presenter) instead of the photograph's.
+  void draw(Vec3 offset = {}, bool gl_rows = false, GlFrameTiming* timing = nullptr);
+  // The last frame: RGBA32F, linear radiance.
+  unsigned color_texture() const;
+  int width() const;
+  int height() const;
+  // The last frame read back (photograph's rows): composite, coverage mask, difference, and the proxy's
+  // composite before the object went over it.
+  void read_back(Image* composite, Image* mask, Image* difference, Image* proxy_composite) const;
+  const SplitLight& light() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// The whole composite on the GPU (a headless context of its own): the albedo estimated on the CPU
+// (estimate_albedo), the light split, one frame read back. Throws ibl::Error (kind Unsupported) when no GL
+// context can be had, and as composite() does on bad input.
+CompositeResult composite(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy, const LocalLight& light,
+                          const geometry::TriMesh& object, Vec3 albedo, const GlCompositeDesc& desc = {},
+                          GlFrameTiming* timing = nullptr);
+
+}  // namespace ibl::augment::gl

@@ -1,0 +1,92 @@
+#include "iblkit/augment/split_light.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "iblkit/core/error.h"
+#include "iblkit/geometry/raytracer.h"
+#include "iblkit/lights/cut.h"
+#include "iblkit/sh/convolve.h"
+#include "iblkit/sh/project.h"
+
+namespace ibl::augment {
+
+namespace {
+constexpr double kDepthInFront = 0.98;  // as light.cpp: a depth this much shorter than the proxy's hit is a lamp
+double mean_rgb(Vec3 L) { return (std::max(0.0, L.x) + std::max(0.0, L.y) + std::max(0.0, L.z)) / 3; }
+}  // namespace
+
+Vec3 HardLight::at(Vec3 centre, Vec3 x, Vec3 n) const {
+  if (distant) return irradiance * std::max(0.0, dot(n, direction));
+  Vec3 v = position - x;
+  double r2 = dot(v, v);
+  if (!(r2 > 0)) return {};
+  Vec3 c = position - centre;
+  return irradiance * (dot(c, c) / r2 * std::max(0.0, dot(n, v) / std::sqrt(r2)));
+}
+
+SplitLight split_light(const LocalLight& light, const geometry::TriMesh& proxy, const SplitDesc& desc) {
+  if (desc.lights < 0 || desc.lights > 256) fail(ErrorKind::Value, "hard lights {} must lie in 0..256", desc.lights);
+  if (!(desc.threshold >= 0) || !std::isfinite(desc.threshold)) fail(ErrorKind::Value, "hard-light threshold {} must be ≥ 0", desc.threshold);
+  if (desc.irradiance_size < 4 || desc.irradiance_size > 1024) fail(ErrorKind::Value, "irradiance map size {} must lie in 4..1024", desc.irradiance_size);
+  lights::LatLongGrid grid = lights::to_latlong_grid(light.map);
+  const int W = grid.width, H = grid.height;
+  double total = 0;
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) total += mean_rgb(grid.rgb[static_cast<size_t>(y) * W + x]) * grid.row_solid_angle[y];
+  if (!(total > 0)) fail(ErrorKind::Value, "the {} light has no positive radiance", light.source);
+  const double limit = desc.threshold * total / (4 * kPi);
+  SplitLight s;
+  s.centre = light.centre;
+  s.soft = Image(W, H, 3);
+  lights::LatLongGrid hard = grid;
+  int hard_texels = 0;
+  double hard_power = 0;
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      size_t i = static_cast<size_t>(y) * W + x;
+      bool is_hard = desc.lights > 0 && desc.threshold > 0 && mean_rgb(grid.rgb[i]) > limit;
+      if (is_hard) {
+        ++hard_texels;
+        hard_power += mean_rgb(grid.rgb[i]) * grid.row_solid_angle[y];
+      } else {
+        hard.rgb[i] = {};
+        s.soft.set_rgb(x, y, grid.rgb[i]);
+      }
+    }
+  s.hard_share = hard_power / total;
+  if (hard_texels > 0) {
+    lights::CutDesc cd;
+    cd.count = std::min(desc.lights, hard_texels);
+    lights::LightSet set = lights::median_cut(hard, cd);
+    geometry::RayTracer rt;
+    rt.add(proxy);
+    rt.commit();
+    for (const auto& l : set.lights) {
+      HardLight h;
+      h.direction = normalize(l.direction);
+      h.irradiance = l.irradiance;
+      h.solid_angle = l.solid_angle;
+      geometry::Hit hit = rt.intersect(light.centre, h.direction, 1e-6);
+      double dist = hit.hit ? hit.t : std::numeric_limits<double>::infinity();
+      if (!light.depth.empty()) {
+        double px, py;
+        if (light.map.mapping.to_pixel(h.direction, &px, &py)) {
+          int ix = std::clamp(static_cast<int>(px), 0, light.depth.width() - 1), iy = std::clamp(static_cast<int>(py), 0, light.depth.height() - 1);
+          double d = light.depth.at(ix, iy, 0);
+          if (d > 0 && std::isfinite(d) && d < kDepthInFront * dist) dist = d;
+        }
+      }
+      h.distant = !std::isfinite(dist);
+      if (!h.distant) h.position = light.centre + h.direction * dist;
+      s.hard.push_back(h);
+    }
+  }
+  sphere::EnvMap soft_map(s.soft, sphere::Mapping(sphere::MappingKind::LatLong, W, H));
+  sh::Coeffs irr = sh::irradiance(sh::project(soft_map, 3));
+  s.soft_irradiance = sh::reconstruct(irr, sphere::Mapping(sphere::MappingKind::LatLong, 2 * desc.irradiance_size, desc.irradiance_size));
+  for (size_t i = 0; i < s.soft_irradiance.size(); ++i) s.soft_irradiance.data()[i] = std::max(0.0f, s.soft_irradiance.data()[i]);
+  return s;
+}
+
+}  // namespace ibl::augment

@@ -1,0 +1,44 @@
+#version 450 core
+// Differential rendering over the proxy's pixels: ΔE = E_with − E_without, written as the sum of what
+// the object changes — the hard lights it blocks (shadow maps) and, from its equivalent sphere, the soft
+// light it hides less the light it reflects (one bounce) — so that ΔE is exactly 0 wherever none of them
+// touches the pixel; composite = photo + min(ρ, 1)/π · ΔE.
+uniform sampler2D u_photo, u_albedo, u_gpos, u_gnormal, u_soft, u_soft_irradiance;
+uniform vec4 u_sphere;        // the object's equivalent sphere: centre (moved), radius
+uniform vec3 u_object_albedo;
+uniform float u_cut;          // cosine-weighted share of the hemisphere below which the soft term is 0
+uniform float u_soft_texel;   // solid angle of a soft-map texel at the equator, sr
+uniform int u_bounce, u_shadows;
+layout(location = 0) out vec4 o_composite;
+void main() {
+  ivec2 px = ivec2(gl_FragCoord.xy);
+  vec3 photo = texelFetch(u_photo, px, 0).rgb;
+  vec4 g = texelFetch(u_gpos, px, 0);
+  if (g.w < 0.5 || u_shadows == 0) {
+    o_composite = vec4(photo, 1.0);
+    return;
+  }
+  vec3 y = g.xyz, n = texelFetch(u_gnormal, px, 0).xyz, dE = vec3(0.0);
+  for (int l = 0; l < u_light_count; ++l) {
+    vec2 s = shadow(l, y, n, 1.0);
+    if (s.x == 0.0 && s.y > 0.0) dE -= s.y * light_at(l, y, n);
+  }
+  vec3 a = u_sphere.xyz - y;
+  float d2 = dot(a, a), s2 = u_sphere.w * u_sphere.w / d2;
+  if (s2 < 1.0) {
+    float om = cap_cosine_integral(dot(n, a) * inversesqrt(d2), s2) - PI * u_cut;
+    if (om > 0.0) {
+      vec3 w = a * inversesqrt(d2);
+      float cap = 2.0 * PI * (1.0 - sqrt(1.0 - s2));
+      vec3 hidden = textureLod(u_soft, latlong(w), 0.5 * log2(max(cap / u_soft_texel, 1.0))).rgb, reflected = vec3(0.0);
+      if (u_bounce != 0) {
+        vec3 face = -w, z = u_sphere.xyz + face * u_sphere.w, e = texture(u_soft_irradiance, latlong(face)).rgb;
+        for (int l = 0; l < u_light_count; ++l) e += light_at(l, z, face);
+        reflected = u_object_albedo / PI * e;
+      }
+      dE += om * (reflected - hidden);
+    }
+  }
+  vec3 rho = min(texelFetch(u_albedo, px, 0).rgb, vec3(1.0));
+  o_composite = vec4(max(photo + rho / PI * dE, vec3(0.0)), 1.0);
+}
