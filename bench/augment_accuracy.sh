@@ -7,16 +7,18 @@
 # Usage: bench/augment_accuracy.sh BUILD/iblkit [WIDTHxHEIGHT] [TRUTH_SAMPLES]
 set -eu
 # PHOTO_ARGS / CAPTURE_ARGS (environment): extra options of every photograph / capture (e.g. more area samples).
+# BACKEND=gl|cpu (environment, default cpu): which compositor the rows measure (--backend); REUSE=1 keeps the
+# photographs, captures and grids a previous run left under $OUT (the GL rows measured on the CPU rows' truths).
 BIN=$1; SIZE=${2:-320x240}; TS=${3:-8}; OUT=${OUT:-/tmp/augment_accuracy}
-read -ra PA <<<"${PHOTO_ARGS:-}"; read -ra CA <<<"${CAPTURE_ARGS:-}"
+read -ra PA <<<"${PHOTO_ARGS:-}"; read -ra CA <<<"${CAPTURE_ARGS:-}"; BACKEND=${BACKEND:-cpu}
 W=${SIZE%x*}; H=${SIZE#*x}
 mkdir -p "$OUT"
 row() {  # row SCENE LABEL ARGS… : one composite, one table row
   local scene=$1 label=$2; shift 2
   local j
   local d="$OUT/$(basename "$scene" .json)"
-  j=$("$BIN" composite "$d/photo.exr" "${CAM[@]}" "${OBJ[@]}" --truth "$d/truth.exr" --json --quiet \
-      --out "$d/comp_${label// /_}.exr" "$@")
+  j=$("$BIN" composite "$d/photo.exr" "${CAM[@]}" "${OBJ[@]}" --truth "$d/truth.exr" --json --quiet --backend "$BACKEND" \
+      --out "$d/comp_${BACKEND}_${label// /_}.exr" "$@")
   python3 -c 'import json, sys
 j = json.loads(sys.argv[3]); e = j["errors"]
 print("| %s | %s | %.1f %% | %.1f %% | %.2f %% | %.1f s |" % (sys.argv[1], sys.argv[2], 100 * e["object"], 100 * e["shadow"], 100 * e["unchanged"], j["seconds"]))' \
@@ -26,6 +28,7 @@ scene_run() {  # scene_run SCENE AT EYE TARGET VOLUME FUSED_PROBES
   local scene=$1 at=$2; CAM=(--eye "$3" --target "$4" --fov 40); local vol=$5 fused=$6
   OBJ=(--object blob --at "$at" --object-size 0.3)
   local name; name=$(basename "$scene" .json); local d="$OUT/$name"; mkdir -p "$d"
+  if [ "${REUSE:-0}" != 1 ] || [ ! -s "$d/grid.shgrid" ]; then
   "$BIN" lab photograph "$scene" "${CAM[@]}" --width "$W" --height "$H" --samples "$TS" "${PA[@]}" --out "$d/photo.exr" --quiet >/dev/null
   "$BIN" lab photograph "$scene" "${CAM[@]}" --width "$W" --height "$H" --samples "$TS" "${PA[@]}" "${OBJ[@]}" --mask "$d/mask.exr" \
     --out "$d/truth.exr" --quiet >/dev/null
@@ -34,13 +37,14 @@ scene_run() {  # scene_run SCENE AT EYE TARGET VOLUME FUSED_PROBES
   "$BIN" lab capture "$scene" --fusion "${probes[@]}" --size 128 "${CA[@]}" --out "$d/fused" --quiet >/dev/null
   "$BIN" lab capture "$scene" --grid 6,6,6 --volume "$vol" --size 32 "${CA[@]}" --out "$d/seq" --quiet >/dev/null
   "$BIN" ilf build "$d/seq/sequence.json" --grid 6 --bands 5 --out "$d/grid.shgrid" --quiet >/dev/null
-  row "$scene" "one probe" --probes "$d/one/probes.json" --layers "$d/layers"
+  fi
+  row "$scene" "one probe" --probes "$d/one/probes.json" --layers "$d/layers_$BACKEND"
   row "$scene" "fused probes" --probes "$d/fused/probes.json"
   row "$scene" "SH grid" --light "$d/grid.shgrid" --proxy "$d/one/proxy.obj"
   row "$scene" "pasted, no shadows" --probes "$d/one/probes.json" --no-shadows
   row "$scene" "16 median-cut lights" --probes "$d/one/probes.json" --median-cut 16
 }
-echo "| scene | light | object | shadow | unchanged | CPU |"
+echo "| scene | light | object | shadow | unchanged | $BACKEND wall |"
 echo "| --- | --- | --- | --- | --- | --- |"
 SCENES=${SCENES:-low-scene2 t-corridor outdoor}
 for sc in $SCENES; do

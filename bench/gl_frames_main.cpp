@@ -12,6 +12,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "iblkit/augment/gl/compositor.h"
 #include "iblkit/geometry/mesh.h"
 #include "iblkit/render/gl/context.h"
 #include "iblkit/render/gl/renderer.h"
@@ -147,7 +148,10 @@ int main(int argc, char** argv) {
     if (crypt.triangles.empty()) std::fprintf(stderr, "iblkit_glbench: no %s, skipping the crypt case\n", crypt_path.c_str());
     std::printf("{\"renderer\": \"%s\", \"triangles\": %zu, \"size\": \"%dx%d\", \"frames\": %d", ctx.renderer().c_str(),
                 blob.triangle_count(), width, height, frames);
+    // A sixth argument "composite" runs the compositor's case alone (llvmpipe takes minutes for the others).
+    const bool composite_only = argc > 6 && std::string(argv[6]) == "composite";
     for (bool deferred : {false, true}) {
+      if (composite_only) break;
       gl::Renderer r({deferred});
       FrameDesc d;
       d.camera.eye = {0, 0.4, 1.6};
@@ -235,6 +239,46 @@ int main(int argc, char** argv) {
       d.objects[0] = {&blob, Material{{0.7, 0.7, 0.7}, {0, 0, 0}, 1}};
       d.camera.eye = {0, 0.4, 1.6};
       d.camera.target = {0, 0, 0};
+    }
+    {
+      // Issue 14: the compositor (augment/gl/compositor.h) at width × height: the blob (tris, 0.4 m) over a
+      // room proxy (make_room), 16 hard lights each with its object and proxy shadow maps (512², 3×3 PCF;
+      // 12 points on the ceiling, 4 distant), the soft sphere term, 4× MSAA; the object moves every frame.
+      geometry::TriMesh room = make_room(6, 4, 8);
+      geometry::Camera cam;
+      cam.eye = {0.5, 1.6, 3.5};
+      cam.target = {0, 0.5, 0};
+      cam.width = width;
+      cam.height = height;
+      augment::SplitLight L;
+      L.centre = {0, 0.5, 0};
+      L.soft = Image(128, 64, 3, 0.2f);
+      L.soft_irradiance = Image(64, 32, 3, static_cast<float>(0.2 * kPi));
+      for (int i = 0; i < 16; ++i) {
+        augment::HardLight h;
+        h.irradiance = {0.3, 0.3, 0.3};
+        if (i < 12) {
+          h.distant = false;
+          h.position = {-2.5 + (i % 4) * 5.0 / 3, 4.0, -3.0 + (i / 4) * 3.0};
+          h.direction = normalize(h.position - L.centre);
+        } else {
+          h.direction = normalize(Vec3{std::cos(i * 1.3), 2.0, std::sin(i * 1.3)});
+        }
+        L.hard.push_back(h);
+      }
+      augment::gl::Compositor comp(Image(width, height, 3, 0.3f), cam, room, L, Image(width, height, 3, 0.5f));
+      geometry::TriMesh object = blob;
+      object.transform(0.5, {0, 0.5, 0});
+      comp.set_object(object, {0.7, 0.7, 0.7});
+      std::vector<double> gpu;
+      double wall = 0;
+      for (int f = 0; f < frames; ++f) {
+        augment::gl::GlFrameTiming t;
+        comp.draw({0.2 * std::sin(0.1 * f), 0, 0}, false, &t);
+        gpu.push_back(t.gpu_ms);
+        wall += t.wall_ms;
+      }
+      std::printf(",\n \"composite_16_lights_ms\": %.4f, \"composite_16_lights_wall_ms\": %.2f", median(gpu), wall / std::max(1, frames));
     }
     std::printf("}\n");
   } catch (const std::exception& e) {

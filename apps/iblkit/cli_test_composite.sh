@@ -39,7 +39,7 @@ check probe-no-position fail "needs its position" -- "$BIN" composite "$T/photo.
   --proxy "$T/fus/proxy.obj" --out "$T/c7.exr"
 check probe-outside-warns ok "lies outside the proxy" -- "$BIN" composite "$T/photo.exr" "${CAM[@]}" "${OBJ[@]}" --light "$T/fus/probes/p0.exr" \
   --at-probe 0,5,0 --proxy "$T/fus/proxy.obj" --samples 4 --object-samples 4 --out "$T/c8.exr"
-check gl-backend fail "only the CPU reference" -- "$BIN" composite "$T/photo.exr" "${CAM[@]}" --probes "$T/fus/probes.json" --backend gl \
+check bad-backend fail "expected cpu, gl or auto" -- "$BIN" composite "$T/photo.exr" "${CAM[@]}" --probes "$T/fus/probes.json" --backend vulkan \
   --out "$T/c9.exr"
 
 echo "$pass passed, $fail failed, $skip skipped"

@@ -16,6 +16,11 @@
 
 #include "cli.h"
 #include "render_setup.h"
+#include "iblkit/augment/albedo.h"
+#include "iblkit/augment/camera_io.h"
+#include "iblkit/augment/gl/compositor.h"
+#include "iblkit/augment/load.h"
+#include "iblkit/augment/object.h"
 #include "iblkit/core/error.h"
 #include "iblkit/io/image_io.h"
 #include "iblkit/io/tonemap.h"
@@ -37,6 +42,10 @@ struct ViewOpts {
   double gloss = 0.15, exponent = 20, exposure = 0, floor_size = 6;
   int frames = 0;
   iblcli::ShadowMapOptions shadow_maps;
+  // Composite mode (--composite PHOTO): the photograph behind, its camera, the captured light and proxy.
+  std::string photo, eye, target, up = "0,1,0", camera, probes, proxy, at_probe, albedo = "0.7,0.7,0.7";
+  double fov = 40;
+  int gl_lights = 16;
 };
 
 // Orbit camera around a target: azimuth, elevation (radians) and distance.
@@ -231,7 +240,105 @@ void show_frame(const ViewOpts& o, Inputs& in, State& st, Viewer& v, GLFWwindow*
                                       st.glossy ? ", glossy" : "").c_str());
 }
 
+// Composite mode: the object moved over the photograph (augment/gl/compositor.h), the camera the
+// photograph's; drag and the arrow keys move the object, + / - the exposure. Scripted (--frames N), the
+// object goes once round a circle of half its size about --at.
+void run_composite(const ViewOpts& o, const ibl::io::EnvReadDesc& rd) {
+  Image photo = io::read_image(o.photo);
+  geometry::Camera cam;
+  if (!o.camera.empty()) {
+    if (!o.eye.empty() || !o.target.empty()) fail(ErrorKind::Value, "give either --camera or --eye/--target, not both");
+    cam = augment::read_camera(o.camera);
+    if ((cam.width != 0 && cam.width != photo.width()) || (cam.height != 0 && cam.height != photo.height()))
+      fail(ErrorKind::Value, "{} is {}x{} but the photograph {} is {}x{}", o.camera, cam.width, cam.height, o.photo, photo.width(), photo.height());
+  } else {
+    if (o.eye.empty() || o.target.empty()) fail(ErrorKind::Value, "--composite: give the photograph's camera (--eye and --target, or --camera)");
+    cam.eye = iblcli::parse_vec3(o.eye, "--eye");
+    cam.target = iblcli::parse_vec3(o.target, "--target");
+    cam.up = iblcli::parse_vec3(o.up, "--up");
+    cam.fov_y_deg = o.fov;
+  }
+  cam.width = photo.width();
+  cam.height = photo.height();
+  augment::validate_camera(cam, o.camera.empty() ? "the camera" : o.camera);
+  const augment::ObjectDesc od = iblcli::inserted_object(o.object.scene, o.object.size, o.object.triangles, o.at, o.albedo);
+  geometry::TriMesh object = augment::make_object(od);
+  Vec3 lo, hi;
+  object.bounds(&lo, &hi);
+  augment::LightInput li;
+  li.probes = o.probes;
+  if (!o.lights.empty()) li.light = o.lights[0];
+  li.proxy = o.proxy;
+  if (!o.at_probe.empty()) li.at_probe = iblcli::parse_vec3(o.at_probe, "--at-probe");
+  li.read = rd;
+  augment::LoadedLight L = augment::load_light(li, lo, hi);
+  for (const auto& w : L.warnings) iblcli::info("warning: " + w);
+  iblcli::info("estimating the proxy's albedo (CPU, once)");
+  augment::AlbedoEstimate est = augment::estimate_albedo(photo, cam, L.proxy, L.light);
+  augment::SplitDesc sd;
+  sd.lights = o.gl_lights;
+  augment::SplitLight split = augment::split_light(L.light, L.proxy, sd);
+  if (!glfwInit()) fail(ErrorKind::Unsupported, "no display: GLFW could not initialise (is DISPLAY set? try xvfb-run)");
+  struct Terminate { ~Terminate() { glfwTerminate(); } } terminate;
+  GLFWwindow* win = open_window(photo.width(), photo.height(), o.frames == 0);
+  glfwSetWindowAttrib(win, GLFW_RESIZABLE, GLFW_FALSE);  // the frame is the photograph's
+  State st;
+  st.exposure = o.exposure;
+  st.step = 0.1 * od.size;
+  install_controls(win, &st);
+  auto comp = std::make_unique<augment::gl::Compositor>(photo, cam, L.proxy, split, est.albedo);
+  comp->set_object(object, od.albedo);
+  auto present = std::make_unique<gl::Presenter>();
+  const double meter = io::auto_exposure_scale(photo);
+  const std::string renderer_name = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+  Image last;
+  int frame = 0;
+  double ms_sum = 0;
+  while (!glfwWindowShouldClose(win) && (o.frames == 0 || frame < o.frames)) {
+    int fw = 0, fh = 0;
+    glfwGetFramebufferSize(win, &fw, &fh);
+    if (fw < 1 || fh < 1) {
+      glfwWaitEvents();
+      continue;
+    }
+    Vec3 offset = st.offset;
+    if (o.frames > 0) {
+      double a = 2 * kPi * frame / o.frames;
+      offset += Vec3{std::cos(a), 0, std::sin(a)} * (0.5 * od.size);
+    } else {
+      offset += Vec3{-st.orbit.azimuth, 0, st.orbit.elevation - 0.35} * (10 * st.step);  // drag: over the floor
+    }
+    augment::gl::GlFrameTiming t;
+    auto t0 = std::chrono::steady_clock::now();
+    comp->draw(offset, true, &t);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    present->draw(comp->color_texture(), std::min(fw, photo.width()), std::min(fh, photo.height()), meter * std::exp2(st.exposure));
+    if (!o.screenshot.empty() && (o.frames == 0 || frame + 1 == o.frames)) last = capture(std::min(fw, photo.width()), std::min(fh, photo.height()));
+    glfwSwapBuffers(win);
+    double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    ms_sum += ms;
+    ++frame;
+    bool software = renderer_name.find("llvmpipe") != std::string::npos;
+    glfwSetWindowTitle(win, fmt::format("iblkit view — composite {} — {} {:.2f} ms/frame, {} hard lights", std::filesystem::path(o.photo).filename().string(),
+                                        software ? "wall" : "GPU", software ? ms : t.gpu_ms, split.hard.size()).c_str());
+    glfwPollEvents();
+  }
+  present.reset();  // before the window's context goes
+  comp.reset();
+  glfwDestroyWindow(win);
+  if (!o.screenshot.empty() && !last.empty()) io::write_image(o.screenshot, last);
+  iblcli::emit({{"frames", frame}, {"ms_per_frame", frame ? ms_sum / frame : 0.0}, {"gl_renderer", renderer_name}, {"screenshot", o.screenshot},
+                {"mode", "composite"}, {"hard_lights", split.hard.size()}},
+               [&] {
+                 fmt::print("{} composite frames, {:.1f} ms per frame (shadow maps, differential render, display) on {}\n", frame,
+                            frame ? ms_sum / frame : 0.0, renderer_name);
+                 if (!o.screenshot.empty()) fmt::print("screenshot {}\n", o.screenshot);
+               });
+}
+
 void run(const ViewOpts& o, const ibl::io::EnvReadDesc& rd) {
+  if (!o.photo.empty()) return run_composite(o, rd);
+  if (o.lights.empty()) fail(ErrorKind::Value, "--light is required (or --composite PHOTO with its light)");
   Inputs in = read_inputs(o, rd);
   if (!glfwInit()) fail(ErrorKind::Unsupported, "no display: GLFW could not initialise (is DISPLAY set? try xvfb-run)");
   struct Terminate { ~Terminate() { glfwTerminate(); } } terminate;
@@ -280,8 +387,19 @@ void run(const ViewOpts& o, const ibl::io::EnvReadDesc& rd) {
 void setup(CLI::App& app) {
   auto* o = new ViewOpts();
   app.add_option("scene", o->object.scene, "the object: blob, sphere, or a mesh file (OBJ, PLY, glTF)")->capture_default_str();
-  app.add_option("-l,--light", o->lights, "lightings to switch between (keys 1-9, Tab): probe, .shgrid, iblkit.sh/1, iblkit.lights/1")
-      ->required();
+  app.add_option("-l,--light", o->lights, "lightings to switch between (keys 1-9, Tab): probe, .shgrid, iblkit.sh/1, iblkit.lights/1; "
+                 "with --composite: an SH grid or a probe image (with --proxy)");
+  app.add_option("--composite", o->photo, "composite mode: this photograph behind, the object moving in it with its shadows");
+  app.add_option("--eye", o->eye, "composite: the photograph's camera position x,y,z");
+  app.add_option("--target", o->target, "composite: the point at the photograph's centre");
+  app.add_option("--up", o->up, "composite: the world direction that appears upwards")->capture_default_str();
+  app.add_option("--fov", o->fov, "composite: vertical field of view, degrees")->capture_default_str();
+  app.add_option("--camera", o->camera, "composite: an iblkit.camera/1 file instead of --eye/--target/--up/--fov");
+  app.add_option("--probes", o->probes, "composite: an iblkit.probes/1 set with its proxy");
+  app.add_option("--proxy", o->proxy, "composite: the local scene's mesh (with --light)");
+  app.add_option("--at-probe", o->at_probe, "composite: where the --light probe was captured, x,y,z");
+  app.add_option("--albedo", o->albedo, "composite: the object's Lambertian albedo r,g,b")->capture_default_str();
+  app.add_option("--gl-lights", o->gl_lights, "composite: most hard lights with shadow maps")->check(CLI::Range(0, 16))->capture_default_str();
   app.add_option("--at", o->at, "the object's starting centre x,y,z (e.g. inside an SH grid's volume)")->capture_default_str();
   app.add_option("--object-size", o->object.size, "object size in metres")->check(CLI::Range(0.001, 1000.0))->capture_default_str();
   app.add_option("--floor-size", o->floor_size, "side of the floor square, metres")->check(CLI::Range(0.0, 1000.0))->capture_default_str();
@@ -301,7 +419,9 @@ void setup(CLI::App& app) {
       "G = glossy on/off, + / - = exposure, E = meter the auto exposure again, Esc = quit. The title shows the frame time.\n"
       "Examples:\n  iblkit view blob --light grid.shgrid --at 0,1,0 --object-size 0.3\n"
       "  iblkit view blob --light probe.exr --light lights.json\n"
-      "  xvfb-run -a iblkit view sphere --light probe.exr --frames 10 --screenshot view.png");
+      "  xvfb-run -a iblkit view sphere --light probe.exr --frames 10 --screenshot view.png\n"
+      "  iblkit view blob --composite photo.exr --eye 0,1.3,2.2 --target 0,0.3,0 --fov 40 --probes probe/probes.json --at 0.1,0.2,0.1\n"
+      "Composite mode: drag or the arrows / PageUp / PageDown move the object, + / - exposure, Esc quits.");
   app.callback([o, &rd] { run(*o, rd); });
 }
 

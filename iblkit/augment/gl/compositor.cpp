@@ -8,9 +8,7 @@
 
 #include <fmt/format.h>
 
-#include "iblkit/augment/albedo.h"
 #include "iblkit/core/error.h"
-#include "iblkit/render/gl/context.h"
 #include "iblkit/render/gl/program.h"
 
 namespace ibl::augment::gl {
@@ -18,7 +16,7 @@ namespace ibl::augment::gl {
 namespace {
 
 using geometry::Mat4f;
-constexpr int kMaxLights = 16;  // augment_common.glsl's MAX_LIGHTS
+constexpr int kMaxLights = Compositor::kMaxLights;
 constexpr float kFar = 1e30f;   // a shadow-map texel nothing covers
 
 // Flat-shaded triangles: position and face normal per corner (6 floats), so that both renders and the
@@ -388,7 +386,7 @@ void Compositor::draw(Vec3 offset, bool gl_rows, GlFrameTiming* timing) {
   const Vec3 c = m.sphere.centre + offset;
   glDisable(GL_CULL_FACE);
   glDisable(GL_BLEND);
-  if (m.desc.shadows) m.shadow_maps(c);
+  m.shadow_maps(c);  // the object's own shadows need them even when the proxy's (desc.shadows) are off
   const GLuint units[] = {m.photo_tex, m.albedo_tex, m.gpos, m.gnormal, m.soft_tex, m.irr_tex, m.object_map, m.proxy_map};
   glBindTextures(0, 8, units);
 
@@ -455,53 +453,6 @@ void Compositor::read_back(Image* composite, Image* mask, Image* difference, Ima
   if (mask) *mask = read_texture(m.diff, m.W, m.H, 1);
   if (difference) *difference = read_texture(m.diff, m.W, m.H, 3);
   if (proxy_composite) *proxy_composite = read_texture(m.proxy_comp, m.W, m.H, 3);
-}
-
-CompositeResult composite(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy, const LocalLight& light,
-                          const geometry::TriMesh& object, Vec3 albedo, const GlCompositeDesc& desc, GlFrameTiming* timing) {
-  auto t0 = std::chrono::steady_clock::now();
-  render::gl::Context context;
-  AlbedoEstimate est = estimate_albedo(photo, cam, proxy, light, desc.albedo_samples, desc.seed);
-  SplitDesc sd = desc.split;
-  sd.lights = std::min(sd.lights, kMaxLights);
-  SplitLight split = split_light(light, proxy, sd);
-  CompositeResult r;
-  {
-    Compositor comp(photo, cam, proxy, split, est.albedo, desc);
-    comp.set_object(object, albedo);
-    comp.draw({}, false, timing);
-    Image proxy_comp;
-    comp.read_back(&r.composite, &r.mask, &r.difference, &proxy_comp);
-    const int W = photo.width(), H = photo.height();
-    r.albedo = est.albedo;
-    r.render_without = Image(W, H, 3);
-    r.render_with = Image(W, H, 3);
-    for (int y = 0; y < H; ++y)
-      for (int x = 0; x < W; ++x) {
-        Vec3 rho = est.albedo.rgb(x, y), ph = photo.rgb(x, y), without;
-        for (int c = 0; c < 3; ++c) without[c] = rho[c] > 0 ? ph[c] * std::min(rho[c], 1.0) / rho[c] : 0.0;  // min(ρ,1)/π E₀
-        Vec3 with = without + (proxy_comp.rgb(x, y) - ph);
-        for (int c = 0; c < 3; ++c) with[c] = std::max(0.0, with[c]);
-        double f = r.mask.at(x, y, 0);
-        r.render_without.set_rgb(x, y, without);
-        r.render_with.set_rgb(x, y, with * (1 - f) + (r.composite.rgb(x, y) - proxy_comp.rgb(x, y) * (1 - f)));
-        if (f > 0) ++r.stats.object_pixels;
-        Vec3 d = proxy_comp.rgb(x, y) - ph;
-        if (d.x != 0 || d.y != 0 || d.z != 0) ++r.stats.changed_pixels;
-      }
-  }
-  r.stats.proxy_pixels = est.proxy_pixels;
-  r.stats.albedo_over_one = est.over_one;
-  r.stats.unlit = est.unlit;
-  r.stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  if (est.over_one > 0)
-    r.warnings.push_back(fmt::format("{} proxy pixels ({:.1f} %) have an estimated albedo > 1: the captured light is weaker there than "
-                                     "the photograph says; their change is limited to what a white surface would show",
-                                     est.over_one, 100.0 * est.over_one / std::max<int64_t>(1, est.proxy_pixels)));
-  if (est.unlit > 0)
-    r.warnings.push_back(fmt::format("{} proxy pixels receive no captured light in some channel: they keep the photograph's value", est.unlit));
-  if (r.stats.object_pixels == 0) r.warnings.push_back("no pixel of the photograph sees the object: check at, the eye and the target");
-  return r;
 }
 
 }  // namespace ibl::augment::gl

@@ -34,7 +34,7 @@ struct GlCompositeDesc {
   int shadow_map_size = 512;   // texels per side of each light's two maps (fitted to the object's bounding sphere)
   int pcf = 1;                 // (2·pcf + 1)² taps per shadow lookup
   int msaa = 4;                // samples per pixel of the object pass (its coverage at edges)
-  double cut = 1e-3;           // the soft term is 0 where the sphere's cosine-weighted share is below this
+  double cut = 4e-3;           // the soft term is 0 where the sphere's cosine-weighted share is below this, whole above 2×
   bool shadows = true;         // false: the object pasted without shadow or reflection (a baseline)
   bool bounce = true;          // the object's light on the proxy
   int albedo_samples = 64;     // composite(): light samples per pixel of the albedo estimate
@@ -49,6 +49,7 @@ struct GlFrameTiming {
 // The scene that stays while the object moves. Needs a current OpenGL 4.5 context that outlives it.
 class Compositor {
  public:
+  static constexpr int kMaxLights = 16;  // hard lights (augment_common.glsl's MAX_LIGHTS)
   Compositor(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy, const SplitLight& light,
              const Image& albedo, const GlCompositeDesc& desc = {});
   ~Compositor();

@@ -6,7 +6,7 @@
 uniform sampler2D u_photo, u_albedo, u_gpos, u_gnormal, u_soft, u_soft_irradiance;
 uniform vec4 u_sphere;        // the object's equivalent sphere: centre (moved), radius
 uniform vec3 u_object_albedo;
-uniform float u_cut;          // cosine-weighted share of the hemisphere below which the soft term is 0
+uniform float u_cut;          // cosine-weighted share of the hemisphere below which the soft term is 0 (faded in up to 2×)
 uniform float u_soft_texel;   // solid angle of a soft-map texel at the equator, sr
 uniform int u_bounce, u_shadows;
 layout(location = 0) out vec4 o_composite;
@@ -26,7 +26,9 @@ void main() {
   vec3 a = u_sphere.xyz - y;
   float d2 = dot(a, a), s2 = u_sphere.w * u_sphere.w / d2;
   if (s2 < 1.0) {
-    float om = cap_cosine_integral(dot(n, a) * inversesqrt(d2), s2) - PI * u_cut;
+    // Faded out between twice the cut-off share and the cut-off (exactly 0 below it).
+    float om = cap_cosine_integral(dot(n, a) * inversesqrt(d2), s2);
+    om *= smoothstep(u_cut, 2.0 * u_cut, om / PI);
     if (om > 0.0) {
       vec3 w = a * inversesqrt(d2);
       float cap = 2.0 * PI * (1.0 - sqrt(1.0 - s2));

@@ -1,0 +1,181 @@
+// The GL compositor on a tiny scene (a 6 m floor seen from above, 96×72 pixels): pixels the object does not
+// touch are the photograph bit for bit, a sun's umbra is where the CPU reference puts it, an object under a
+// constant sky has radiance ρL, and a wall hides it. Skips where no OpenGL 4.5 context can be made.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "iblkit/augment/gl/compositor.h"
+#include "iblkit/augment/object.h"
+#include "iblkit/core/error.h"
+#include "iblkit/render/gl/context.h"
+
+namespace ibl::augment::gl {
+namespace {
+
+constexpr int kW = 96, kH = 72;
+
+bool same(Vec3 a, Vec3 b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
+
+#define SKIP_WITHOUT_GL()                                                                 \
+  do {                                                                                    \
+    std::string why;                                                                      \
+    if (!render::gl::available(&why)) GTEST_SKIP() << "no OpenGL 4.5 through EGL here: " << why; \
+  } while (0)
+
+geometry::Camera top_camera() {
+  geometry::Camera c;
+  c.eye = {0, 3, 0.5};
+  c.target = {0, 0, 0};
+  c.fov_y_deg = 60;
+  c.width = kW;
+  c.height = kH;
+  return c;
+}
+
+geometry::TriMesh floor_mesh() { return geometry::make_quad({0, 0, 0}, {0, 1, 0}, {0, 0, -1}, 6, 6); }
+
+Image constant_photo(double v) {
+  Image p(kW, kH, 3);
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x) p.set_rgb(x, y, {v, v, v});
+  return p;
+}
+
+geometry::TriMesh sphere_at(Vec3 c, double size) {
+  ObjectDesc d;
+  d.kind = "sphere";
+  d.size = size;
+  d.at = c;
+  return make_object(d);
+}
+
+LocalLight sky(Vec3 L, Vec3 sun, Vec3 centre) {
+  Image img(64, 32, 3);
+  for (int y = 0; y < 32; ++y)
+    for (int x = 0; x < 64; ++x) img.set_rgb(x, y, L);
+  if (max_component(sun) > 0) img.set_rgb(20, 8, sun);  // one texel ≈ 48° from the zenith
+  LocalLight l;
+  l.map = sphere::EnvMap(img, sphere::Mapping(sphere::MappingKind::LatLong, 64, 32));
+  l.centre = centre;
+  l.source = "test sky";
+  return l;
+}
+
+TEST(AugmentGl, PixelsTheObjectDoesNotTouchAreThePhotographBitForBit) {
+  SKIP_WITHOUT_GL();
+  const Vec3 at{0.3, 0.3, -0.2};
+  Image photo = constant_photo(0.4);
+  geometry::Camera cam = top_camera();
+  cam.fov_y_deg = 90;
+  const geometry::TriMesh floor = geometry::make_quad({0, 0, 0}, {0, 1, 0}, {0, 0, -1}, 12, 12);
+  auto r = augment::gl::composite(photo, cam, floor, sky({1, 1, 1}, {3000, 3000, 3000}, at), sphere_at(at, 0.3), {0.7, 0.7, 0.7});
+  int far_pixels = 0, changed_near = 0;
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x) {
+      Vec3 d = cam.pixel_direction(x, y);
+      Vec3 p = cam.eye + d * (cam.eye.y / -d.y);  // the floor point the pixel sees
+      double far = length(p - Vec3{at.x, 0, at.z});
+      if (!same(r.difference.rgb(x, y), Vec3{})) ++changed_near;
+      // Beyond the soft term's reach (sin²α cos β = r² h / d³ < 4·10⁻³: d > 1.2 m for r = 0.15, h = 0.3) and
+      // off the sun's shadow (towards +z, −x) nothing changes.
+      if (far > 1.3 && !(p.z > at.z && p.x < at.x + 0.5)) {
+        ++far_pixels;
+        ASSERT_TRUE(same(r.composite.rgb(x, y), photo.rgb(x, y))) << x << "," << y;
+      }
+    }
+  EXPECT_GT(far_pixels, 500);
+  EXPECT_GT(changed_near, 50);
+  EXPECT_GT(r.stats.object_pixels, 8);
+
+  // No shadows (the pasted baseline): only the object's pixels change.
+  GlCompositeDesc none;
+  none.shadows = false;
+  auto p = augment::gl::composite(photo, cam, floor, sky({1, 1, 1}, {3000, 3000, 3000}, at), sphere_at(at, 0.3), {0.7, 0.7, 0.7}, none);
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x)
+      if (p.mask.at(x, y, 0) == 0) ASSERT_TRUE(same(p.composite.rgb(x, y), photo.rgb(x, y))) << x << "," << y;
+}
+
+TEST(AugmentGl, SunUmbraFallsWhereTheCpuReferencePutsIt) {
+  SKIP_WITHOUT_GL();
+  const Vec3 at{0, 0.35, 0};
+  Image photo = constant_photo(0.4);
+  LocalLight sun = sky({0, 0, 0}, {5000, 5000, 5000}, at);
+  geometry::TriMesh object = sphere_at(at, 0.3);
+  CompositeDesc cd;
+  cd.bounce_samples = 0;
+  auto cpu = augment::composite(photo, top_camera(), floor_mesh(), sun, object, {0.7, 0.7, 0.7}, cd);
+  GlCompositeDesc gd;
+  gd.bounce = false;
+  auto gl = augment::gl::composite(photo, top_camera(), floor_mesh(), sun, object, {0.7, 0.7, 0.7}, gd);
+  // The CPU's umbra (≥ 90 % darker, off the object) against the GL's.
+  int both = 0, either = 0;
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x) {
+      if (cpu.mask.at(x, y, 0) > 0 || gl.mask.at(x, y, 0) > 0) continue;
+      bool a = cpu.composite.rgb(x, y).y < 0.04, b = gl.composite.rgb(x, y).y < 0.04;
+      both += a && b;
+      either += a || b;
+    }
+  ASSERT_GT(either, 30);
+  EXPECT_GT(static_cast<double>(both) / either, 0.85);  // the two umbrae overlap (intersection over union)
+}
+
+TEST(AugmentGl, ObjectUnderAConstantSkyHasRadianceRhoL) {
+  SKIP_WITHOUT_GL();
+  // Nothing but sky: the proxy is a small floor far off to the side, the light is constant everywhere (even
+  // below), so E = π L on every object normal and the object's radiance is ρ L exactly.
+  geometry::TriMesh proxy = geometry::make_quad({5, -5, 0}, {0, 1, 0}, {0, 0, -1}, 0.5, 0.5);
+  geometry::Camera cam = top_camera();
+  auto r = augment::gl::composite(constant_photo(0.1), cam, proxy, sky({2, 2, 2}, {}, {0, 0.3, 0}), sphere_at({0, 0.3, 0}, 0.6), {0.5, 0.5, 0.5});
+  int full = 0;
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x)
+      if (r.mask.at(x, y, 0) == 1) {
+        ++full;
+        EXPECT_NEAR(r.composite.rgb(x, y).y, 0.5 * 2, 0.01) << x << "," << y;
+      }
+  EXPECT_GT(full, 100);
+}
+
+TEST(AugmentGl, AWallInFrontHidesTheObjectAndTheFrameMovesWithIt) {
+  SKIP_WITHOUT_GL();
+  geometry::TriMesh proxy = floor_mesh();
+  proxy.append(geometry::make_quad({0, 1.5, 0.2}, {0, 0, 1}, {0, 1, 0}, 6, 3));  // a wall between camera and object
+  geometry::Camera cam;
+  cam.eye = {0, 1, 3};
+  cam.target = {0, 0.3, 0};
+  cam.width = kW;
+  cam.height = kH;
+  const Vec3 at{0, 0.3, -0.5};
+  auto r = augment::gl::composite(constant_photo(0.3), cam, proxy, sky({1, 1, 1}, {}, at), sphere_at(at, 0.3), {0.7, 0.7, 0.7});
+  EXPECT_EQ(r.stats.object_pixels, 0);
+
+  // The same scene without the wall, through a Compositor: moving the object moves its pixels.
+  render::gl::Context ctx;
+  Image albedo(kW, kH, 3, 0.3f);
+  SplitLight split = split_light(sky({1, 1, 1}, {}, at), floor_mesh());
+  Compositor comp(constant_photo(0.3), cam, floor_mesh(), split, albedo);
+  comp.set_object(sphere_at(at, 0.3), {0.7, 0.7, 0.7});
+  Image m0, m1;
+  comp.draw({});
+  comp.read_back(nullptr, &m0, nullptr, nullptr);
+  comp.draw({0.5, 0, 0});
+  comp.read_back(nullptr, &m1, nullptr, nullptr);
+  double cx0 = 0, cx1 = 0, n0 = 0, n1 = 0;
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x) {
+      cx0 += x * m0.at(x, y, 0);
+      n0 += m0.at(x, y, 0);
+      cx1 += x * m1.at(x, y, 0);
+      n1 += m1.at(x, y, 0);
+    }
+  ASSERT_GT(n0, 20);
+  ASSERT_GT(n1, 20);
+  EXPECT_GT(cx1 / n1, cx0 / n0 + 5);  // to the right
+  EXPECT_THROW(Compositor(constant_photo(0.3), cam, floor_mesh(), split, Image(4, 4, 3)), Error);
+}
+
+}  // namespace
+}  // namespace ibl::augment::gl

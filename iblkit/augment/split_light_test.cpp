@@ -1,0 +1,107 @@
+// split_light and sphere_occlusion against closed forms: the cap's cosine integral against quadrature,
+// the equivalent sphere of a sphere and of an open square, and the split conserving the map's power.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "iblkit/augment/object.h"
+#include "iblkit/augment/sphere_occlusion.h"
+#include "iblkit/augment/split_light.h"
+#include "iblkit/core/error.h"
+
+namespace ibl::augment {
+namespace {
+
+// ∫_cap max(0, n·ω) dω by a midpoint rule over the cap (polar angle t from the cap's axis, azimuth p).
+double cap_quadrature(double beta, double alpha) {
+  Vec3 axis{std::sin(beta), 0, std::cos(beta)}, n{0, 0, 1};
+  Frame f = Frame::from_normal(axis);
+  constexpr int kT = 400, kP = 800;
+  double sum = 0;
+  for (int i = 0; i < kT; ++i) {
+    double t = (i + 0.5) / kT * alpha, dt = alpha / kT;
+    for (int j = 0; j < kP; ++j) {
+      double p = (j + 0.5) / kP * 2 * kPi;
+      Vec3 w = f.from_local({std::sin(t) * std::cos(p), std::sin(t) * std::sin(p), std::cos(t)});
+      sum += std::max(0.0, dot(n, w)) * std::sin(t) * dt * (2 * kPi / kP);
+    }
+  }
+  return sum;
+}
+
+TEST(AugmentSphereOcclusion, CapCosineIntegralMatchesQuadratureAcrossTheHorizon) {
+  for (double alpha_deg : {5.0, 20.0, 45.0, 70.0})
+    for (double beta_deg : {0.0, 30.0, 60.0, 80.0, 90.0, 100.0, 120.0}) {
+      double a = alpha_deg * kPi / 180, b = beta_deg * kPi / 180;
+      double q = cap_quadrature(b, a), c = cap_cosine_integral(std::cos(b), std::sin(a) * std::sin(a));
+      EXPECT_NEAR(c, q, 2e-4 + 1e-3 * q) << "alpha " << alpha_deg << " beta " << beta_deg;
+    }
+  EXPECT_EQ(cap_cosine_integral(std::cos(2.0), 0.01), 0.0);  // wholly below the horizon
+}
+
+TEST(AugmentSphereOcclusion, EquivalentSphereOfASphereAndOfAnOpenSquare) {
+  ObjectDesc d;
+  d.kind = "sphere";
+  d.size = 0.4;
+  d.at = {1, 2, 3};
+  OccluderSphere s = equivalent_sphere(make_object(d));
+  EXPECT_NEAR(s.radius, 0.2, 0.004);  // the tessellated sphere's volume is a little smaller
+  EXPECT_NEAR(s.bound_radius, 0.2, 1e-3);
+  EXPECT_NEAR(length(s.centre - Vec3{1, 2, 3}), 0, 1e-6);
+  OccluderSphere q = equivalent_sphere(geometry::make_quad({0, 0, 0}, {0, 1, 0}, {0, 0, -1}, 1, 1));  // open: S/4 = π r²
+  EXPECT_NEAR(q.radius, std::sqrt(1.0 / (4 * kPi)), 1e-9);
+}
+
+LocalLight sky_and_sun(Vec3 centre) {
+  Image img(64, 32, 3);
+  for (int y = 0; y < 32; ++y)
+    for (int x = 0; x < 64; ++x) img.set_rgb(x, y, y < 16 ? Vec3{0.5, 0.6, 1.0} : Vec3{0.2, 0.2, 0.2});
+  img.set_rgb(20, 6, {3000, 2800, 2500});
+  img.set_rgb(21, 6, {3000, 2800, 2500});
+  LocalLight l;
+  l.map = sphere::EnvMap(img, sphere::Mapping(sphere::MappingKind::LatLong, 64, 32));
+  l.centre = centre;
+  l.source = "test sky";
+  return l;
+}
+
+TEST(AugmentSplit, HardLightsAndSoftMapHoldAllOfTheMapsPowerAndSitWhereTheProxyIs) {
+  LocalLight l = sky_and_sun({0, 0.5, 0});
+  std::vector<double> total = l.map.integral();
+  geometry::TriMesh floor = geometry::make_quad({0, 0, 0}, {0, 1, 0}, {0, 0, -1}, 6, 6);
+  SplitLight s = split_light(l, floor);
+  ASSERT_EQ(s.hard.size(), 2u);  // the two sun texels, nothing else is 8× the mean
+  Vec3 hard;
+  for (const auto& h : s.hard) {
+    hard += h.irradiance;
+    EXPECT_TRUE(h.distant);  // above an open floor
+  }
+  sphere::EnvMap soft(s.soft, sphere::Mapping(sphere::MappingKind::LatLong, 64, 32));
+  std::vector<double> rest = soft.integral();
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(hard[c] + rest[c], total[c], 1e-6 * total[c]);
+  EXPECT_GT(s.hard_share, 0.5);
+  // The soft irradiance on an upward normal: π × the upper hemisphere's radiance (1.0 in blue), the lower
+  // hemisphere's (0.2) on a downward one, within what 3 SH bands of a step between hemispheres keep.
+  const Image& irr = s.soft_irradiance;
+  EXPECT_NEAR(irr.rgb(irr.width() / 2, 0).z, kPi * 1.0, 0.1);
+  EXPECT_NEAR(irr.rgb(irr.width() / 2, irr.height() - 1).z, kPi * 0.2, 0.1);
+
+  // Under a ceiling the sun's light comes from a point on it (intensity E·d² W/sr).
+  geometry::TriMesh room = floor;
+  room.append(geometry::make_quad({0, 2, 0}, {0, -1, 0}, {0, 0, 1}, 6, 6));
+  SplitLight r = split_light(l, room);
+  ASSERT_FALSE(r.hard.empty());
+  EXPECT_FALSE(r.hard[0].distant);
+  EXPECT_NEAR(r.hard[0].position.y, 2.0, 1e-6);
+  Vec3 e = r.hard[0].at(l.centre, l.centre, r.hard[0].direction);
+  EXPECT_NEAR(e.x, r.hard[0].irradiance.x, 1e-9 * e.x);
+
+  SplitDesc none;
+  none.threshold = 0;
+  EXPECT_TRUE(split_light(l, floor, none).hard.empty());
+  none.lights = -1;
+  EXPECT_THROW(split_light(l, floor, none), Error);
+}
+
+}  // namespace
+}  // namespace ibl::augment
