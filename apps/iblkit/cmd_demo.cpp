@@ -68,7 +68,7 @@ void setup(CLI::App& app) {
   app.add_option("--probe", o->probe, "probe to start from (default: blender-data's forest.exr)");
   app.add_option("--only", o->only, "run only these steps, comma-separated (mappings, sh, lights, lab, ilf, render, …)")
       ->delimiter(',');
-  app.footer("Example:\n  iblkit demo --out demo-out\n  iblkit demo --out /tmp/d --probe ../shared/probes/ict/uffizi_latlong_256.hdr --only mappings,sh");
+  app.footer("Examples:\n  iblkit demo --out demo-out --only sh,lights\n  iblkit demo --out d --probe ../shared/probes/ict/uffizi_latlong_256.hdr --only mappings,sh");
   app.callback([o] {
     iblcli::DemoContext ctx;
     ctx.out_dir = o->out;

@@ -100,7 +100,7 @@ void setup_build(CLI::App& app) {
     std::string directions = directions_name(bd.buckets.octahedral);
     double subsample = -1, subsample_dist = ilf::SubsampleDesc{}.max_distance;  // off unless given
     CLI::Option* subsample_opt = nullptr;
-    bool no_reuse = !bd.buckets.reuse;
+    bool no_reuse = !bd.buckets.reuse, drop_buckets = false;
   };
   auto* o = new Opts();
   auto& bd0 = o->bd;
@@ -122,7 +122,8 @@ void setup_build(CLI::App& app) {
   app.add_flag("--skip-bad", bd0.buckets.skip_bad, "skip bad probes (missing/unreadable frames, wrong size, NaN, outside the volume, duplicates) and report how many");
   app.add_flag("--sanitize", bd0.buckets.sanitize, "replace NaN/Inf/negative pixels by 0 instead of failing");
   app.add_flag("--no-reuse", o->no_reuse, "rebuild the direction buckets even when an earlier run's match");
-  app.footer("Example:\n  iblkit ilf build captures/sequence.json --grid 32 --bands 5 --out room.shgrid");
+  app.add_flag("--drop-buckets", o->drop_buckets, "remove the direction buckets once the grid is written (a re-run sorts again)");
+  app.footer("Example:\n  iblkit ilf build cap/sequence.json --grid 8 --bands 5 --out room8.shgrid");
   app.callback([o] {
     auto grid = parse_grid(o->grid);
     if (!o->vdb.empty() && !ilf::have_vdb()) ilf::write_vdb(o->vdb, ilf::SHGrid());  // fails now, not after the build
@@ -150,6 +151,7 @@ void setup_build(CLI::App& app) {
     iblcli::progress_done();
     ilf::write_shgrid(o->out, g);
     if (!o->vdb.empty()) ilf::write_vdb(o->vdb, g);
+    if (o->drop_buckets) ilf::remove_bucket_cache(bd.buckets.dir);
     rep.skipped += srep.skipped;
     for (auto& r : srep.reasons) rep.skip_reasons.insert(rep.skip_reasons.begin(), r);
     for (auto& r : rep.skip_reasons) iblcli::info("skipped: " + r);
@@ -302,7 +304,7 @@ void setup_synth(CLI::App& app) {
   app.add_flag("--pfm", *pfm, "float PFM frames instead of half-float EXR");
   app.footer("A closed-form light field (three emitting spheres outside a 1 m cube and a sky) captured by\n"
              "mirror balls at random positions in the cube: for tests, benchmarks and trying the pipeline.\n"
-             "Example:\n  iblkit ilf synth --out /tmp/seq --probes 500 --size 64");
+             "Example:\n  iblkit ilf synth --out synth --probes 50 --size 32");
   app.callback([d, pfm] {
     d->half = !*pfm;
     auto m = ilf::write_synthetic_sequence(ilf::AnalyticField::three_spheres(), *d, iblcli::progress_bar());

@@ -230,7 +230,7 @@ void run_photograph(const PhotoOpts& o) {
 
 void setup(CLI::App& app) {
   app.require_subcommand(1);
-  app.footer("Examples:\n  iblkit lab capture low-scene1 --probe 0,1,0 --size 128 --out cap\n"
+  app.footer("Examples:\n  iblkit lab capture low-scene1 --probe 0,1,0 --size 128 --out one\n"
              "  iblkit lab truth low-scene1 --at 0,1,0 --out truth");
   auto* c = app.add_subcommand("capture", "Capture a probe, a probe sequence (iblkit.sequence/1) or a fusion probe set (iblkit.probes/1)");
   auto* co = new CaptureOpts();
@@ -260,11 +260,11 @@ void setup(CLI::App& app) {
   c->add_option("--format", co->format, "frame format: exr, hdr, pfm")->capture_default_str();
   c->add_flag("--half", co->half, ".exr frames as 16-bit halves");
   c->add_option("-o,--out", co->out, "output folder")->required();
-  c->footer("Examples:\n  iblkit lab capture low-scene1 --probe 0,1,0 --size 128 --out cap\n"
-            "  iblkit lab capture low-scene1 --grid 8,8,8 --camera ball --size 250 --out seq\n"
-            "  iblkit lab capture t-corridor --path \"0,1.5,9;0,1.5,0.5\" --count 20 --out corridor\n"
-            "  iblkit lab capture low-scene2 --random 200 --mapping mirrorball --out handheld\n"
-            "  iblkit lab capture t-corridor --fusion --probe 0,1.5,2 --probe 0,1.5,6 --out fusion");
+  c->footer("Examples:\n  iblkit lab capture low-scene1 --probe 0,1,0 --size 128 --out one\n"
+            "  iblkit lab capture low-scene1 --grid 3,3,3 --camera ball --size 64 --out seq\n"
+            "  iblkit lab capture t-corridor --path \"0,1.5,9;0,1.5,0.5\" --count 5 --size 64 --out corridor\n"
+            "  iblkit lab capture low-scene2 --random 20 --mapping mirrorball --size 64 --out handheld\n"
+            "  iblkit lab capture t-corridor --fusion --probe 0,1.5,2 --probe 0,1.5,6 --size 64 --out corridor-fusion");
   c->callback([co] { run_capture(*co); });
 
   auto* t = app.add_subcommand("truth", "Ground truth at a point: radiance map, SH coefficients, irradiance");
@@ -282,7 +282,7 @@ void setup(CLI::App& app) {
   t->add_option("--blind-axis", to->blind_axis, "world axis of --blind-cone (a ball with --look L has its dead angle around -L)")
       ->capture_default_str();
   t->add_option("-o,--out", to->out, "folder for radiance.exr/.png, sh.json, truth.json");
-  t->footer("Example:\n  iblkit lab truth low-scene1 --at 0,1,0 --size 256 --out truth");
+  t->footer("Example:\n  iblkit lab truth low-scene1 --at 0,1,0 --size 64 --out truth");
   t->callback([to] { run_truth(*to); });
 
   auto* ph = app.add_subcommand("photograph", "A pinhole photograph of a scene, optionally with an object in it (path traced; the truth of a composite)");

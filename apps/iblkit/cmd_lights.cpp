@@ -229,7 +229,7 @@ void setup_eval(CLI::App& app) {
   app.add_option("-o,--out", o->out, "output prefix: PREFIX.csv, PREFIX_fig4.png, PREFIX_irradiance.png")->capture_default_str();
   app.add_flag("--no-pictures", o->no_pictures, "write only the CSV");
   auto& rd = iblcli::add_probe_read_options(app);
-  app.footer("Example:\n  iblkit eval forest.exr --methods median-cut,variance-cut,optimize --counts 1,2,4,8,16,32,64 --out forest");
+  app.footer("Example:\n  iblkit eval forest.exr --methods median-cut,variance-cut,optimize --counts 1,4,16 --out forest");
   app.callback([o, &rd] { run_eval(*o, rd); });
 }
 
