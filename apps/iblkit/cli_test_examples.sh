@@ -11,6 +11,7 @@
 # those that read ../shared where it is absent.
 set -u
 source "$(dirname "$0")/cli_check.sh" "$1"
+BIN=$(realpath "$BIN")
 SRC=$(cd "$(dirname "$0")/../.." && pwd)
 SHARED=${IBLKIT_SHARED:-$SRC/../shared}
 W="$T/run"

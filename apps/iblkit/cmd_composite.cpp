@@ -120,7 +120,7 @@ void run(const Opts& o, const ibl::io::EnvReadDesc& read) {
 }
 
 void setup(CLI::App& app) {
-  auto* o = new Opts();
+  auto* o = iblcli::app_owned<Opts>();
   app.add_option("photo", o->photo, "the background photograph (HDR, linear; any format OpenImageIO reads)")->required();
   app.add_option("--eye", o->eye, "the photograph's camera position x,y,z");
   app.add_option("--target", o->target, "the point at the frame's centre");

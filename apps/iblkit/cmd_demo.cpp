@@ -63,7 +63,7 @@ void setup(CLI::App& app) {
     std::string out = "demo-out", probe;
     std::vector<std::string> only;
   };
-  auto* o = new Opts();
+  auto* o = iblcli::app_owned<Opts>();
   app.add_option("-o,--out", o->out, "folder for the pictures and numbers")->capture_default_str();
   app.add_option("--probe", o->probe, "probe to start from (default: blender-data's forest.exr)");
   app.add_option("--only", o->only, "run only these steps, comma-separated (mappings, sh, lights, lab, ilf, render, …)")

@@ -102,7 +102,7 @@ void setup_build(CLI::App& app) {
     CLI::Option* subsample_opt = nullptr;
     bool no_reuse = !bd.buckets.reuse, drop_buckets = false;
   };
-  auto* o = new Opts();
+  auto* o = iblcli::app_owned<Opts>();
   auto& bd0 = o->bd;
   app.add_option("sequence", o->seq, "iblkit.sequence/1 manifest")->required();
   app.add_option("-o,--out", o->out, "output .shgrid")->required();
@@ -174,7 +174,7 @@ void setup_build(CLI::App& app) {
 
 void setup_query(CLI::App& app) {
   struct Opts { std::string grid, at, normal, dir; double exponent = 4; };
-  auto* o = new Opts();
+  auto* o = iblcli::app_owned<Opts>();
   app.add_option("grid", o->grid, ".shgrid file")->required();
   app.add_option("--at", o->at, "point x,y,z")->required();
   app.add_option("--normal", o->normal, "irradiance for this normal x,y,z (default +Y)");
@@ -233,7 +233,7 @@ Image irradiance_slice(const ilf::SHGrid& g, int axis, double value, int size, d
 
 void setup_slice(CLI::App& app) {
   struct Opts { std::string grid, plane, out; int size = 256; bool down = false; double exposure = 0; };
-  auto* o = new Opts();
+  auto* o = iblcli::app_owned<Opts>();
   app.add_option("grid", o->grid, ".shgrid file")->required();
   app.add_option("--plane", o->plane, "axis-aligned plane, e.g. y=0.3")->required();
   app.add_option("-o,--out", o->out, "output image (.png tone mapped, .exr linear W/m²)")->required();
@@ -265,7 +265,7 @@ void setup_slice(CLI::App& app) {
 }
 
 void setup_info(CLI::App& app) {
-  auto* path = new std::string();
+  auto* path = iblcli::app_owned<std::string>();
   app.add_option("grid", *path, ".shgrid file")->required();
   app.footer("Example:\n  iblkit ilf info room.shgrid");
   app.callback([path] {
@@ -294,8 +294,8 @@ void setup_info(CLI::App& app) {
 }
 
 void setup_synth(CLI::App& app) {
-  auto* d = new ilf::SynthDesc();
-  bool* pfm = new bool(!d->half);
+  auto* d = iblcli::app_owned<ilf::SynthDesc>();
+  bool* pfm = iblcli::app_owned<bool>(!d->half);
   app.add_option("-o,--out", d->out_dir, "output folder (frames/ and sequence.json)")->required();
   app.add_option("--probes", d->probes, "number of probes")->capture_default_str()->check(CLI::Range(1, 1000000));
   app.add_option("--size", d->size, "mirror-ball frame size in pixels")->capture_default_str()->check(CLI::Range(8, 4096));

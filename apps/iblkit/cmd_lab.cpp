@@ -233,7 +233,7 @@ void setup(CLI::App& app) {
   app.footer("Examples:\n  iblkit lab capture low-scene1 --probe 0,1,0 --size 128 --out one\n"
              "  iblkit lab truth low-scene1 --at 0,1,0 --out truth");
   auto* c = app.add_subcommand("capture", "Capture a probe, a probe sequence (iblkit.sequence/1) or a fusion probe set (iblkit.probes/1)");
-  auto* co = new CaptureOpts();
+  auto* co = iblcli::app_owned<CaptureOpts>();
   c->add_option("scene", co->scene, "scene file (iblkit.scene/1) or built-in name: low-scene1, low-scene2, t-corridor, crypt")->required();
   c->add_option("--probe", co->probes, "probe position x,y,z (repeat for several)");
   c->add_option("--grid", co->grid, "a regular grid nx,ny,nz over the volume");
@@ -268,7 +268,7 @@ void setup(CLI::App& app) {
   c->callback([co] { run_capture(*co); });
 
   auto* t = app.add_subcommand("truth", "Ground truth at a point: radiance map, SH coefficients, irradiance");
-  auto* to = new TruthOpts();
+  auto* to = iblcli::app_owned<TruthOpts>();
   t->add_option("scene", to->scene, "scene file or built-in name")->required();
   t->add_option("--at", to->at, "the point x,y,z")->required();
   t->add_option("-s,--size", to->size, "lat-long height of the radiance map")->capture_default_str();
@@ -286,7 +286,7 @@ void setup(CLI::App& app) {
   t->callback([to] { run_truth(*to); });
 
   auto* ph = app.add_subcommand("photograph", "A pinhole photograph of a scene, optionally with an object in it (path traced; the truth of a composite)");
-  auto* po = new PhotoOpts();
+  auto* po = iblcli::app_owned<PhotoOpts>();
   ph->add_option("scene", po->scene, "scene file or built-in name")->required();
   ph->add_option("--eye", po->eye, "camera position x,y,z")->capture_default_str();
   ph->add_option("--target", po->target, "the point seen at the frame's centre")->capture_default_str();

@@ -348,7 +348,7 @@ void run(const Opts& o, const io::EnvReadDesc& rd) {
 }
 
 void setup(CLI::App& app) {
-  auto* o = new Opts();
+  auto* o = iblcli::app_owned<Opts>();
   add_options(app, o);
   auto& rd = iblcli::add_probe_read_options(app);
   app.callback([o, &rd] { run(*o, rd); });
