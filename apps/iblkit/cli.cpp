@@ -132,8 +132,8 @@ std::vector<int> parse_int_list(const std::string& s, const std::string& what) {
 }
 
 ibl::io::EnvReadDesc& add_probe_read_options(CLI::App& app) {
-  auto* desc = new ibl::io::EnvReadDesc();  // lives as long as the app (the process)
-  auto* mapping = new std::string();
+  auto* desc = iblcli::app_owned<ibl::io::EnvReadDesc>();  // lives as long as the app (the process)
+  auto* mapping = iblcli::app_owned<std::string>();
   app.add_option("--in-mapping", *mapping,
                  "mapping of the input (latlong, mirrorball, angular, hcross, vcross, cubestrip, octahedral); "
                  "default: detected from the image shape and name")

@@ -150,7 +150,7 @@ void run(const Opts& o, const ibl::io::EnvReadDesc& read) {
 }
 
 void setup(CLI::App& app) {
-  auto* o = new Opts();
+  auto* o = iblcli::app_owned<Opts>();
   app.add_option("photo", o->photo, "the background photograph (HDR, linear; any format OpenImageIO reads)")->required();
   app.add_option("--eye", o->eye, "the photograph's camera position x,y,z");
   app.add_option("--target", o->target, "the point at the frame's centre");
@@ -192,9 +192,9 @@ void setup(CLI::App& app) {
   app.add_option("--truth", o->truth, "a photograph with the object really there (iblkit lab photograph): print the errors");
   app.footer(
       "Examples:\n  iblkit composite photo.exr --eye 0,1.2,2.4 --target 0,0.3,0 --fov 40 --probes fusion/probes.json --object blob "
-      "--at 0,0.15,0 --out comp.exr --layers layers\n"
+      "--at 0,0.2,0 --out comp.exr --layers layers\n"
       "  iblkit composite photo.exr --camera cam.json --light grid.shgrid --proxy room.obj --object sphere --at 0,0.2,0\n"
-      "  iblkit composite photo.exr --camera cam.json --light probe.exr --at-probe 0,0.5,0 --proxy floor.obj");
+      "  iblkit composite photo.exr --camera cam.json --light probe.exr --at-probe 0,0.5,0 --proxy floor.obj --at 0,0.2,0");
   app.callback([o, &rd] { run(*o, rd); });
 }
 

@@ -31,7 +31,7 @@ void setup(CLI::App& app) {
     int size = 0;
     bool half = false, faces = false;
   };
-  auto* o = new Opts();
+  auto* o = iblcli::app_owned<Opts>();
   app.add_option("input", o->in, "input probe (image, or folder of six cube faces)")->required();
   app.add_option("output", o->out, "output image (.exr .hdr .pfm .tif .png), or a folder with --faces")->required();
   app.add_option("-m,--mapping", o->mapping, "output mapping: latlong, mirrorball, angular, hcross, vcross, cubestrip, octahedral")

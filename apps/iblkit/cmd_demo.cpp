@@ -63,12 +63,12 @@ void setup(CLI::App& app) {
     std::string out = "demo-out", probe;
     std::vector<std::string> only;
   };
-  auto* o = new Opts();
+  auto* o = iblcli::app_owned<Opts>();
   app.add_option("-o,--out", o->out, "folder for the pictures and numbers")->capture_default_str();
   app.add_option("--probe", o->probe, "probe to start from (default: blender-data's forest.exr)");
   app.add_option("--only", o->only, "run only these steps, comma-separated (mappings, sh, lights, lab, ilf, render, …)")
       ->delimiter(',');
-  app.footer("Example:\n  iblkit demo --out demo-out\n  iblkit demo --out /tmp/d --probe ../shared/probes/ict/uffizi_latlong_256.hdr --only mappings,sh");
+  app.footer("Examples:\n  iblkit demo --out demo-out --only sh,lights\n  iblkit demo --out d --probe ../shared/probes/ict/uffizi_latlong_256.hdr --only mappings,sh");
   app.callback([o] {
     iblcli::DemoContext ctx;
     ctx.out_dir = o->out;

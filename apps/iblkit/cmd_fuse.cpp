@@ -239,7 +239,7 @@ void setup(CLI::App& app) {
     bool no_filter = !fu::PathDesc{}.track.filter, force = false;
     std::string depth_probes;
   };
-  auto* o = new Opts();
+  auto* o = iblcli::app_owned<Opts>();
   o->f.size = 128;  // --at and --path write the maps themselves: finer than the library's default
   app.add_option("probes", o->probes, "probe set (iblkit.probes/1)");
   app.add_option("--at", o->at, "the point x,y,z");

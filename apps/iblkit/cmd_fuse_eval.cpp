@@ -150,7 +150,7 @@ void run_eval(const EvalOpts& o) {
 
 void setup_eval(CLI::App& fuse) {
   auto* c = fuse.add_subcommand("eval", "Fused maps against the lab's exact local radiance map (every blend, visibility on/off)");
-  auto* o = new EvalOpts();
+  auto* o = iblcli::app_owned<EvalOpts>();
   o->f.size = 64;
   o->f.samples = 2;
   c->add_option("probes", o->probes, "probe set captured by `iblkit lab capture SCENE --fusion`")->required();

@@ -101,9 +101,9 @@ void setup_build(CLI::App& app) {
     std::string directions = directions_name(bd.buckets.octahedral);
     double subsample = -1, subsample_dist = ilf::SubsampleDesc{}.max_distance;  // off unless given
     CLI::Option* subsample_opt = nullptr;
-    bool no_reuse = !bd.buckets.reuse;
+    bool no_reuse = !bd.buckets.reuse, drop_buckets = false;
   };
-  auto* o = new Opts();
+  auto* o = iblcli::app_owned<Opts>();
   auto& bd0 = o->bd;
   app.add_option("sequence", o->seq, "iblkit.sequence/1 manifest")->required();
   app.add_option("-o,--out", o->out, "output .shgrid")->required();
@@ -123,7 +123,8 @@ void setup_build(CLI::App& app) {
   app.add_flag("--skip-bad", bd0.buckets.skip_bad, "skip bad probes (missing/unreadable frames, wrong size, NaN, outside the volume, duplicates) and report how many");
   app.add_flag("--sanitize", bd0.buckets.sanitize, "replace NaN/Inf/negative pixels by 0 instead of failing");
   app.add_flag("--no-reuse", o->no_reuse, "rebuild the direction buckets even when an earlier run's match");
-  app.footer("Example:\n  iblkit ilf build captures/sequence.json --grid 32 --bands 5 --out room.shgrid");
+  app.add_flag("--drop-buckets", o->drop_buckets, "remove the direction buckets once the grid is written (a re-run sorts again)");
+  app.footer("Example:\n  iblkit ilf build cap/sequence.json --grid 8 --bands 5 --out room8.shgrid");
   app.callback([o] {
     auto grid = parse_grid(o->grid);
     if (!o->vdb.empty() && !ilf::have_vdb()) ilf::write_vdb(o->vdb, ilf::SHGrid());  // fails now, not after the build
@@ -151,6 +152,7 @@ void setup_build(CLI::App& app) {
     iblcli::progress_done();
     ilf::write_shgrid(o->out, g);
     if (!o->vdb.empty()) ilf::write_vdb(o->vdb, g);
+    if (o->drop_buckets) ilf::remove_bucket_cache(bd.buckets.dir);
     rep.skipped += srep.skipped;
     for (auto& r : srep.reasons) rep.skip_reasons.insert(rep.skip_reasons.begin(), r);
     for (auto& r : rep.skip_reasons) iblcli::info("skipped: " + r);
@@ -173,7 +175,7 @@ void setup_build(CLI::App& app) {
 
 void setup_query(CLI::App& app) {
   struct Opts { std::string grid, at, normal, dir; double exponent = 4; };
-  auto* o = new Opts();
+  auto* o = iblcli::app_owned<Opts>();
   app.add_option("grid", o->grid, ".shgrid file")->required();
   app.add_option("--at", o->at, "point x,y,z")->required();
   app.add_option("--normal", o->normal, "irradiance for this normal x,y,z (default +Y)");
@@ -232,7 +234,7 @@ Image irradiance_slice(const ilf::SHGrid& g, int axis, double value, int size, d
 
 void setup_slice(CLI::App& app) {
   struct Opts { std::string grid, plane, out; int size = 256; bool down = false; double exposure = 0; };
-  auto* o = new Opts();
+  auto* o = iblcli::app_owned<Opts>();
   app.add_option("grid", o->grid, ".shgrid file")->required();
   app.add_option("--plane", o->plane, "axis-aligned plane, e.g. y=0.3")->required();
   app.add_option("-o,--out", o->out, "output image (.png tone mapped, .exr linear W/m²)")->required();
@@ -264,7 +266,7 @@ void setup_slice(CLI::App& app) {
 }
 
 void setup_info(CLI::App& app) {
-  auto* path = new std::string();
+  auto* path = iblcli::app_owned<std::string>();
   app.add_option("grid", *path, ".shgrid file")->required();
   app.footer("Example:\n  iblkit ilf info room.shgrid");
   app.callback([path] {
@@ -293,8 +295,8 @@ void setup_info(CLI::App& app) {
 }
 
 void setup_synth(CLI::App& app) {
-  auto* d = new ilf::SynthDesc();
-  bool* pfm = new bool(!d->half);
+  auto* d = iblcli::app_owned<ilf::SynthDesc>();
+  bool* pfm = iblcli::app_owned<bool>(!d->half);
   app.add_option("-o,--out", d->out_dir, "output folder (frames/ and sequence.json)")->required();
   app.add_option("--probes", d->probes, "number of probes")->capture_default_str()->check(CLI::Range(1, 1000000));
   app.add_option("--size", d->size, "mirror-ball frame size in pixels")->capture_default_str()->check(CLI::Range(8, 4096));
@@ -303,7 +305,7 @@ void setup_synth(CLI::App& app) {
   app.add_flag("--pfm", *pfm, "float PFM frames instead of half-float EXR");
   app.footer("A closed-form light field (three emitting spheres outside a 1 m cube and a sky) captured by\n"
              "mirror balls at random positions in the cube: for tests, benchmarks and trying the pipeline.\n"
-             "Example:\n  iblkit ilf synth --out /tmp/seq --probes 500 --size 64");
+             "Example:\n  iblkit ilf synth --out synth --probes 50 --size 32");
   app.callback([d, pfm] {
     d->half = !*pfm;
     auto m = ilf::write_synthetic_sequence(ilf::AnalyticField::three_spheres(), *d, iblcli::progress_bar());

@@ -8,7 +8,7 @@
 namespace {
 
 void setup(CLI::App& app) {
-  auto* path = new std::string();
+  auto* path = iblcli::app_owned<std::string>();
   app.add_option("probe", *path, "HDR probe image (or a folder of six cube faces)")->required();
   auto& rd = iblcli::add_probe_read_options(app);
   app.footer("Example:\n  iblkit info /usr/share/blender/datafiles/studiolights/world/forest.exr");

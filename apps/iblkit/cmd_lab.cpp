@@ -230,10 +230,10 @@ void run_photograph(const PhotoOpts& o) {
 
 void setup(CLI::App& app) {
   app.require_subcommand(1);
-  app.footer("Examples:\n  iblkit lab capture low-scene1 --probe 0,1,0 --size 128 --out cap\n"
+  app.footer("Examples:\n  iblkit lab capture low-scene1 --probe 0,1,0 --size 128 --out one\n"
              "  iblkit lab truth low-scene1 --at 0,1,0 --out truth");
   auto* c = app.add_subcommand("capture", "Capture a probe, a probe sequence (iblkit.sequence/1) or a fusion probe set (iblkit.probes/1)");
-  auto* co = new CaptureOpts();
+  auto* co = iblcli::app_owned<CaptureOpts>();
   c->add_option("scene", co->scene, "scene file (iblkit.scene/1) or built-in name: low-scene1, low-scene2, t-corridor, crypt")->required();
   c->add_option("--probe", co->probes, "probe position x,y,z (repeat for several)");
   c->add_option("--grid", co->grid, "a regular grid nx,ny,nz over the volume");
@@ -260,15 +260,15 @@ void setup(CLI::App& app) {
   c->add_option("--format", co->format, "frame format: exr, hdr, pfm")->capture_default_str();
   c->add_flag("--half", co->half, ".exr frames as 16-bit halves");
   c->add_option("-o,--out", co->out, "output folder")->required();
-  c->footer("Examples:\n  iblkit lab capture low-scene1 --probe 0,1,0 --size 128 --out cap\n"
-            "  iblkit lab capture low-scene1 --grid 8,8,8 --camera ball --size 250 --out seq\n"
-            "  iblkit lab capture t-corridor --path \"0,1.5,9;0,1.5,0.5\" --count 20 --out corridor\n"
-            "  iblkit lab capture low-scene2 --random 200 --mapping mirrorball --out handheld\n"
-            "  iblkit lab capture t-corridor --fusion --probe 0,1.5,2 --probe 0,1.5,6 --out fusion");
+  c->footer("Examples:\n  iblkit lab capture low-scene1 --probe 0,1,0 --size 128 --out one\n"
+            "  iblkit lab capture low-scene1 --grid 3,3,3 --camera ball --size 64 --out seq\n"
+            "  iblkit lab capture t-corridor --path \"0,1.5,9;0,1.5,0.5\" --count 5 --size 64 --out corridor\n"
+            "  iblkit lab capture low-scene2 --random 20 --mapping mirrorball --size 64 --out handheld\n"
+            "  iblkit lab capture t-corridor --fusion --probe 0,1.5,2 --probe 0,1.5,6 --size 64 --out corridor-fusion");
   c->callback([co] { run_capture(*co); });
 
   auto* t = app.add_subcommand("truth", "Ground truth at a point: radiance map, SH coefficients, irradiance");
-  auto* to = new TruthOpts();
+  auto* to = iblcli::app_owned<TruthOpts>();
   t->add_option("scene", to->scene, "scene file or built-in name")->required();
   t->add_option("--at", to->at, "the point x,y,z")->required();
   t->add_option("-s,--size", to->size, "lat-long height of the radiance map")->capture_default_str();
@@ -282,11 +282,11 @@ void setup(CLI::App& app) {
   t->add_option("--blind-axis", to->blind_axis, "world axis of --blind-cone (a ball with --look L has its dead angle around -L)")
       ->capture_default_str();
   t->add_option("-o,--out", to->out, "folder for radiance.exr/.png, sh.json, truth.json");
-  t->footer("Example:\n  iblkit lab truth low-scene1 --at 0,1,0 --size 256 --out truth");
+  t->footer("Example:\n  iblkit lab truth low-scene1 --at 0,1,0 --size 64 --out truth");
   t->callback([to] { run_truth(*to); });
 
   auto* ph = app.add_subcommand("photograph", "A pinhole photograph of a scene, optionally with an object in it (path traced; the truth of a composite)");
-  auto* po = new PhotoOpts();
+  auto* po = iblcli::app_owned<PhotoOpts>();
   ph->add_option("scene", po->scene, "scene file or built-in name")->required();
   ph->add_option("--eye", po->eye, "camera position x,y,z")->capture_default_str();
   ph->add_option("--target", po->target, "the point seen at the frame's centre")->capture_default_str();

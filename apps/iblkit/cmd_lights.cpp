@@ -95,7 +95,7 @@ CLI::Option* add_normals_level_option(CLI::App& app, int* level, const std::stri
 }
 
 void setup_lights(CLI::App& app) {
-  auto* o = new LightsOpts();
+  auto* o = iblcli::app_owned<LightsOpts>();
   auto& ex = o->ex;
   app.add_option("probe", o->probe, "HDR probe image")->required();
   app.add_option("-m,--method", ex.method, "extraction method: " + extraction_method_list())->capture_default_str();
@@ -215,7 +215,7 @@ void run_eval(const EvalOpts& o, const ibl::io::EnvReadDesc& rd) {
 }
 
 void setup_eval(CLI::App& app) {
-  auto* o = new EvalOpts();
+  auto* o = iblcli::app_owned<EvalOpts>();
   auto& ev = o->ev;
   app.add_option("probe", o->probe, "HDR probe image")->required();
   app.add_option("--methods", o->methods, "comma-separated methods (default: all built): " + extraction_method_list());
@@ -229,7 +229,7 @@ void setup_eval(CLI::App& app) {
   app.add_option("-o,--out", o->out, "output prefix: PREFIX.csv, PREFIX_fig4.png, PREFIX_irradiance.png")->capture_default_str();
   app.add_flag("--no-pictures", o->no_pictures, "write only the CSV");
   auto& rd = iblcli::add_probe_read_options(app);
-  app.footer("Example:\n  iblkit eval forest.exr --methods median-cut,variance-cut,optimize --counts 1,2,4,8,16,32,64 --out forest");
+  app.footer("Example:\n  iblkit eval forest.exr --methods median-cut,variance-cut,optimize --counts 1,4,16 --out forest");
   app.callback([o, &rd] { run_eval(*o, rd); });
 }
 

@@ -334,7 +334,7 @@ void setup(CLI::App& app) {
   app.require_subcommand(1);
   app.footer("Examples:\n  iblkit nearfield simulate flashlight --grid 3x3 --resolution 16 --out nf/nf.json\n"
              "  iblkit nearfield render nf/nf.json --out nf.png");
-  auto* so = new SimOpts();
+  auto* so = iblcli::app_owned<SimOpts>();
   auto* s = app.add_subcommand("simulate", "Simulate the acquisition of a lab luminaire: a dataset of filter positions (iblkit.nearfield/1)");
   s->add_option("luminaire", so->luminaire, "flashlight or bikelight")->capture_default_str();
   s->add_option("--grid", so->grid, "filter positions NXxNY")->capture_default_str();
@@ -348,13 +348,13 @@ void setup(CLI::App& app) {
             "  iblkit nearfield simulate flashlight --grid 5x5 --spacing 0.0075 --out mag5/mag5.json");
   s->callback([so] { run_simulate(*so); });
 
-  auto* path = new std::string();
+  auto* path = iblcli::app_owned<std::string>();
   auto* i = app.add_subcommand("info", "Summary of a near-field dataset: grid, basis, power, shift-invariance error");
   i->add_option("dataset", *path, "iblkit.nearfield/1 manifest")->required();
   i->footer("Example:\n  iblkit nearfield info bike/bike.json");
   i->callback([path] { run_info(*path); });
 
-  auto* ro = new RenderOpts();
+  auto* ro = iblcli::app_owned<RenderOpts>();
   auto* r = app.add_subcommand("render", "Render a lab scene lit by the dataset's textured spotlights (CPU reference, shadow rays)");
   r->add_option("dataset", ro->dataset, "iblkit.nearfield/1 manifest");
   r->add_option("--ies", ro->ies, "render an IES LM-63 file instead (one far-field spotlight)");
@@ -378,7 +378,7 @@ void setup(CLI::App& app) {
     run_render(*ro);
   });
 
-  auto* io = new IrrOpts();
+  auto* io = iblcli::app_owned<IrrOpts>();
   auto* ir = app.add_subcommand("irradiance", "Irradiance on a receiver plane facing the luminaire (vs the exact answer for lab datasets)");
   ir->add_option("dataset", io->dataset, "iblkit.nearfield/1 manifest")->required();
   ir->add_option("--plane", io->plane, "z=DISTANCE from S along the beam (metres)")->capture_default_str();
@@ -389,7 +389,7 @@ void setup(CLI::App& app) {
   ir->footer("Example:\n  iblkit nearfield irradiance bike/bike.json --plane z=0.25 --out irr.exr");
   ir->callback([io] { run_irradiance(*io); });
 
-  auto* fo = new std::string();
+  auto* fo = iblcli::app_owned<std::string>();
   auto* f = app.add_subcommand("fig3", "Plot the shift-invariance error E_r(θ0) (Granier et al. Fig. 3)");
   f->add_option("-o,--out", *fo, "picture (.png); a _2d.png with the 2-D support is written beside it")->required();
   f->footer("Example:\n  iblkit nearfield fig3 --out fig3.png");

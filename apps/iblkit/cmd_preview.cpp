@@ -14,7 +14,7 @@ void setup(CLI::App& app) {
     double exposure = 0;
     bool fixed = false, sanitize = false;
   };
-  auto* o = new Opts();
+  auto* o = iblcli::app_owned<Opts>();
   app.add_option("input", o->in, "HDR image")->required();
   app.add_option("output", o->out, "PNG (or JPEG) to write")->required();
   app.add_option("--exposure", o->exposure, "exposure in stops (added to auto exposure unless --fixed)");

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <optional>
 #include <filesystem>
+#include <map>
 #include <fstream>
 
 #include <fmt/format.h>
@@ -61,7 +62,7 @@ void add_options(CLI::App& app, Opts* o) {
       ->capture_default_str();
   app.add_option("-l,--light", o->lights,
                  "lighting: a probe image, an SH grid (.shgrid), iblkit.sh/1 or iblkit.lights/1 JSON; several render one "
-                 "frame each (OUT_<name>.ext)")
+                 "frame each (OUT_<name>.ext; NAME_<k> where two share a name)")
       ->required();
   app.add_option("--at", o->at, "place the object's centre here, x,y,z (e.g. inside an SH grid's volume)")->capture_default_str();
   app.add_option("--object-size", o->object.size, "object size in metres; 0 keeps a mesh file's own size and place (a room)")
@@ -113,7 +114,7 @@ void add_options(CLI::App& app, Opts* o) {
   app.add_option("--fov", o->fov, "vertical field of view, degrees")->check(CLI::Range(1.0, 170.0))->capture_default_str();
   app.add_option("--target", o->target, "camera target x,y,z (default: --at)");
   app.footer("Examples:\n  iblkit render blob --light probe.exr --out blob.png --backend cpu --size 400x300\n"
-             "  iblkit render blob --light lights.json --backend gl --frames 100 --out blob.exr\n"
+             "  iblkit render blob --light lights.json --backend gl --frames 10 --size 320x240 --out blob.exr\n"
              "  iblkit render blob --light grid.shgrid --at 0.5,0.3,0.5 --object-size 0.3 --eye 0.5,0.6,1.6 --target 0.5,0.3,0.5");
 }
 
@@ -294,6 +295,20 @@ void print_renders(const Opts& o, const nlohmann::json& renders, const nlohmann:
   if (result.contains("truth_pictures")) fmt::print("pictures: {}\n", result["truth_pictures"].get<std::string>());
 }
 
+// The name of each --light in OUT_<name>.ext: its file's stem, and where two share a stem (a/probe.exr
+// and b/probe.exr, or one file given twice) the stem and the light's place in the list, from 1
+// ("probe_1", "probe_2"), so that no two frames write the same file.
+std::vector<std::string> light_output_names(const std::vector<std::string>& lights) {
+  std::map<std::string, int> count;
+  for (const auto& l : lights) ++count[fs::path(l).stem().string()];
+  std::vector<std::string> names;
+  for (size_t i = 0; i < lights.size(); ++i) {
+    std::string stem = fs::path(lights[i]).stem().string();
+    names.push_back(count[stem] > 1 ? fmt::format("{}_{}", stem, i + 1) : stem);
+  }
+  return names;
+}
+
 // The frame lit by each --light in turn, written to --out (OUT_<light name>.ext for several).
 void run(const Opts& o, const io::EnvReadDesc& rd) {
   Scene s;
@@ -310,7 +325,9 @@ void run(const Opts& o, const io::EnvReadDesc& rd) {
   const fs::path stem = fs::path(o.out).replace_extension();
   const std::string ext = fs::path(o.out).extension().string();
   nlohmann::json renders = nlohmann::json::array();
-  for (const std::string& light : o.lights) {
+  const std::vector<std::string> names = light_output_names(o.lights);
+  for (size_t li = 0; li < o.lights.size(); ++li) {
+    const std::string& light = o.lights[li];
     d.lighting = Lighting{};
     std::string kind;
     render::read_lighting(light, lopt, &d.lighting, &kind);
@@ -318,7 +335,7 @@ void run(const Opts& o, const io::EnvReadDesc& rd) {
     nlohmann::json j = {{"scene", o.object.scene}, {"light", light}, {"lighting", kind}, {"size", o.size}};
     RenderResult f = render_frame(o, d, backend, j);
     // One --light writes --out; several write OUT_<light name>.ext each.
-    std::string out = o.lights.size() == 1 ? o.out : stem.string() + "_" + fs::path(light).stem().string() + ext;
+    std::string out = o.lights.size() == 1 ? o.out : stem.string() + "_" + names[li] + ext;
     if (ext == ".png" || ext == ".jpg") io::write_image(out, io::tonemap(f.color, truth.td));
     else io::write_image(out, f.color);
     j["output"] = out;
@@ -331,7 +348,7 @@ void run(const Opts& o, const io::EnvReadDesc& rd) {
 }
 
 void setup(CLI::App& app) {
-  auto* o = new Opts();
+  auto* o = iblcli::app_owned<Opts>();
   add_options(app, o);
   auto& rd = iblcli::add_probe_read_options(app);
   app.callback([o, &rd] { run(*o, rd); });

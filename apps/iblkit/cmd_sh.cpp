@@ -36,7 +36,7 @@ void setup(CLI::App& app) {
     std::string probe, window = "none", format = "iblkit", out, irradiance_map;
     int bands = 3, irradiance_size = 64;
   };
-  auto* o = new Opts();
+  auto* o = iblcli::app_owned<Opts>();
   app.add_option("probe", o->probe, "HDR probe image (or a folder of six cube faces)")->required();
   app.add_option("-b,--bands", o->bands, fmt::format("number of bands L+1 (1..{}; 3 = 9 coefficients)", sh::kMaxBands))
       ->capture_default_str();

@@ -385,7 +385,7 @@ void run(const ViewOpts& o, const ibl::io::EnvReadDesc& rd) {
 }
 
 void setup(CLI::App& app) {
-  auto* o = new ViewOpts();
+  auto* o = iblcli::app_owned<ViewOpts>();
   app.add_option("scene", o->object.scene, "the object: blob, sphere, or a mesh file (OBJ, PLY, glTF)")->capture_default_str();
   app.add_option("-l,--light", o->lights, "lightings to switch between (keys 1-9, Tab): probe, .shgrid, iblkit.sh/1, iblkit.lights/1; "
                  "with --composite: an SH grid or a probe image (with --proxy)");

@@ -94,7 +94,7 @@ int main(int argc, char** argv) {
       "Examples:\n"
       "  iblkit info probe.exr\n"
       "  iblkit sh probe.exr --bands 3 --format threejs\n"
-      "  iblkit demo --out demo-out",
+      "  iblkit demo --out demo-out --only mappings,sh",
       "iblkit"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "iblkit 0.1.0");

@@ -71,7 +71,9 @@ TEST(AtomicFile, CommitReplacesAndAbandonLeavesThePreviousFile) {
 
 TEST(AtomicFile, FailuresNameTheFileAndLeaveNothing) {
   auto d = fresh_dir("fail");
-  std::string missing = (d / "no_such_folder" / "x.json").string();
+  // A file where a folder of the output should be (a missing folder is made: make_output_folders).
+  std::ofstream(d / "not_a_folder") << "x";
+  std::string missing = (d / "not_a_folder" / "x.json").string();
   try {
     write_file_atomically(missing, "x");
     FAIL() << "no error";
@@ -82,7 +84,7 @@ TEST(AtomicFile, FailuresNameTheFileAndLeaveNothing) {
   // A folder where the file should go: the rename fails, and the temporary file goes.
   fs::create_directories(d / "taken.json");
   EXPECT_THROW(write_file_atomically((d / "taken.json").string(), "x"), Error);
-  EXPECT_EQ(listing(d), std::vector<std::string>{"taken.json"});
+  EXPECT_EQ(listing(d), (std::vector<std::string>{"not_a_folder", "taken.json"}));
   EXPECT_TRUE(fs::is_empty(d / "taken.json"));
   fs::remove_all(d);
 }
@@ -133,6 +135,93 @@ TEST(AtomicFileDeathTest, SignalRemovesLiveTempFiles) {
       testing::KilledBySignal(SIGTERM), "");
   EXPECT_EQ(listing(d), std::vector<std::string>{"grid.shgrid"});
   EXPECT_EQ(slurp(out), "previous");
+  fs::remove_all(d);
+}
+
+TEST(OutputTransaction, FailurePutsBackReplacedFilesAndRemovesNewOnes) {
+  auto d = fresh_dir("tx_fail");
+  write_file_atomically((d / "l.json").string(), "old lights");
+  {
+    OutputTransaction tx;
+    write_file_atomically((d / "l.json").string(), "new lights");
+    write_file_atomically((d / "l.json").string(), "newer lights");  // twice: the first state comes back
+    make_output_folders((d / "frames" / "deep").string());
+    write_file_atomically((d / "frames" / "deep" / "f0.exr").string(), "frame");
+    write_file_atomically((d / "made" / "x.gltf").string(), "gltf");  // AtomicFile makes the folder
+    EXPECT_EQ(slurp(d / "l.json"), "newer lights");  // in place at once: readable by the command
+    EXPECT_EQ(tx.files(), 3u);
+    // ... the command throws here: no commit
+  }
+  EXPECT_EQ(listing(d), std::vector<std::string>{"l.json"});
+  EXPECT_EQ(slurp(d / "l.json"), "old lights");
+  fs::remove_all(d);
+}
+
+TEST(OutputTransaction, CommitKeepsEverythingAndLeavesNoKeptCopies) {
+  auto d = fresh_dir("tx_commit");
+  write_file_atomically((d / "s.json").string(), "old");
+  fs::create_directories(d / "frames");
+  write_file_atomically((d / "frames" / "keep.exr").string(), "someone else's");
+  {
+    OutputTransaction tx;
+    EXPECT_THROW(OutputTransaction second, Error);  // one at a time
+    write_file_atomically((d / "s.json").string(), "new");
+    write_file_atomically((d / "i.exr").string(), "map");
+    make_output_folders((d / "frames").string());  // there already: not the transaction's
+    tx.commit();
+    EXPECT_THROW(tx.commit(), Error);
+  }
+  EXPECT_EQ(listing(d), (std::vector<std::string>{"frames", "i.exr", "s.json"}));
+  EXPECT_EQ(slurp(d / "s.json"), "new");
+  // A rollback leaves a folder that was there, and one that holds a file it did not write.
+  {
+    OutputTransaction tx;
+    write_file_atomically((d / "frames" / "f1.exr").string(), "frame");
+  }
+  EXPECT_EQ(listing(d / "frames"), std::vector<std::string>{"keep.exr"});
+  {
+    OutputTransaction tx;
+    write_file_atomically((d / "new" / "a.exr").string(), "a");
+    std::ofstream(d / "new" / "user.txt") << "written meanwhile by someone else";
+  }
+  EXPECT_EQ(listing(d / "new"), std::vector<std::string>{"user.txt"});
+  fs::remove_all(d);
+}
+
+TEST(OutputTransaction, FolderErrorsNameTheFolder) {
+  auto d = fresh_dir("tx_folders");
+  write_file_atomically((d / "file").string(), "x");
+  try {
+    make_output_folders((d / "file" / "sub").string());
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("is not a folder"), std::string::npos) << e.what();
+  }
+  try {
+    write_file_atomically((d / "file" / "sub" / "o.json").string(), "x");
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("o.json: cannot write"), std::string::npos) << e.what();
+  }
+  make_output_folders((d / "a" / "b" / "").string());  // a trailing separator
+  EXPECT_TRUE(fs::is_directory(d / "a" / "b"));
+  fs::remove_all(d);
+}
+
+TEST(OutputTransactionDeathTest, SignalRollsBack) {
+  auto d = fresh_dir("tx_signal");
+  write_file_atomically((d / "l.json").string(), "previous");
+  auto killed_after_one_output = [&] {
+    remove_temp_files_on_signals();
+    OutputTransaction tx;
+    write_file_atomically((d / "l.json").string(), "new");
+    write_file_atomically((d / "cap" / "frames" / "f0.exr").string(), "frame");
+    ::raise(SIGTERM);
+    std::exit(0);  // not reached
+  };
+  EXPECT_EXIT(killed_after_one_output(), testing::KilledBySignal(SIGTERM), "");
+  EXPECT_EQ(listing(d), std::vector<std::string>{"l.json"});
+  EXPECT_EQ(slurp(d / "l.json"), "previous");
   fs::remove_all(d);
 }
 

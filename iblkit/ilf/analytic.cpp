@@ -1,4 +1,3 @@
-#include "iblkit/core/atomic_file.h"
 #include "iblkit/ilf/analytic.h"
 
 #include <atomic>
@@ -6,6 +5,7 @@
 #include <filesystem>
 #include <random>
 
+#include "iblkit/core/atomic_file.h"
 #include "iblkit/core/error.h"
 #include "iblkit/core/parallel.h"
 #include "iblkit/io/image_io.h"

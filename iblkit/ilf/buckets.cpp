@@ -1,6 +1,6 @@
-#include "iblkit/core/atomic_file.h"
 #include "iblkit/ilf/buckets.h"
 
+#include <algorithm>
 #include <Imath/half.h>
 
 #include <atomic>
@@ -13,6 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "iblkit/core/atomic_file.h"
 #include "iblkit/core/error.h"
 #include "iblkit/core/json_file.h"
 #include "iblkit/core/parallel.h"
@@ -89,6 +90,13 @@ DirectionTable make_direction_table(const Sequence& seq, int width, int height, 
 
 std::string BucketStore::block_path(const std::string& dir, int k) {
   return (fs::path(dir) / fmt::format("block_{:05d}.bin", k)).string();
+}
+
+bool is_cache_file(const fs::path& p) {
+  const std::string n = p.filename().string();
+  if (n == "index.json") return true;
+  return n.size() == 15 && n.rfind("block_", 0) == 0 && n.substr(11) == ".bin" &&
+         std::all_of(n.begin() + 6, n.begin() + 11, [](char c) { return c >= '0' && c <= '9'; });
 }
 
 // FNV-1a over the inputs that determine the block files' contents.
@@ -282,6 +290,14 @@ BucketStore BucketStore::sort(const Sequence& seq, const BucketDesc& desc, const
   write_json_file(index.string(), j, -1);
   ibl::report(progress, "sort", 1.0);
   return st;
+}
+
+void remove_bucket_cache(const std::string& dir) {
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) return;
+  for (const auto& e : fs::directory_iterator(dir, ec))
+    if (e.is_regular_file(ec) && is_cache_file(e.path())) fs::remove(e.path(), ec);
+  if (fs::is_empty(dir, ec)) fs::remove(dir, ec);
 }
 
 }  // namespace ibl::ilf

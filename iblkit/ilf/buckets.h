@@ -98,6 +98,10 @@ void scatter_probe_samples(const DirectionTable& t, const float* rgb, int pc, in
 std::string bucket_cache_key(const Sequence& seq, const BucketDesc& desc, int width, int height);
 
 // Half-float conversion helpers (IEEE binary16).
+// Removes the bucket cache a sort wrote into `dir` (its block_NNNNN.bin files and index.json), and
+// `dir` itself once nothing else is in it; what else is there stays. Nothing to remove is no error.
+void remove_bucket_cache(const std::string& dir);
+
 void halves_to_floats(const uint16_t* in, float* out, size_t n);
 void floats_to_halves(const float* in, uint16_t* out, size_t n);
 

@@ -1,9 +1,9 @@
-#include "iblkit/core/atomic_file.h"
 #include "iblkit/io/envmap_io.h"
 
 #include <array>
 #include <filesystem>
 
+#include "iblkit/core/atomic_file.h"
 #include "iblkit/core/error.h"
 
 namespace ibl::io {

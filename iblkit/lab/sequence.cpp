@@ -1,4 +1,3 @@
-#include "iblkit/core/atomic_file.h"
 #include "iblkit/lab/sequence.h"
 
 #include <chrono>
@@ -9,6 +8,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "iblkit/core/atomic_file.h"
 #include "iblkit/core/check.h"
 #include "iblkit/core/error.h"
 #include "iblkit/core/json_file.h"

@@ -1,4 +1,3 @@
-#include "iblkit/core/atomic_file.h"
 #include "iblkit/nearfield/dataset.h"
 
 #include <cmath>
@@ -7,6 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "iblkit/core/atomic_file.h"
 #include "iblkit/core/enum_names.h"
 #include "iblkit/core/error.h"
 #include "iblkit/core/json_file.h"
@@ -73,10 +73,7 @@ void Dataset::validate(const std::string& what) const {
 
 namespace {
 
-double number(const json& j, const char* key, const std::string& what) {
-  if (!j.contains(key) || !j[key].is_number()) fail(ErrorKind::Format, "{}: field '{}' missing or not a number", what, key);
-  return j[key].get<double>();
-}
+double number(const json& j, const char* key, const std::string& what) { return req_field<double>(j, what, key); }
 
 Vec2 vec2(const json& j, const std::string& what) {
   if (!j.is_array() || j.size() != 2 || !j[0].is_number() || !j[1].is_number())
@@ -98,10 +95,11 @@ Dataset read_dataset(const std::string& path) {
   ds.distance = number(j, "distance", path);
   if (!j.contains("grid") || !j["grid"].is_array() || j["grid"].size() != 2 || !j["grid"][0].is_number_integer() ||
       !j["grid"][1].is_number_integer())
-    fail(ErrorKind::Format, "{}: 'grid' must be [nx, ny]", path);
-  ds.nx = j["grid"][0].get<int>();
-  ds.ny = j["grid"][1].get<int>();
-  if (ds.nx < 1 || ds.ny < 1 || ds.nx > 256 || ds.ny > 256) fail(ErrorKind::Value, "{}: grid {}x{} out of range (1..256)", path, ds.nx, ds.ny);
+    fail(ErrorKind::Format, "{}: field \"grid\" must be [nx, ny] of whole numbers, got {}", path, j.contains("grid") ? j["grid"].dump() : "nothing");
+  const int64_t nx = j["grid"][0].get<int64_t>(), ny = j["grid"][1].get<int64_t>();
+  if (nx < 1 || ny < 1 || nx > 256 || ny > 256) fail(ErrorKind::Value, "{}: field \"grid\": {}x{} out of range (1..256)", path, nx, ny);
+  ds.nx = static_cast<int>(nx);
+  ds.ny = static_cast<int>(ny);
   if (!j.contains("m_extent") || !j["m_extent"].is_object()) fail(ErrorKind::Format, "{}: 'm_extent' {{min, max}} missing", path);
   ds.m_min = vec2(j["m_extent"].value("min", json()), path + ": m_extent.min");
   ds.m_max = vec2(j["m_extent"].value("max", json()), path + ": m_extent.max");
@@ -113,10 +111,13 @@ Dataset read_dataset(const std::string& path) {
   ds.negative.assign(n, Image());
   std::vector<bool> seen(n, false);
   const fs::path dir = fs::path(path).parent_path();
+  size_t index = 0;
   for (const auto& m : j["measurements"]) {
-    if (!m.is_object() || !m.contains("i") || !m.contains("j") || !m["i"].is_number_integer() || !m["j"].is_number_integer())
-      fail(ErrorKind::Format, "{}: a measurement lacks integer 'i' and 'j'", path);
-    const int i = m["i"].get<int>(), jj = m["j"].get<int>();
+    const std::string where = fmt::format("{}: measurements[{}]", path, index++);
+    const int64_t i64 = req_field<int64_t>(m, where, "i"), j64 = req_field<int64_t>(m, where, "j");
+    if (i64 < 0 || i64 >= ds.nx || j64 < 0 || j64 >= ds.ny)
+      fail(ErrorKind::Value, "{}: measurement ({}, {}) is outside the {}x{} grid", path, i64, j64, ds.nx, ds.ny);
+    const int i = static_cast<int>(i64), jj = static_cast<int>(j64);
     if (i < 0 || i >= ds.nx || jj < 0 || jj >= ds.ny)
       fail(ErrorKind::Value, "{}: measurement ({}, {}) is outside the {}x{} grid", path, i, jj, ds.nx, ds.ny);
     const size_t k = static_cast<size_t>(jj * ds.nx + i);
@@ -124,11 +125,10 @@ Dataset read_dataset(const std::string& path) {
     seen[k] = true;
     for (int part = 0; part < 2; ++part) {
       const char* key = part ? "negative" : "positive";
-      if (!m.contains(key) || !m[key].is_string())
-        fail(ErrorKind::Format, "{}: measurement ({}, {}) has no '{}' image", path, i, jj, key);
+      const std::string file = req_field<std::string>(m, where, key);
       io::ReadDesc rd;
       rd.max_channels = 3;
-      Image img = io::read_image((dir / m[key].get<std::string>()).string(), rd);
+      Image img = io::read_image((dir / file).string(), rd);
       if (img.channels() < 3) img = img.with_channels(3);
       (part ? ds.negative : ds.positive)[k] = std::move(img);
     }
