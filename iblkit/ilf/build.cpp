@@ -59,6 +59,7 @@ SHGrid build_shgrid(const Sequence& seq_in, const BuildDesc& desc, const Progres
   if (!std::isfinite(desc.project.kernel_cells))
     fail(ErrorKind::Value, "kernel_cells {} must be a finite number of grid cells", desc.project.kernel_cells);
   GridDesc grid{desc.nx, desc.ny, desc.nz, desc.volume ? *desc.volume : seq_in.volume};
+  ProjectDesc pd = desc.project;
   SHGrid out(grid, desc.bands);  // validates resolution, bands and volume
   {  // project_bucket's raster per thread: the projected volume plus the kernel's support, at Δ = raster_cells·h
     Vec3 sp = grid.spacing();
@@ -110,6 +111,29 @@ SHGrid build_shgrid(const Sequence& seq_in, const BuildDesc& desc, const Progres
   rep.probes_used = P - br.skipped;
   std::vector<Vec3> origins(static_cast<size_t>(P));
   for (int p = 0; p < P; ++p) origins[p] = seq.probes[p].position;
+  if (desc.auto_kernel || desc.auto_grid) {  // cross-validated choice (ilf/crossval.h)
+    ResampleSearch rs{.kernel = desc.auto_kernel, .grid = desc.auto_grid, .volume = grid.volume, .nx = grid.nx, .ny = grid.ny,
+                      .nz = grid.nz, .kernel_cells = pd.kernel_cells, .bands = desc.bands, .memory_bytes = bd.memory_bytes,
+                      .max_buckets = desc.auto_max_buckets};
+    rep.choice = choose_resampling(store, origins, pd, rs, desc.crossval, desc.ball_parallax);
+    rep.t_choose = rep.choice->seconds;
+    pd.kernel_cells = rep.choice->kernel;
+    if (rep.choice->nx != grid.nx || rep.choice->ny != grid.ny || rep.choice->nz != grid.nz) {
+      grid.nx = rep.choice->nx; grid.ny = rep.choice->ny; grid.nz = rep.choice->nz;
+      out = SHGrid(grid, desc.bands);
+    }
+  }
+  rep.nx = grid.nx; rep.ny = grid.ny; rep.nz = grid.nz;
+  rep.kernel_cells = pd.kernel_cells;
+  rep.ball_radius = desc.ball_parallax && !t.start.empty() ? seq.ball.radius : 0.0;
+  if (rep.choice && desc.crossval.folds >= 2) rep.crossval = rep.choice->best;  // the chosen trial's
+  else if (desc.crossval.folds >= 2) {
+    auto tc = Clock::now();
+    rep.crossval = cross_validate(store, origins, grid, pd, desc.bands, desc.crossval, desc.auto_max_buckets, desc.ball_parallax,
+                                  &rep.crossval_buckets);
+    rep.t_crossval = since(tc);
+  }
+  if (rep.choice) rep.crossval_buckets = rep.choice->buckets_used;
   // Resample, block by block.
   int K = desc.bands * desc.bands;
   int64_t G = grid.count(), rows = 3 * G;
@@ -132,6 +156,7 @@ SHGrid build_shgrid(const Sequence& seq_in, const BuildDesc& desc, const Progres
       BucketRays rays;
       rays.dirs = t.dir.data() + t.bucket_begin[b] * 3;
       rays.weights = t.weight.data() + t.bucket_begin[b];
+      if (desc.ball_parallax && !t.start.empty()) rays.starts = t.start.data() + t.bucket_begin[b] * 3;
       rays.n_dirs = nb;
       rays.origins = origins.data();
       rays.valid = store.valid().data();
@@ -141,7 +166,7 @@ SHGrid build_shgrid(const Sequence& seq_in, const BuildDesc& desc, const Progres
         auto* x = static_cast<const Ctx*>(c);
         return x->data + p * x->stride;
       };
-      auto st = project_bucket(grid, rays, desc.project, R.data() + size_t(j) * rows, G, scratch.local());
+      auto st = project_bucket(grid, rays, pd, R.data() + size_t(j) * rows, G, scratch.local());
       samples += st.rays;
       uncovered += st.uncovered;
     });
