@@ -66,10 +66,34 @@ nlohmann::json report_json(const ilf::BuildReport& r) {
           {"fraction_uncovered", r.fraction_uncovered}, {"buckets_reused", r.buckets_reused},
           {"seconds", {{"subsample", r.t_subsample}, {"sort", r.t_sort}, {"project", r.t_project},
                        {"accumulate", r.t_accumulate}, {"total", r.t_total}}},
-          {"gemm_gflop", r.gemm_flops * 1e-9},
+          {"gemm_gflop", r.gemm_flops * 1e-9}, {"resolution", {r.nx, r.ny, r.nz}}, {"kernel", r.kernel_cells},
+          {"ball_radius", r.ball_radius},
           {"gemm_gflops_per_s", r.t_accumulate > 0 ? r.gemm_flops * 1e-9 / r.t_accumulate : 0.0},
           {"samples_per_s", r.t_total > 0 ? r.samples / r.t_total : 0.0}};
 }
+
+// The cross-validation and the automatic choice in --json (null entries where a region had no probe).
+void add_crossval_json(nlohmann::json& j, const ilf::BuildReport& r) {
+  if (r.choice) {
+    nlohmann::json trials = nlohmann::json::array();
+    for (const auto& t : r.choice->trials) trials.push_back({{"grid", t.n}, {"kernel", t.kernel}, {"cv_error", t.cv_error}});
+    j["choice"] = {{"resolution", {r.choice->nx, r.choice->ny, r.choice->nz}}, {"kernel", r.choice->kernel},
+                   {"buckets_used", r.choice->buckets_used}, {"seconds", r.choice->seconds}, {"trials", trials}};
+  }
+  if (r.crossval) {
+    const auto& c = *r.crossval;
+    nlohmann::json regions = nlohmann::json::array();
+    for (size_t i = 0; i < c.region_error.size(); ++i)
+      regions.push_back({{"index", {int(i) % c.regions, int(i) / c.regions % c.regions, int(i) / (c.regions * c.regions)}},
+                         {"probes", c.region_probes[i]},
+                         {"rel_error", std::isfinite(c.region_error[i]) ? nlohmann::json(c.region_error[i]) : nlohmann::json()}});
+    j["crossval"] = {{"folds", c.folds}, {"evaluated", c.evaluated}, {"rel_error", c.rel_error},
+                     {"median_probe_error", c.median_probe_error}, {"regions_per_axis", c.regions}, {"regions", regions}};
+  }
+}
+
+// "--grid auto" or a resolution; "--kernel auto" or a width.
+bool is_auto(const std::string& s) { return s == "auto"; }
 
 // Inverse of parse_bytes for the --memory default: whole gibibytes or mebibytes as "2G", "512M".
 std::string format_bytes(size_t bytes) {
@@ -95,24 +119,39 @@ void setup_build(CLI::App& app) {
   // Defaults come from BuildDesc (and the descs it holds); the strings are their parsed forms.
   struct Opts {
     ilf::BuildDesc bd;
-    std::string seq, out, volume, buckets, vdb;
+    std::string seq, out, volume, buckets, vdb, error_grid, kernel = "auto";
     std::string grid = bd.nx == bd.ny && bd.ny == bd.nz ? std::to_string(bd.nx) : fmt::format("{},{},{}", bd.nx, bd.ny, bd.nz);
     std::string repair = ilf::repair_name(bd.project.repair), memory = format_bytes(bd.buckets.memory_bytes);
     std::string directions = directions_name(bd.buckets.octahedral);
     double subsample = -1, subsample_dist = ilf::SubsampleDesc{}.max_distance;  // off unless given
     CLI::Option* subsample_opt = nullptr;
     bool no_reuse = !bd.buckets.reuse, drop_buckets = false;
+    bool no_parallax = !bd.ball_parallax;
   };
   auto* o = iblcli::app_owned<Opts>();
   auto& bd0 = o->bd;
   app.add_option("sequence", o->seq, "iblkit.sequence/1 manifest")->required();
   app.add_option("-o,--out", o->out, "output .shgrid")->required();
-  app.add_option("--grid", o->grid, "grid points: N or NX,NY,NZ")->capture_default_str();
+  app.add_option("--grid", o->grid, "grid points: N, NX,NY,NZ, or auto (cross-validated choice among 8…64 within --memory)")->capture_default_str();
   app.add_option("--bands", bd0.bands, "SH bands (5 = 25 coefficients)")->capture_default_str()
       ->check(CLI::Range(ilf::kMinBuildBands, ilf::kMaxBuildBands));
   app.add_option("--volume", o->volume, "grid volume minx,miny,minz,maxx,maxy,maxz (default: the sequence's)");
-  app.add_option("--kernel", bd0.project.kernel_cells, "Gaussian kernel support diameter in grid cells")->capture_default_str()
-      ->check(positive_number);
+  app.add_option("--kernel", o->kernel, "Gaussian kernel support diameter in grid cells, or auto (cross-validated choice among 1.5…4)")
+      ->capture_default_str()->check([](const std::string& v) {
+        if (v == "auto") return std::string();
+        char* end = nullptr;
+        std::strtod(v.c_str(), &end);
+        if (end == v.c_str() || *end != '\0') return "expected auto or a number of grid cells, got " + v;
+        return positive_number(v);
+      });
+  bd0.crossval.folds = 5;  // the CLI cross-validates by default
+  app.add_option("--cv-folds", bd0.crossval.folds, "k-fold cross-validation of the grid against its own probes (0: off)")
+      ->capture_default_str()->check([](const std::string& v) {
+        char* end = nullptr;
+        long n = std::strtol(v.c_str(), &end, 10);
+        return end != v.c_str() && *end == '\0' && (n == 0 || (n >= 2 && n <= 255)) ? std::string() : "expected 0 or 2 to 255, got " + v;
+      });
+  app.add_option("--error-grid", o->error_grid, "write the cross-validated error volume here (a one-band .shgrid; ilf slice shows it)");
   app.add_option("--repair", o->repair, "filling of grid points no ray reached: mip (the paper's), pullpush, none")->capture_default_str();
   app.add_option("--memory", o->memory, "peak memory budget (e.g. 2G, 512M)")->capture_default_str();
   app.add_option("--buckets", o->buckets, "folder for the direction buckets (default: OUT.buckets; reused by re-runs)");
@@ -124,17 +163,24 @@ void setup_build(CLI::App& app) {
   app.add_flag("--sanitize", bd0.buckets.sanitize, "replace NaN/Inf/negative pixels by 0 instead of failing");
   app.add_flag("--no-reuse", o->no_reuse, "rebuild the direction buckets even when an earlier run's match");
   app.add_flag("--drop-buckets", o->drop_buckets, "remove the direction buckets once the grid is written (a re-run sorts again)");
+  app.add_flag("--no-parallax", o->no_parallax, "ignore the manifest's ball_radius: every ray through the probe position (single viewpoint)");
   app.footer("Example:\n  iblkit ilf build cap/sequence.json --grid 8 --bands 5 --out room8.shgrid");
   app.callback([o] {
-    auto grid = parse_grid(o->grid);
+    bool grid_auto = is_auto(o->grid);
+    auto grid = grid_auto ? std::vector<int>{16, 16, 16} : parse_grid(o->grid);
     if (!o->vdb.empty() && !ilf::have_vdb()) ilf::write_vdb(o->vdb, ilf::SHGrid());  // fails now, not after the build
     ilf::BuildDesc bd = o->bd;
     bd.nx = grid[0]; bd.ny = grid[1]; bd.nz = grid[2];
+    bd.auto_grid = grid_auto;
+    bd.auto_kernel = is_auto(o->kernel);
+    if (!bd.auto_kernel) bd.project.kernel_cells = std::stod(o->kernel);
+    if (!o->error_grid.empty() && bd.crossval.folds < 2) fail(ErrorKind::Value, "--error-grid needs the cross-validation (--cv-folds ≥ 2)");
     if (!o->volume.empty()) bd.volume = parse_box(o->volume);
     bd.project.repair = ilf::parse_repair(o->repair);
     bd.buckets.memory_bytes = parse_bytes(o->memory);
     bd.buckets.dir = o->buckets.empty() ? o->out + ".buckets" : o->buckets;
     bd.buckets.reuse = !o->no_reuse;
+    bd.ball_parallax = !o->no_parallax;
     if (o->directions == "auto") bd.buckets.octahedral = -1;
     else if (o->directions == "pixel") bd.buckets.octahedral = 0;
     else {
@@ -153,13 +199,28 @@ void setup_build(CLI::App& app) {
     ilf::write_shgrid(o->out, g);
     if (!o->vdb.empty()) ilf::write_vdb(o->vdb, g);
     if (o->drop_buckets) ilf::remove_bucket_cache(bd.buckets.dir);
+    if (!o->error_grid.empty()) ilf::write_shgrid(o->error_grid, ilf::error_volume(*rep.crossval, g.grid()));
     rep.skipped += srep.skipped;
     for (auto& r : srep.reasons) rep.skip_reasons.insert(rep.skip_reasons.begin(), r);
     for (auto& r : rep.skip_reasons) iblcli::info("skipped: " + r);
     auto j = report_json(rep);
     j["out"] = o->out;
+    add_crossval_json(j, rep);
+    if (!o->error_grid.empty()) j["error_grid"] = o->error_grid;
     iblcli::emit(j, [&] {
-      fmt::print("wrote {} ({}x{}x{}, {} coefficients)\n", o->out, bd.nx, bd.ny, bd.nz, bd.bands * bd.bands);
+      fmt::print("wrote {} ({}x{}x{}, {} coefficients)\n", o->out, rep.nx, rep.ny, rep.nz, bd.bands * bd.bands);
+      fmt::print("kernel    {:g} grid cells{}{}\n", rep.kernel_cells, rep.choice ? fmt::format(" (chosen of {} cross-validated trials on {} buckets in {:.1f}s{})",
+                 rep.choice->trials.size(), rep.choice->buckets_used, rep.choice->seconds, bd.auto_grid ? ", with the grid" : "") : "",
+                 rep.ball_radius > 0 ? fmt::format("; rays start on the ball (radius {:g} m)", rep.ball_radius) : "");
+      if (rep.crossval) {
+        const auto& c = *rep.crossval;
+        fmt::print("cv error  {:.4f} relative ({}-fold, {} probes; median probe {:.4f})\n", c.rel_error, c.folds, c.evaluated, c.median_probe_error);
+        std::string regs;
+        for (size_t i = 0; i < c.region_error.size(); ++i)
+          regs += std::isfinite(c.region_error[i]) ? fmt::format(" {:.3f}", c.region_error[i]) : " -";
+        fmt::print("  regions {}³ (x fastest, then y, z):{}\n", c.regions, regs);
+      }
+      if (!o->error_grid.empty()) fmt::print("wrote {} (cross-validated error volume)\n", o->error_grid);
       fmt::print("probes    {} used of {} in the manifest{}{}\n", rep.probes_used, rep.probes_in + srep.skipped,
                  rep.skipped ? fmt::format(", {} skipped as bad", rep.skipped) : "",
                  rep.subsampled_out ? fmt::format(", {} dropped by --subsample", rep.subsampled_out) : "");
@@ -233,16 +294,20 @@ Image irradiance_slice(const ilf::SHGrid& g, int axis, double value, int size, d
 }
 
 void setup_slice(CLI::App& app) {
-  struct Opts { std::string grid, plane, out; int size = 256; bool down = false; double exposure = 0; };
+  struct Opts { std::string grid, plane, out; int size = 256; bool down = false; double exposure = 0, max_error = 0.5; };
   auto* o = iblcli::app_owned<Opts>();
   app.add_option("grid", o->grid, ".shgrid file")->required();
   app.add_option("--plane", o->plane, "axis-aligned plane, e.g. y=0.3")->required();
   app.add_option("-o,--out", o->out, "output image (.png tone mapped, .exr linear W/m²)")->required();
   app.add_option("--size", o->size, "image width in pixels")->capture_default_str()->check(CLI::Range(8, 8192));
   app.add_flag("--down", o->down, "normal along the negative axis (default: positive)");
-  app.footer("Example:\n  iblkit ilf slice room.shgrid --plane y=0.3 --out slice.png");
+  app.add_option("--max-error", o->max_error, "error volumes (ilf build --error-grid): the relative error shown red")
+      ->capture_default_str()->check(positive_number);
+  app.footer("An error volume (ilf build --error-grid) is drawn as its relative error in false colour (.png: black 0,\n"
+             "blue, green, yellow, red at --max-error) or as its three channels (.exr: relative, absolute, weight).\n"
+             "Example:\n  iblkit ilf slice room.shgrid --plane y=0.3 --out slice.png");
   app.callback([o] {
-    auto g = ilf::read_shgrid(o->grid);
+    auto g = ilf::read_shgrid(o->grid, true);
     auto eq = o->plane.find('=');
     std::string ax = eq == std::string::npos ? "" : o->plane.substr(0, eq);
     int axis = ax == "x" ? 0 : ax == "y" ? 1 : ax == "z" ? 2 : -1;
@@ -254,8 +319,30 @@ void setup_slice(CLI::App& app) {
     if (!std::isfinite(val) || std::abs(val) > kMaxCoordinate)
       fail(ErrorKind::Value, "--plane: {} must be a finite coordinate within ±{:g} m", o->plane, kMaxCoordinate);
     if (o->size < 1 || o->size > 16384) fail(ErrorKind::Value, "--size {}: expected 1 to 16384 pixels", o->size);
-    Image img = irradiance_slice(g, axis, val, o->size, o->down ? -1 : 1);
     std::string ext = fs::path(o->out).extension().string();
+    if (g.content() == "cv-error") {
+      Image e = ilf::error_slice(g, axis, val, o->size);
+      if (ext == ".png" || ext == ".jpg") io::write_image(o->out, io::tonemap(ilf::error_colours(e, o->max_error), [] {
+        io::ToneMapDesc td;
+        td.auto_exposure = false;
+        td.curve = io::ToneCurve::Clamp;
+        return td;
+      }()));
+      else io::write_image(o->out, e);
+      double mx = 0, sum = 0;
+      for (int y = 0; y < e.height(); ++y)
+        for (int x = 0; x < e.width(); ++x) {
+          mx = std::max<double>(mx, e.rgb(x, y).x);
+          sum += e.rgb(x, y).x;
+        }
+      double mean = sum / (double(e.width()) * e.height());
+      iblcli::emit({{"out", o->out}, {"width", e.width()}, {"height", e.height()}, {"content", "cv-error"}, {"max_rel_error", mx},
+                    {"mean_rel_error", mean}},
+                   [&] { fmt::print("wrote {} ({}x{}), cross-validated relative error: mean {:.3f}, max {:.3f}\n", o->out, e.width(), e.height(), mean, mx); });
+      return;
+    }
+    if (!g.content().empty()) fail(ErrorKind::Value, "{}: content \"{}\" is neither radiance SH nor cv-error", o->grid, g.content());
+    Image img = irradiance_slice(g, axis, val, o->size, o->down ? -1 : 1);
     if (ext == ".png" || ext == ".jpg") io::write_image(o->out, io::tonemap(img));
     else io::write_image(o->out, img);
     double mx = 0;
@@ -270,7 +357,7 @@ void setup_info(CLI::App& app) {
   app.add_option("grid", *path, ".shgrid file")->required();
   app.footer("Example:\n  iblkit ilf info room.shgrid");
   app.callback([path] {
-    auto g = ilf::read_shgrid(*path);
+    auto g = ilf::read_shgrid(*path, true);
     const auto& gd = g.grid();
     double lo = 1e300, hi = -1e300;
     int K = g.coeff_count();
@@ -284,12 +371,14 @@ void setup_info(CLI::App& app) {
                         {"min", {gd.volume.min.x, gd.volume.min.y, gd.volume.min.z}},
                         {"max", {gd.volume.max.x, gd.volume.max.y, gd.volume.max.z}},
                         {"bytes", g.data().size() * 4}, {"c00_range", {lo, hi}}};
+    if (!g.content().empty()) j["content"] = g.content();
     iblcli::emit(j, [&] {
       fmt::print("file        {}\n", *path);
       fmt::print("grid        {}x{}x{}, {} bands ({} coefficients), {:.1f} MB\n", gd.nx, gd.ny, gd.nz, g.bands(), K, g.data().size() * 4 / 1048576.0);
       fmt::print("volume      ({:.4g}, {:.4g}, {:.4g}) .. ({:.4g}, {:.4g}, {:.4g})\n", gd.volume.min.x, gd.volume.min.y, gd.volume.min.z,
                  gd.volume.max.x, gd.volume.max.y, gd.volume.max.z);
       fmt::print("c00 range   {:.6g} .. {:.6g}\n", lo, hi);
+      if (!g.content().empty()) fmt::print("content     {} (channel 1: relative error, 2: absolute, 3: probe weight)\n", g.content());
     });
   });
 }
@@ -317,7 +406,7 @@ void setup_synth(CLI::App& app) {
 // The grid as three.js r187's LightProbeGridWebGL loads it (ilf/threejs_grid.h, docs/web.md).
 void setup_export_threejs(CLI::App& app) {
   struct Opts { std::string grid, out, name = "grid"; };
-  auto* o = new Opts();
+  auto* o = iblcli::app_owned<Opts>();
   app.add_option("grid", o->grid, ".shgrid file")->required();
   app.add_option("-o,--out", o->out, "output folder (NAME.json and NAME_atlas.bin)")->required();
   app.add_option("--name", o->name, "base name of the two files")->capture_default_str();

@@ -20,7 +20,7 @@ void setup(CLI::App& app) {
     iblcli::StaticServerDesc d;
     double seconds = 0;
   };
-  auto* o = new Opts();
+  auto* o = iblcli::app_owned<Opts>();
   app.add_option("dir", o->d.root, "folder to serve (its index.html is the page)")->required();
   app.add_option("--port", o->d.port, "TCP port (0: any free port)")->capture_default_str()->check(CLI::Range(0, 65535));
   app.add_option("--host", o->d.host, "loopback address to listen on (127.0.0.0/8 or ::1)")->capture_default_str();

@@ -18,7 +18,7 @@ void setup(CLI::App& app) {
     std::string screenshot, query = "mode=sh";
     std::string size = "800x600";
   };
-  auto* o = new Opts();
+  auto* o = iblcli::app_owned<Opts>();
   app.add_option("-o,--out", o->d.out, "folder to write (index.html, viewer.js, three/, data/, iblkit-web.json)")->required();
   app.add_option("-p,--probe", o->d.probes, "HDR probe (any mapping): its SH and a lat-long background; repeatable");
   app.add_option("--specular", o->d.specular, "specular KTX2 (iblkit specular) of the --probe of the same rank; repeatable");

@@ -40,22 +40,33 @@ DirectionTable make_direction_table(const Sequence& seq, int width, int height, 
   int n = desc.octahedral;
   if (n < 0 || n > 4096) fail(ErrorKind::Value, "direction buckets: octahedral resolution {} outside [0, 4096]", n);
   sphere::Mapping oct(sphere::MappingKind::Octahedral, std::max(n, 1), std::max(n, 1));
-  struct Slot { int64_t bucket; int32_t pixel; Vec3 d; double w; };
+  struct Slot { int64_t bucket; int32_t pixel; Vec3 d; double w; Vec3 s; };
   std::vector<Slot> slots;
+  bool ball = seq.mapping == sphere::MappingKind::MirrorBall && (seq.ball.radius > 0 || seq.ball.distance > 0);
+  bool perspective = ball && seq.ball.distance > seq.ball.radius && seq.ball.radius > 0;
+  double cos_dead = seq.dead_angle_deg > 0 ? std::cos(seq.dead_angle_deg * kPi / 180) : 2.0;
   for (int y = 0; y < height; ++y)
     for (int x = 0; x < width; ++x) {
-      Vec3 d;
-      if (!m.to_direction(x + 0.5, y + 0.5, &d)) continue;
-      double w = m.solid_angle(x, y);
+      Vec3 d, s{0, 0, 0};
+      double w;
+      if (perspective) {
+        if (!ball_ray(seq.ball, width, height, x + 0.5, y + 0.5, &s, &d) || d.z < -cos_dead) continue;
+        w = ball_pixel_solid_angle(seq.ball, width, height, x, y);
+      } else {
+        if (!m.to_direction(x + 0.5, y + 0.5, &d)) continue;
+        if (ball) ball_ray(seq.ball, width, height, x + 0.5, y + 0.5, &s, &d);  // the same direction, and the start
+        w = m.solid_angle(x, y);
+      }
       if (!(w > 0)) continue;
       d = normalize(seq.rotation * d);
+      s = seq.rotation * s;
       int64_t b = int64_t(y) * width + x;
       if (n > 0) {
         double px, py;
         oct.to_pixel(d, &px, &py);
         b = std::clamp(int(py), 0, n - 1) * int64_t(n) + std::clamp(int(px), 0, n - 1);
       }
-      slots.push_back({b, int32_t(int64_t(y) * width + x), d, w});
+      slots.push_back({b, int32_t(int64_t(y) * width + x), d, w, s});
     }
   if (slots.empty()) fail(ErrorKind::Value, "{}: frames of {}x{} in mapping {} carry no directions", seq.manifest, width, height, sphere::mapping_name(seq.mapping));
   std::stable_sort(slots.begin(), slots.end(), [](const Slot& a, const Slot& b) { return a.bucket < b.bucket; });
@@ -68,6 +79,7 @@ DirectionTable make_direction_table(const Sequence& seq, int width, int height, 
     t.pixel.push_back(slots[i].pixel);
     t.dir.insert(t.dir.end(), {float(slots[i].d.x), float(slots[i].d.y), float(slots[i].d.z)});
     t.weight.push_back(slots[i].w);
+    if (ball) t.start.insert(t.start.end(), {float(slots[i].s.x), float(slots[i].s.y), float(slots[i].s.z)});
   }
   t.bucket_begin.push_back(int64_t(slots.size()));
   // Blocks: at most max_block_buckets buckets and at most 1/8 of the memory budget of samples.
@@ -107,6 +119,7 @@ std::string bucket_cache_key(const Sequence& seq, const BucketDesc& desc, int w,
   };
   mix(fmt::format("v1 {} {} {} {} {} {} {} {} {}", sphere::mapping_name(seq.mapping), seq.dead_angle_deg, w, h,
                   desc.octahedral, desc.max_block_buckets, desc.memory_bytes, desc.skip_bad, desc.sanitize));
+  if (seq.ball.radius > 0 || seq.ball.distance > 0) mix(fmt::format("ball {} {}", seq.ball.radius, seq.ball.distance));
   for (int a = 0; a < 3; ++a) mix(fmt::format("{} {} {}", seq.rotation.m[a][0], seq.rotation.m[a][1], seq.rotation.m[a][2]));
   for (const auto& p : seq.probes) {
     std::error_code ec;

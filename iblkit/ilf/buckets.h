@@ -34,6 +34,9 @@ struct DirectionTable {
   std::vector<int32_t> pixel;       // per sample slot: pixel index y·width + x, ordered by bucket
   std::vector<float> dir;           // per sample slot: world direction, 3 floats
   std::vector<double> weight;       // per sample slot: exact solid angle of the pixel (sr)
+  std::vector<float> start;         // per sample slot: world offset of the ray's start from the probe
+                                    // position (its reflection point on the ball), 3 floats; empty for a
+                                    // single viewpoint (Sequence::ball.radius 0)
   std::vector<int64_t> bucket_begin;  // bucket b owns slots [bucket_begin[b], bucket_begin[b+1])
   std::vector<int> block_begin;     // block k owns buckets [block_begin[k], block_begin[k+1])
   int buckets() const { return int(bucket_begin.size()) - 1; }
@@ -42,7 +45,9 @@ struct DirectionTable {
 };
 
 // Builds the table for a frame size. Pixels whose centre has no direction (outside the mirror ball's
-// disc, in its dead angle, unused cube-cross cells) get no slot.
+// disc, in its dead angle, unused cube-cross cells) get no slot. A mirror ball with a radius gives each
+// slot its start on the ball (ilf/ball.h), with a camera distance also its perspective direction and
+// solid angle.
 DirectionTable make_direction_table(const Sequence& seq, int width, int height, const BucketDesc& desc,
                                     int64_t probe_count);
 

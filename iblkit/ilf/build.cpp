@@ -88,7 +88,8 @@ BucketDesc resolve_directions(const Sequence& seq, const BuildDesc& desc) {
 }
 
 BlockStats project_block(const BucketStore& store, int k, const std::vector<uint16_t>& buf, const GridDesc& grid,
-                         const ProjectDesc& desc, const std::vector<Vec3>& origins, float* R, BlockScratch& scratch) {
+                         const ProjectDesc& desc, const std::vector<Vec3>& origins, float* R, BlockScratch& scratch,
+                         bool ball_parallax) {
   const DirectionTable& t = store.table();
   int P = store.probe_count();
   int64_t G = grid.count(), rows = 3 * G;
@@ -107,6 +108,7 @@ BlockStats project_block(const BucketStore& store, int k, const std::vector<uint
     BucketRays rays;
     rays.dirs = t.dir.data() + t.bucket_begin[b] * 3;
     rays.weights = t.weight.data() + t.bucket_begin[b];
+    if (ball_parallax && !t.start.empty()) rays.starts = t.start.data() + t.bucket_begin[b] * 3;
     rays.n_dirs = nb;
     rays.origins = origins.data();
     rays.valid = store.valid().data();
@@ -146,6 +148,7 @@ SHGrid build_shgrid(const Sequence& seq_in, const BuildDesc& desc, const Progres
   BuildReport& rep = report ? *report : local;
   GridDesc grid = build_grid(seq_in, desc);
   SHGrid out(grid, desc.bands);
+  ProjectDesc pd = desc.project;
   rep.probes_in = int(seq_in.probes.size());
   Sequence seq = seq_in;
   if (desc.subsample) {
@@ -175,6 +178,29 @@ SHGrid build_shgrid(const Sequence& seq_in, const BuildDesc& desc, const Progres
   rep.probes_used = P - br.skipped;
   std::vector<Vec3> origins(static_cast<size_t>(P));
   for (int p = 0; p < P; ++p) origins[p] = seq.probes[p].position;
+  if (desc.auto_kernel || desc.auto_grid) {  // cross-validated choice (ilf/crossval.h)
+    ResampleSearch rs{.kernel = desc.auto_kernel, .grid = desc.auto_grid, .volume = grid.volume, .nx = grid.nx, .ny = grid.ny,
+                      .nz = grid.nz, .kernel_cells = pd.kernel_cells, .bands = desc.bands, .memory_bytes = bd.memory_bytes,
+                      .max_buckets = desc.auto_max_buckets};
+    rep.choice = choose_resampling(store, origins, pd, rs, desc.crossval, desc.ball_parallax);
+    rep.t_choose = rep.choice->seconds;
+    pd.kernel_cells = rep.choice->kernel;
+    if (rep.choice->nx != grid.nx || rep.choice->ny != grid.ny || rep.choice->nz != grid.nz) {
+      grid.nx = rep.choice->nx; grid.ny = rep.choice->ny; grid.nz = rep.choice->nz;
+      out = SHGrid(grid, desc.bands);
+    }
+  }
+  rep.nx = grid.nx; rep.ny = grid.ny; rep.nz = grid.nz;
+  rep.kernel_cells = pd.kernel_cells;
+  rep.ball_radius = desc.ball_parallax && !t.start.empty() ? seq.ball.radius : 0.0;
+  if (rep.choice && desc.crossval.folds >= 2) rep.crossval = rep.choice->best;  // the chosen trial's
+  else if (desc.crossval.folds >= 2) {
+    auto tc = Clock::now();
+    rep.crossval = cross_validate(store, origins, grid, pd, desc.bands, desc.crossval, desc.auto_max_buckets, desc.ball_parallax,
+                                  &rep.crossval_buckets);
+    rep.t_crossval = since(tc);
+  }
+  if (rep.choice) rep.crossval_buckets = rep.choice->buckets_used;
   // Resample, block by block.
   int K = desc.bands * desc.bands;
   int64_t G = grid.count(), rows = 3 * G;
@@ -187,7 +213,7 @@ SHGrid build_shgrid(const Sequence& seq_in, const BuildDesc& desc, const Progres
     store.load_block(k, buf);
     int b0 = t.block_begin[k], b1 = t.block_begin[k + 1], D = b1 - b0;
     R.resize(size_t(rows) * D);  // no clearing: project_bucket writes every (point, channel) of its column
-    auto bs = project_block(store, k, buf, grid, desc.project, origins, R.data(), scratch);
+    auto bs = project_block(store, k, buf, grid, pd, origins, R.data(), scratch, desc.ball_parallax);
     rep.samples += bs.rays;
     rep.uncovered += bs.uncovered;
     repair_s += bs.repair_seconds;

@@ -11,6 +11,7 @@
 
 #include "iblkit/core/progress.h"
 #include "iblkit/ilf/buckets.h"
+#include "iblkit/ilf/crossval.h"
 #include "iblkit/ilf/project.h"
 #include "iblkit/ilf/shgrid.h"
 #include "iblkit/ilf/subsample.h"
@@ -29,6 +30,14 @@ struct BuildDesc {
   int auto_pixel_buckets = 1 << 20;   // auto: one bucket per pixel when a frame has at most this many pixels
   int auto_octahedral = 256;          // auto: otherwise n×n octahedral buckets with this n
   std::optional<SubsampleDesc> subsample;  // sub-sample first when set
+  bool auto_kernel = false;           // choose project.kernel_cells by cross-validation (kAutoKernels)
+  bool auto_grid = false;             // choose the resolution by cross-validation (kAutoGrids; nx, ny, nz
+                                      // give the aspect; builds over half of buckets.memory_bytes not tried)
+  CrossValDesc crossval{.folds = 0};  // folds ≥ 2: report the cross-validated error (BuildReport::crossval)
+  int auto_max_buckets = 2048;        // cross-validation and the automatic choice use at most this many
+                                      // buckets (every s-th; all when there are fewer)
+  bool ball_parallax = true;          // start each ray at its reflection point on the ball (Sequence::ball);
+                                      // false: every ray through the probe position (single viewpoint)
 };
 
 struct BuildReport {
@@ -45,6 +54,14 @@ struct BuildReport {
   double t_subsample = 0, t_sort = 0, t_project = 0, t_accumulate = 0, t_total = 0;  // seconds
   double t_repair = 0;                 // the repair's share of t_project (its share of the buckets' thread time)
   double gemm_flops = 0;               // floating-point operations of the SH matrix products
+  int nx = 0, ny = 0, nz = 0;          // the resolution built (chosen with auto_grid)
+  double kernel_cells = 0;             // the kernel used (chosen with auto_kernel)
+  double ball_radius = 0;              // rays started on a ball of this radius (0: single viewpoint)
+  std::optional<ResampleChoice> choice;  // the automatic choice, when made
+  std::optional<CrossValResult> crossval;  // the cross-validated error, when asked for
+  int crossval_buckets = 0;            // buckets the cross-validation used
+  double t_choose = 0, t_crossval = 0;  // seconds of the automatic choice, of a separate cross-validation
+                                        // (fixed kernel and grid); both part of t_total
 };
 
 // SH accumulation of one block: C (rows × K, column-major) += R (rows × D, column-major) · B (D × K,
@@ -71,7 +88,8 @@ struct BlockStats {
 };
 using BlockScratch = tbb::enumerable_thread_specific<ProjectScratch>;
 BlockStats project_block(const BucketStore& store, int k, const std::vector<uint16_t>& buf, const GridDesc& grid,
-                         const ProjectDesc& desc, const std::vector<Vec3>& origins, float* R, BlockScratch& scratch);
+                         const ProjectDesc& desc, const std::vector<Vec3>& origins, float* R, BlockScratch& scratch,
+                         bool ball_parallax = true);  // rays start on the ball when the table has starts
 // C (3·G × K, column-major, as accumulate_block leaves it) into the grid's coefficient layout.
 void store_coefficients(const float* C, SHGrid& out);
 

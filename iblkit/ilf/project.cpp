@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <array>
 #include <cmath>
 #include <string>
 
@@ -78,10 +79,109 @@ void pull_push(std::vector<float>& v, std::vector<float>& w, int W, int H, std::
     for (int ch = 0; ch < 3; ++ch) v[i * 3 + ch] = tmp[i * 4 + ch];
 }
 
+// The held-out estimates of one bucket (CvBucket): for each probe of fold f, the rasters' sum minus
+// fold f's, read bilinearly at the projections of its cell's 8 corners (raster x = a[0] + i·a[1] +
+// j·a[2] + k·a[3], y alike), the covered corners' values trilinearly weighted and renormalised —
+// SHGrid::coeffs_at of the grid built without fold f, where that grid's points have data. Where none
+// of the 8 has data (the build would repair them), the finest level of the complement's 2×2 box
+// pyramid holding data at the probe's own projection: the pull of pull–push, the repair's stand-in.
+void cross_validate(const CvBucket& cv, const BucketRays& rays, const GridDesc& grid, ProjectScratch& sc, int W, int H,
+                    std::array<double, 4> a, std::array<double, 4> b) {
+  size_t npx = size_t(W) * H;
+  std::vector<int> pyr_of(size_t(cv.n_folds), -1);  // offset index into sc.pyr per fold, built on demand
+  std::vector<std::array<int, 3>> levels;            // per level: w, h, offset (in 4-float pixels)
+  int pyr_total = 0;
+  {
+    int w = W, h = H;
+    levels.push_back({w, h, 0});
+    pyr_total = w * h;
+    while (w > 1 || h > 1) {
+      w = (w + 1) / 2;
+      h = (h + 1) / 2;
+      levels.push_back({w, h, pyr_total});
+      pyr_total += w * h;
+    }
+  }
+  int built = 0;
+  auto bil = [&](const float* r, int ch, int nch, size_t i00, float fx, float fy) {
+    return (1 - fx) * (1 - fy) * r[i00 * nch + ch] + fx * (1 - fy) * r[(i00 + 1) * nch + ch] + (1 - fx) * fy * r[(i00 + W) * nch + ch] +
+           fx * fy * r[(i00 + W + 1) * nch + ch];
+  };
+  for (int p = 0; p < rays.n_probes; ++p) {
+    if (rays.valid && !rays.valid[p]) continue;
+    int f = cv.fold[p];
+    const float* fn = sc.fnum.data() + size_t(f) * npx * 3;
+    const float* fd = sc.fden.data() + size_t(f) * npx;
+    const int32_t* c0 = cv.cell + 3 * size_t(p);
+    const float* t = cv.frac + 3 * size_t(p);
+    double acc[3] = {0, 0, 0}, ws = 0;
+    for (int c = 0; c < 8; ++c) {
+      int ii = c0[0] + (c & 1), jj = c0[1] + ((c >> 1) & 1), kk = c0[2] + (c >> 2);
+      double w = ((c & 1) ? t[0] : 1 - t[0]) * ((c & 2) ? t[1] : 1 - t[1]) * ((c & 4) ? t[2] : 1 - t[2]);
+      if (w <= 0) continue;
+      double px = std::clamp(a[0] + ii * a[1] + jj * a[2] + kk * a[3], 0.0, W - 1.001);
+      double py = std::clamp(b[0] + ii * b[1] + jj * b[2] + kk * b[3], 0.0, H - 1.001);
+      int x0 = int(px), y0 = int(py);
+      float fx = float(px - x0), fy = float(py - y0);
+      size_t i00 = size_t(y0) * W + x0;
+      float da = bil(sc.den.data(), 0, 1, i00, fx, fy), dm = da - bil(fd, 0, 1, i00, fx, fy);
+      if (!(dm > 1e-4f * da + 1e-6f)) continue;
+      for (int ch = 0; ch < 3; ++ch) acc[ch] += w * (bil(sc.num.data(), ch, 3, i00, fx, fy) - bil(fn, ch, 3, i00, fx, fy)) / dm;
+      ws += w;
+    }
+    if (ws > 0) {
+      for (int ch = 0; ch < 3; ++ch) cv.pred[ch * cv.stride + p] = float(acc[ch] / ws);
+      continue;
+    }
+    // Fallback: the complement's box pyramid at the probe's projection.
+    if (pyr_of[f] < 0) {
+      pyr_of[f] = built++;
+      sc.pyr.resize(size_t(built) * pyr_total * 4);
+      float* P = sc.pyr.data() + size_t(pyr_of[f]) * pyr_total * 4;
+      for (size_t i = 0; i < npx; ++i) {
+        for (int ch = 0; ch < 3; ++ch) P[i * 4 + ch] = sc.num[i * 3 + ch] - fn[i * 3 + ch];
+        P[i * 4 + 3] = sc.den[i] - fd[i];
+      }
+      for (size_t l = 1; l < levels.size(); ++l) {
+        auto [fw, fh, fo] = levels[l - 1];
+        auto [cw, ch_, co] = levels[l];
+        for (int y = 0; y < ch_; ++y)
+          for (int x = 0; x < cw; ++x) {
+            float* q = P + (size_t(co) + size_t(y) * cw + x) * 4;
+            q[0] = q[1] = q[2] = q[3] = 0;
+            for (int dy = 0; dy < 2; ++dy)
+              for (int dx = 0; dx < 2; ++dx) {
+                int xx = 2 * x + dx, yy = 2 * y + dy;
+                if (xx >= fw || yy >= fh) continue;
+                const float* s = P + (size_t(fo) + size_t(yy) * fw + xx) * 4;
+                for (int k = 0; k < 4; ++k) q[k] += s[k];
+              }
+          }
+      }
+    }
+    const float* P = sc.pyr.data() + size_t(pyr_of[f]) * pyr_total * 4;
+    double ci = c0[0] + t[0], cj = c0[1] + t[1], ck = c0[2] + t[2];
+    int x = std::clamp(int(a[0] + ci * a[1] + cj * a[2] + ck * a[3]), 0, W - 1);
+    int y = std::clamp(int(b[0] + ci * b[1] + cj * b[2] + ck * b[3]), 0, H - 1);
+    float v[3] = {0, 0, 0};
+    for (size_t l = 0; l < levels.size(); ++l) {
+      auto [lw, lh, lo] = levels[l];
+      const float* q = P + (size_t(lo) + size_t(std::min(y >> l, lh - 1)) * lw + std::min(x >> l, lw - 1)) * 4;
+      if (q[3] > 1e-3f) {
+        for (int ch = 0; ch < 3; ++ch) v[ch] = q[ch] / q[3];
+        break;
+      }
+    }
+    for (int ch = 0; ch < 3; ++ch) cv.pred[ch * cv.stride + p] = v[ch];
+  }
+  (void)grid;
+}
+
 }  // namespace
 
 // Derivation (radiance projection of one bucket, [1] §3.2 done on a plane):
-//   A bucket holds rays R_pq(s) = x_p + s·ω_q, q over the bucket's directions (one in pixel buckets),
+//   A bucket holds rays R_pq(s) = x_p + s·ω_q (x_p + o_q + s·ω_q when the rays start on a mirror ball, o_q
+//   the reflection point of direction q relative to the ball's centre: everything below with x_p + o_q), q over the bucket's directions (one in pixel buckets),
 //   p over the probes. Let ω_b be the solid-angle-weighted mean of the ω_q and Π the plane through the
 //   volume centre c perpendicular to ω_b, with orthonormal axes (t, u). Ray pq meets Π at
 //     y_pq = x_p + λ·ω_q,  λ = (c − x_p)·ω_b / (ω_q·ω_b),
@@ -97,7 +197,7 @@ void pull_push(std::vector<float>& v, std::vector<float>& w, int W, int H, std::
 //   O(rays·grid points along the ray). For non-parallel rays of an octahedral bucket, the 2D distance
 //   differs from the 3D one by at most |(g − c)·ω_b|·sin∠(ω_q, ω_b).
 ProjectStats project_bucket(const GridDesc& grid, const BucketRays& rays, const ProjectDesc& desc, float* out,
-                            int64_t out_stride, ProjectScratch& sc) {
+                            int64_t out_stride, ProjectScratch& sc, const CvBucket* cv) {
   ProjectStats st;
   Vec3 sp = grid.spacing();
   double h = std::max({sp.x, sp.y, sp.z});
@@ -122,20 +222,43 @@ ProjectStats project_bucket(const GridDesc& grid, const BucketRays& rays, const 
   size_t npx = size_t(W) * H;
   sc.num.assign(npx * 3, 0.0f);
   sc.den.assign(npx, 0.0f);
+  if (cv) {
+    sc.fnum.assign(npx * 3 * cv->n_folds, 0.0f);
+    sc.fden.assign(npx * cv->n_folds, 0.0f);
+  }
+  Vec3 ob{0, 0, 0};  // the bucket's mean ray start offset (cross-validation reads there)
+  double wsum = 0;
+  for (int q = 0; q < rays.n_dirs; ++q) {
+    if (rays.starts) ob += Vec3(rays.starts[3 * q], rays.starts[3 * q + 1], rays.starts[3 * q + 2]) * rays.weights[q];
+    wsum += rays.weights[q];
+  }
+  if (wsum > 0) ob = ob / wsum;
   int rad_px = int(std::ceil(R / delta));
   double inv2s2 = 1.0 / (2 * sigma * sigma), R2 = R * R;
   std::vector<double> dx2(size_t(2 * rad_px + 2));
   std::vector<float> ex(size_t(2 * rad_px + 2));
   for (int p = 0; p < rays.n_probes; ++p) {
-    if (rays.valid && !rays.valid[p]) continue;
+    if (rays.valid && !rays.valid[p]) {
+      if (cv)
+        for (int ch = 0; ch < 3; ++ch) cv->own[ch * cv->stride + p] = cv->pred[ch * cv->stride + p] = 0.0f;
+      continue;
+    }
     const float* L = rays.radiance(rays.ctx, p);
-    Vec3 x = rays.origins[p];
-    double num_c = dot(c - x, wb);
+    Vec3 xp = rays.origins[p];
+    float* num_t = cv ? sc.fnum.data() + size_t(cv->fold[p]) * npx * 3 : sc.num.data();
+    float* den_t = cv ? sc.fden.data() + size_t(cv->fold[p]) * npx : sc.den.data();
+    if (cv) {
+      double m[3] = {0, 0, 0};
+      for (int q = 0; q < rays.n_dirs; ++q)
+        for (int ch = 0; ch < 3; ++ch) m[ch] += rays.weights[q] * L[3 * q + ch];
+      for (int ch = 0; ch < 3; ++ch) cv->own[ch * cv->stride + p] = wsum > 0 ? float(m[ch] / wsum) : 0.0f;
+    }
     for (int q = 0; q < rays.n_dirs; ++q) {
       Vec3 wq{rays.dirs[3 * q], rays.dirs[3 * q + 1], rays.dirs[3 * q + 2]};
       double cosq = dot(wq, wb);
       if (cosq < 1e-3) continue;
-      Vec3 y = x + wq * (num_c / cosq) - c;
+      Vec3 x = rays.starts ? xp + Vec3(rays.starts[3 * q], rays.starts[3 * q + 1], rays.starts[3 * q + 2]) : xp;
+      Vec3 y = x + wq * (dot(c - x, wb) / cosq) - c;
       double px = (dot(y, fr.t) - lo[0]) / delta, py = (dot(y, fr.b) - lo[1]) / delta;  // raster coords
       int cx = int(std::floor(px)), cy = int(std::floor(py));
       if (cx < -rad_px || cy < -rad_px || cx >= W + rad_px || cy >= H + rad_px) continue;
@@ -153,8 +276,8 @@ ProjectStats project_bucket(const GridDesc& grid, const BucketRays& rays, const 
         double dy = (yy - py) * delta, dy2 = dy * dy;
         if (dy2 >= R2) continue;
         float ey = float(std::exp(-dy2 * inv2s2));
-        float* nrow = sc.num.data() + (size_t(yy) * W) * 3;
-        float* drow = sc.den.data() + size_t(yy) * W;
+        float* nrow = num_t + (size_t(yy) * W) * 3;
+        float* drow = den_t + size_t(yy) * W;
         for (int xx = x0; xx <= x1; ++xx) {
           if (dx2[xx - x0] + dy2 >= R2) continue;
           float k = ex[xx - x0] * ey;
@@ -166,8 +289,15 @@ ProjectStats project_bucket(const GridDesc& grid, const BucketRays& rays, const 
       }
     }
   }
+  if (cv)  // the whole estimate is the sum of the folds'
+    for (int f = 0; f < cv->n_folds; ++f) {
+      const float* fn = sc.fnum.data() + size_t(f) * npx * 3;
+      const float* fd = sc.fden.data() + size_t(f) * npx;
+      for (size_t i = 0; i < npx * 3; ++i) sc.num[i] += fn[i];
+      for (size_t i = 0; i < npx; ++i) sc.den[i] += fd[i];
+    }
   // Raster pixel (xx, yy) is the plane point lo + (xx, yy)·Δ (the splat above evaluates K there).
-  bool plane_fill = desc.repair == Repair::PullPush;
+  bool plane_fill = desc.repair == Repair::PullPush && !cv;
   if (plane_fill) {
     sc.rad.assign(npx * 3, 0.0f);
     std::vector<float> w(npx);
@@ -180,7 +310,7 @@ ProjectStats project_bucket(const GridDesc& grid, const BucketRays& rays, const 
     st.repair_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
   int64_t G = grid.count();
-  sc.covered.assign(size_t(G), 0);
+  if (!cv) sc.covered.assign(size_t(G), 0);
   // Raster coordinates of grid point (i, j, k) are affine in (i, j, k): px = a0 + i·ai + j·aj + k·ak.
   Vec3 sp3 = grid.spacing(), o = grid.volume.min - c;
   double ax0 = (dot(o, fr.t) - lo[0]) / delta, ay0 = (dot(o, fr.b) - lo[1]) / delta;
@@ -189,6 +319,9 @@ ProjectStats project_bucket(const GridDesc& grid, const BucketRays& rays, const 
   const float* num = sc.num.data();
   const float* den_r = sc.den.data();
   const float* fill = plane_fill ? sc.rad.data() : nullptr;
+  if (cv) cross_validate(*cv, rays, grid, sc, W, H, {ax0 + dot(ob, fr.t) / delta, axi, axj, axk},
+                         {ay0 + dot(ob, fr.b) / delta, ayi, ayj, ayk});
+  if (cv) return st;
   int64_t gi = 0;
   for (int k = 0; k < grid.nz; ++k)
     for (int j = 0; j < grid.ny; ++j) {

@@ -27,6 +27,8 @@ struct ProjectDesc {
 struct BucketRays {
   const float* dirs = nullptr;      // n_dirs world directions (3 floats each)
   const double* weights = nullptr;  // n_dirs solid angles (to form the mean direction)
+  const float* starts = nullptr;    // optional: n_dirs offsets (3 floats) of each direction's ray start
+                                    // from its probe's origin (a mirror ball's reflection points)
   int n_dirs = 0;
   const Vec3* origins = nullptr;    // n_probes capture positions
   const uint8_t* valid = nullptr;   // n_probes flags (0 = skipped probe)
@@ -34,6 +36,20 @@ struct BucketRays {
   // radiance(p) returns the 3·n_dirs floats of probe p (RGB per direction of the bucket).
   const float* (*radiance)(const void* ctx, int p) = nullptr;
   const void* ctx = nullptr;
+};
+
+// Cross-validation of one bucket (ilf/crossval.h): the probes are split into folds; the rays of each
+// fold are splatted into a raster of their own, so that the estimate without fold f is the sum over
+// all folds minus fold f's, read at the 8 grid points around each probe of f (its trilinear cell, as
+// SHGrid::coeffs_at reads it), shifted by the bucket's mean start offset when rays start on a ball.
+struct CvBucket {
+  int n_folds = 0;                  // ≥ 2
+  const uint8_t* fold = nullptr;    // n_probes: the fold of each probe
+  const int32_t* cell = nullptr;    // n_probes × 3: the lower corner (i, j, k) of the probe's cell
+  const float* frac = nullptr;      // n_probes × 3: its trilinear fractions in the cell
+  float* pred = nullptr;            // out: pred[c·stride + p], the estimate without p's fold
+  float* own = nullptr;             // out: own[c·stride + p], p's own solid-angle-weighted mean radiance
+  int64_t stride = 0;
 };
 
 struct ProjectStats {
@@ -47,11 +63,14 @@ struct ProjectScratch {
   std::vector<float> num, den, tmp;  // plane rasters and pyramid storage
   std::vector<float> rad;            // per-grid-point radiance before the 3D repair
   std::vector<uint8_t> covered;
+  std::vector<float> fnum, fden;     // cross-validation: one raster per fold
+  std::vector<float> pyr;            // cross-validation: box pyramid of one fold's complement
 };
 
 // Writes the bucket's radiance at grid point g, channel c into out[c·out_stride + g].
+// With `cv`, the held-out estimates (CvBucket) instead: `out` is not written, nothing is repaired.
 ProjectStats project_bucket(const GridDesc& grid, const BucketRays& rays, const ProjectDesc& desc, float* out,
-                            int64_t out_stride, ProjectScratch& scratch);
+                            int64_t out_stride, ProjectScratch& scratch, const CvBucket* cv = nullptr);
 
 // [1] §3.3 on one channel set: values (3 channels, stride `stride`) at the grid's points, covered[g]
 // says which hold data. Fills every uncovered point from the finest box-filtered mip level whose

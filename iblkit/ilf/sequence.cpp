@@ -46,6 +46,18 @@ Sequence read_sequence(const std::string& path, const SequenceReadDesc& desc, Se
     if (!(seq.dead_angle_deg >= 0 && seq.dead_angle_deg < 90))
       fail(ErrorKind::Value, "{}: field \"dead_angle_deg\" = {} is outside [0, 90)", path, seq.dead_angle_deg);
   }
+  for (const char* key : {"ball_radius", "ball_distance"}) {
+    if (!j.contains(key)) continue;
+    if (!j[key].is_number()) fail(ErrorKind::Format, "{}: field \"{}\" is not a number", path, key);
+    double v = j[key].get<double>();
+    if (!(v >= 0 && v <= 100)) fail(ErrorKind::Value, "{}: field \"{}\" = {} is outside [0, 100] metres", path, key, v);
+    (std::string(key) == "ball_radius" ? seq.ball.radius : seq.ball.distance) = v;
+  }
+  if ((seq.ball.radius > 0 || seq.ball.distance > 0) && seq.mapping != sphere::MappingKind::MirrorBall)
+    fail(ErrorKind::Value, "{}: fields \"ball_radius\"/\"ball_distance\" need the mirrorball mapping, not {}", path, mapping);
+  if (seq.ball.distance > 0 && !(seq.ball.distance > seq.ball.radius && seq.ball.radius > 0))
+    fail(ErrorKind::Value, "{}: field \"ball_distance\" = {} needs a \"ball_radius\" > 0 below it (got {})", path,
+         seq.ball.distance, seq.ball.radius);
   if (j.contains("rotation")) {
     const auto& r = j["rotation"];
     if (!r.is_array() || r.size() != 3) fail(ErrorKind::Format, "{}: field \"rotation\" must be 3 rows of 3", path);
@@ -152,6 +164,8 @@ void write_sequence(const std::string& path, const Sequence& seq) {
                         {"max", {seq.volume.max.x, seq.volume.max.y, seq.volume.max.z}}}},
             {"probes", probes}};
   if (!seq.scene.empty()) j["scene"] = seq.scene;
+  if (seq.ball.radius > 0) j["ball_radius"] = seq.ball.radius;
+  if (seq.ball.distance > 0) j["ball_distance"] = seq.ball.distance;
   write_json_file(path, j);
 }
 

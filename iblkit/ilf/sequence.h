@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "iblkit/core/vec.h"
+#include "iblkit/ilf/ball.h"
 #include "iblkit/sphere/mapping.h"
 
 namespace ibl::ilf {
@@ -32,6 +33,7 @@ struct Sequence {
   std::string manifest;             // path the sequence was read from ("" when built in memory)
   sphere::MappingKind mapping = sphere::MappingKind::MirrorBall;  // mapping of every frame
   double dead_angle_deg = 0.0;      // mirror ball: unusable cone behind the ball
+  BallOptics ball;                  // mirror ball: radius and camera distance (0, 0: a single viewpoint)
   Mat3 rotation = Mat3::identity(); // probe frame -> world
   Box volume;                       // capture volume (bounding box of the positions by default)
   bool volume_given = false;        // true when the manifest names the volume

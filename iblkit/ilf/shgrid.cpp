@@ -89,6 +89,7 @@ void write_shgrid(const std::string& path, const SHGrid& g) {
               {"max", {gd.volume.max.x, gd.volume.max.y, gd.volume.max.z}},
               {"dtype", "float32"},
               {"layout", "z,y,x,coefficient,channel"}};
+  if (!g.content().empty()) hdr["content"] = g.content();
   std::string head = "IBLKIT-SHGRID 1\n" + hdr.dump();
   size_t total = ((head.size() + 1 + 63) / 64) * 64;
   head.append(total - head.size() - 1, ' ');
@@ -104,7 +105,7 @@ void write_shgrid(const std::string& path, const SHGrid& g) {
   file.commit();
 }
 
-SHGrid read_shgrid(const std::string& path) {
+SHGrid read_shgrid(const std::string& path, bool any_content) {
   std::ifstream in(path, std::ios::binary);
   if (!in) fail(ErrorKind::Io, "{}: cannot open", path);
   std::string magic, header;
@@ -152,6 +153,12 @@ SHGrid read_shgrid(const std::string& path) {
            path, gd.nx, gd.ny, gd.nz, bands, want, std::max(0.0, file_bytes - double(off)));
   }
   SHGrid g(gd, bands);
+  if (h.contains("content")) {
+    if (!h["content"].is_string()) fail(ErrorKind::Format, "{}: header field \"content\" is not a string", path);
+    g.set_content(h["content"].get<std::string>());
+    if (!any_content && !g.content().empty())
+      fail(ErrorKind::Format, "{}: holds \"{}\", not radiance SH (an error volume: `iblkit ilf slice` shows it)", path, g.content());
+  }
   size_t n = g.data().size();
   in.read(reinterpret_cast<char*>(g.data().data()), std::streamsize(n * 4));
   if (size_t(in.gcount()) != n * 4) fail(ErrorKind::Format, "{}: truncated: {} of {} data bytes", path, in.gcount(), n * 4);

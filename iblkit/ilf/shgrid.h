@@ -19,6 +19,9 @@ class SHGrid {
 
   const GridDesc& grid() const { return grid_; }
   int bands() const { return bands_; }
+  // What the values are: "" radiance SH (the default); "cv-error" an error volume (ilf/crossval.h).
+  const std::string& content() const { return content_; }
+  void set_content(std::string c) { content_ = std::move(c); }
   int coeff_count() const { return bands_ * bands_; }
   std::vector<float>& data() { return data_; }
   const std::vector<float>& data() const { return data_; }
@@ -42,11 +45,13 @@ class SHGrid {
  private:
   GridDesc grid_;
   int bands_ = 0;
+  std::string content_;
   std::vector<float> data_;
 };
 
 // Reads/writes a .shgrid; errors name the file and the field.
-SHGrid read_shgrid(const std::string& path);
+// A file whose header names a "content" (an error volume, ilf/crossval.h) is refused unless any_content.
+SHGrid read_shgrid(const std::string& path, bool any_content = false);
 void write_shgrid(const std::string& path, const SHGrid& g);
 
 // Writes the grid as OpenVDB (one Vec3f grid per coefficient named "sh_l{l}_m{m}", index space = grid

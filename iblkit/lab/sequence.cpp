@@ -142,6 +142,8 @@ SequenceResult write_sequence(const Scene& scene, const std::vector<Vec3>& posit
   seq.dead_angle_deg = desc.capture.dead_angle_deg;
   seq.rotation = desc.capture.rotation;
   seq.scene = scene.name;
+  if (desc.capture.camera == Camera::MirrorBall && desc.capture.ball_parallax)
+    seq.ball.radius = desc.capture.ball_radius;  // the orthographic ball camera's rays start on the ball
   Vec3 lo = positions.empty() ? Vec3{} : positions[0], hi = lo;
   bool inside = true;
   for (Vec3 p : positions) {
