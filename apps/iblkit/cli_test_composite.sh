@@ -70,11 +70,11 @@ check object-outside-grid fail "outside the SH grid's volume" -- "$BIN" composit
 check object-reaches-outside-grid ok "reaches outside the SH grid's volume" -- "$BIN" composite "$T/photo.exr" "${CAM[@]}" \
   --light "$T/grid.shgrid" --proxy "$T/fus/proxy.obj" --object blob --at 0.25,0.3,0 --object-size 0.3 --triangles 2000 --samples 4 \
   --object-samples 4 --out "$T/c19.exr"
-# A probe set whose one probe is said to stand outside its proxy (5 m up, above the room's ceiling): a warning,
-# the composite goes on.
+# A probe set whose one probe is said to stand above the room's ceiling: fusion turns the proxy to face it (with
+# a warning), and the object then lies outside that proxy: an error, not a composite lit from the wrong side.
 python3 -c 'import json, sys; j = json.load(open(sys.argv[1])); j["probes"][0]["position"] = [0, 5, 0]; json.dump(j, open(sys.argv[2], "w"))' \
   "$T/fus/probes.json" "$T/fus/above.json"
-check probe-set-outside-warns ok "the probe at .* lies outside the proxy" -- "$BIN" composite "$T/photo.exr" "${CAM[@]}" \
+check probe-set-outside fail "lies outside the proxy of" -- "$BIN" composite "$T/photo.exr" "${CAM[@]}" \
   --probes "$T/fus/above.json" "${OBJ[@]}" --samples 4 --object-samples 4 --out "$T/c20.exr"
 
 echo "$pass passed, $fail failed, $skip skipped"

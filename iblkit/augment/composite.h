@@ -41,7 +41,7 @@ namespace ibl::augment {
 
 struct CompositeDesc {
   int light_samples = 64;      // patch samples per proxy pixel (albedo and shadow)
-  int object_samples = 256;    // patch samples per object pixel (split over its camera rays)
+  int object_samples = 1024;   // patch samples per object pixel (split over its camera rays)
   int bounce_samples = 16;     // cone samples per proxy pixel for the object's light on it (0: no bounce)
   int triangle_samples = 64;   // patch samples per object triangle (its radiance for the bounce)
   int pixel_samples = 2;       // n: n×n camera rays per pixel (object coverage at its edges)

@@ -10,6 +10,7 @@
 #include "iblkit/core/parallel.h"
 #include "iblkit/fusion/fuse.h"
 #include "iblkit/lights/cut.h"
+#include "iblkit/sh/convolve.h"
 
 namespace ibl::augment {
 
@@ -29,15 +30,33 @@ LocalLight light_from_grid(const ilf::SHGrid& grid, Vec3 at, int size) {
   LocalLight l;
   l.map = sphere::EnvMap(Image(2 * size, size, 3), sphere::Mapping(sphere::MappingKind::LatLong, 2 * size, size));
   l.centre = at;
-  l.source = "SH grid";
+  // A radiance map from band-limited coefficients rings: a bright lamp's few bands swing negative around it.
+  // Light is never negative, but clamping the rings to 0 adds their area's worth of light (docs/augment.md
+  // gives the factor measured in low-scene2's grid: the object was lit from every side). So the
+  // coefficients are Hanning-windowed first (smaller rings, sh::apply_window), the rest is clamped, and the map
+  // is scaled per channel back to the grid's own power (its DC term: ∫L dω = √(4π)·c₀₀, which the window keeps).
+  sh::WindowDesc wd;
+  wd.kind = sh::Window::Hanning;
+  const sh::Coeffs c = sh::apply_window(grid.coeffs_at(at), wd);
+  std::vector<Vec3> row_sum(static_cast<size_t>(size));
   parallel_for(0, size, [&](int64_t y) {
     for (int x = 0; x < 2 * size; ++x) {
       Vec3 d;
       l.map.mapping.to_direction(x + 0.5, y + 0.5, &d);
-      Vec3 L = grid.radiance(at, d);
-      l.map.image.set_rgb(x, static_cast<int>(y), {std::max(0.0, L.x), std::max(0.0, L.y), std::max(0.0, L.z)});
+      Vec3 L = c.evaluate(d);
+      L = {std::max(0.0, L.x), std::max(0.0, L.y), std::max(0.0, L.z)};
+      l.map.image.set_rgb(x, static_cast<int>(y), L);
+      row_sum[static_cast<size_t>(y)] += L * l.map.mapping.solid_angle(x, static_cast<int>(y));
     }
   });
+  Vec3 clamped;
+  for (const Vec3& r : row_sum) clamped += r;
+  const Vec3 power = c.c[0] * std::sqrt(4 * kPi);
+  Vec3 scale{1, 1, 1};
+  for (int k = 0; k < 3; ++k) scale[k] = clamped[k] > 0 && power[k] > 0 ? power[k] / clamped[k] : 1.0;
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < 2 * size; ++x) l.map.image.set_rgb(x, y, l.map.image.rgb(x, y) * scale);
+  l.source = fmt::format("SH grid (Hanning-windowed, rings clamped: power x{:.2f}, scaled back)", luminance(clamped) / std::max(luminance(power), 1e-300));
   return l;
 }
 

@@ -29,7 +29,8 @@ struct LocalLight {
   std::string source;  // "probe", "SH grid", "fused probes": for messages
 };
 
-// The grid's radiance at `at` as a lat-long map of 2·size × size (negative SH ringing clamped to 0).
+// The grid's radiance at `at` as a lat-long map of 2·size × size: Hanning-windowed, negative ringing clamped to
+// 0, then scaled per channel to the grid's own power there (clamping alone adds light).
 LocalLight light_from_grid(const ilf::SHGrid& grid, Vec3 at, int size = 64);
 // The probe set fused at `at` (fusion::fuse, footprint blend) as a lat-long map of 2·size × size.
 LocalLight light_from_probes(const fusion::ProbeSet& set, Vec3 at, int size = 128);

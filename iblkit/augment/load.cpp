@@ -83,8 +83,7 @@ LoadedLight load_light(const LightInput& in, Vec3 lo, Vec3 hi) {
       out.light.centre = p.position;
       if (p.depth_source == fusion::DepthSource::File && is_identity(p.rotation)) out.light.depth = p.depth;
       out.light.source = "probe";
-      require_inside(out.proxy, centre, in.probes);
-      if (auto w = probe_outside(out.proxy, p.position); !w.empty()) out.warnings.push_back(w);
+      require_inside(out.proxy, centre, in.probes);  // (a set's probes outside its proxy: fusion::prepare's check)
     } else {
       fusion::PointCheck pc = fusion::check_point(set, centre);
       if (pc.backface > kOutsideShare)
