@@ -31,8 +31,8 @@ LocalLight light_from_grid(const ilf::SHGrid& grid, Vec3 at, int size) {
   l.map = sphere::EnvMap(Image(2 * size, size, 3), sphere::Mapping(sphere::MappingKind::LatLong, 2 * size, size));
   l.centre = at;
   // A radiance map from band-limited coefficients rings: a bright lamp's few bands swing negative around it.
-  // Light is never negative, but clamping the rings to 0 adds their area's worth of light (docs/augment.md
-  // gives the factor measured in low-scene2's grid: the object was lit from every side). So the
+  // Light is never negative; evaluated as they are and clamped, the rings lit the object from every side
+  // (docs/augment.md: low-scene2's object error 48 %). So the
   // coefficients are Hanning-windowed first (smaller rings, sh::apply_window), the rest is clamped, and the map
   // is scaled per channel back to the grid's own power (its DC term: ∫L dω = √(4π)·c₀₀, which the window keeps).
   sh::WindowDesc wd;
