@@ -4,24 +4,35 @@
 # composites from one probe at the object, fused probes around it, an SH grid, and the two baselines
 # (pasted without shadows; N median-cut lights only), each measured with --truth. Prints a Markdown
 # table; leaves everything under $OUT (default /tmp/augment_accuracy).
+# The truth is two photographs with the object (seeds 1 and 2, TRUTH_SAMPLES² rays per pixel each); the
+# composites are measured against their mean, and the mean's own noise (from the two truths' spread,
+# augment::measure_against) is the row "truth's own noise": the error a perfect composite would show.
 # Usage: bench/augment_accuracy.sh BUILD/iblkit [WIDTHxHEIGHT] [TRUTH_SAMPLES]
 set -eu
-# PHOTO_ARGS / CAPTURE_ARGS (environment): extra options of every photograph / capture (e.g. more area samples).
+# PHOTO_ARGS / CAPTURE_ARGS / COMPOSITE_ARGS (environment): extra options of every photograph / capture /
+# composite. By default the photographs carry two bounces and the probes one (the photograph reflects the
+# light the probes see, and light that reaches the floor via the object has the bounces the composite gives it),
+# and every probe texel is the mean of 4×4 rays (a camera's pixel integrates; one ray per texel misses or
+# doubles small lamps and the sun).
+BIN=$1; SIZE=${2:-160x120}; TS=${3:-32}; OUT=${OUT:-/tmp/augment_accuracy}
+read -ra PA <<<"${PHOTO_ARGS---bounces 2}"; read -ra CA <<<"${CAPTURE_ARGS---bounces 1 --samples 4}"; read -ra XA <<<"${COMPOSITE_ARGS:-}"
 # BACKEND=gl|cpu (environment, default cpu): which compositor the rows measure (--backend); REUSE=1 keeps the
 # photographs, captures and grids a previous run left under $OUT (the GL rows measured on the CPU rows' truths).
-BIN=$1; SIZE=${2:-320x240}; TS=${3:-8}; OUT=${OUT:-/tmp/augment_accuracy}
-read -ra PA <<<"${PHOTO_ARGS:-}"; read -ra CA <<<"${CAPTURE_ARGS:-}"; BACKEND=${BACKEND:-cpu}
+BACKEND=${BACKEND:-cpu}
 W=${SIZE%x*}; H=${SIZE#*x}
 mkdir -p "$OUT"
 row() {  # row SCENE LABEL ARGS… : one composite, one table row
   local scene=$1 label=$2; shift 2
   local j
   local d="$OUT/$(basename "$scene" .json)"
-  j=$("$BIN" composite "$d/photo.exr" "${CAM[@]}" "${OBJ[@]}" --truth "$d/truth.exr" --json --quiet --backend "$BACKEND" \
-      --out "$d/comp_${BACKEND}_${label// /_}.exr" "$@")
+  j=$("$BIN" composite "$d/photo.exr" "${CAM[@]}" "${OBJ[@]}" --truth "$d/truth.exr" --truth "$d/truth2.exr" --json --quiet \
+      --backend "$BACKEND" --out "$d/comp_${BACKEND}_${label// /_}.exr" "${XA[@]}" "$@")
   python3 -c 'import json, sys
 j = json.loads(sys.argv[3]); e = j["errors"]
-print("| %s | %s | %.1f %% | %.1f %% | %.2f %% | %.1f s |" % (sys.argv[1], sys.argv[2], 100 * e["object"], 100 * e["shadow"], 100 * e["unchanged"], j["seconds"]))' \
+print("| %s | %s | %.1f %% | %.1f %% | %.2f %% | %.1f s |" % (sys.argv[1], sys.argv[2], 100 * e["object"], 100 * e["shadow"], 100 * e["unchanged"], j["seconds"]))
+if sys.argv[2] == "one probe":
+  n = j["truth_noise"]
+  print("| %s | truth\x27s own noise | %.1f %% | %.1f %% | %.2f %% | |" % (sys.argv[1], 100 * n["object"], 100 * n["shadow"], 100 * n["unchanged"]))' \
     "$scene" "$label" "$j"
 }
 scene_run() {  # scene_run SCENE AT EYE TARGET VOLUME FUSED_PROBES
@@ -32,6 +43,8 @@ scene_run() {  # scene_run SCENE AT EYE TARGET VOLUME FUSED_PROBES
   "$BIN" lab photograph "$scene" "${CAM[@]}" --width "$W" --height "$H" --samples "$TS" "${PA[@]}" --out "$d/photo.exr" --quiet >/dev/null
   "$BIN" lab photograph "$scene" "${CAM[@]}" --width "$W" --height "$H" --samples "$TS" "${PA[@]}" "${OBJ[@]}" --mask "$d/mask.exr" \
     --out "$d/truth.exr" --quiet >/dev/null
+  "$BIN" lab photograph "$scene" "${CAM[@]}" --width "$W" --height "$H" --samples "$TS" "${PA[@]}" "${OBJ[@]}" --seed 2 \
+    --out "$d/truth2.exr" --quiet >/dev/null
   "$BIN" lab capture "$scene" --fusion --probe "$at" --size 128 "${CA[@]}" --out "$d/one" --quiet >/dev/null
   local probes=(); IFS=';' read -ra pts <<<"$fused"; for p in "${pts[@]}"; do probes+=(--probe "$p"); done
   "$BIN" lab capture "$scene" --fusion "${probes[@]}" --size 128 "${CA[@]}" --out "$d/fused" --quiet >/dev/null

@@ -42,5 +42,40 @@ check probe-outside-warns ok "lies outside the proxy" -- "$BIN" composite "$T/ph
 check bad-backend fail "expected cpu, gl or auto" -- "$BIN" composite "$T/photo.exr" "${CAM[@]}" --probes "$T/fus/probes.json" --backend vulkan \
   --out "$T/c9.exr"
 
+# The object's surface: a texture at its UVs, a glossy lobe (as render's options).
+"$BIN" preview "$T/photo.exr" "$T/tex.png" --quiet >/dev/null 2>&1
+check texture ok "composited" -- "$BIN" composite "$T/photo.exr" "${CAM[@]}" --probes "$T/fus/probes.json" "${OBJ[@]}" --texture "$T/tex.png" \
+  --samples 4 --object-samples 4 --out "$T/c10.exr"
+check gloss ok "composited" -- "$BIN" composite "$T/photo.exr" "${CAM[@]}" --probes "$T/fus/probes.json" "${OBJ[@]}" --gloss 0.3 \
+  --exponent 40 --lobe blinn --samples 4 --object-samples 4 --out "$T/c11.exr"
+check texture-missing fail "nonexistent" -- "$BIN" composite "$T/photo.exr" "${CAM[@]}" --probes "$T/fus/probes.json" "${OBJ[@]}" \
+  --texture "$T/nonexistent.png" --out "$T/c12.exr"
+check gloss-range fail "gloss" -- "$BIN" composite "$T/photo.exr" "${CAM[@]}" --probes "$T/fus/probes.json" "${OBJ[@]}" --gloss 2 \
+  --out "$T/c13.exr"
+check albedo-range fail "must lie in \[0, 1\]" -- "$BIN" composite "$T/photo.exr" "${CAM[@]}" --probes "$T/fus/probes.json" \
+  --object blob --at 0,0.2,0 --albedo 1.5,0.5,0.5 --out "$T/c14.exr"
+
+# The object outside the light's volume: under the room's floor (outside its proxy), outside an SH grid.
+check object-outside-proxy fail "lies outside the proxy of" -- "$BIN" composite "$T/photo.exr" "${CAM[@]}" --probes "$T/fus/probes.json" \
+  --object blob --at 0,-1,0 --object-size 0.3 --triangles 2000 --out "$T/c15.exr"
+check object-outside-proxy-light fail "lies outside the proxy of" -- "$BIN" composite "$T/photo.exr" "${CAM[@]}" \
+  --light "$T/fus/probes/p0.exr" --at-probe 0,0.5,0 --proxy "$T/fus/proxy.obj" --object blob --at 0,-1,0 --object-size 0.3 --triangles 2000 \
+  --out "$T/c16.exr"
+"$BIN" lab capture low-scene2 --grid 2,2,2 --volume "-0.3,0.1,-0.3;0.3,0.7,0.3" --size 8 --out "$T/seq" --quiet >/dev/null 2>&1
+"$BIN" ilf build "$T/seq/sequence.json" --grid 2 --bands 2 --out "$T/grid.shgrid" --quiet >/dev/null 2>&1
+check grid ok "composited" -- "$BIN" composite "$T/photo.exr" "${CAM[@]}" --light "$T/grid.shgrid" --proxy "$T/fus/proxy.obj" "${OBJ[@]}" \
+  --samples 4 --object-samples 4 --out "$T/c17.exr"
+check object-outside-grid fail "outside the SH grid's volume" -- "$BIN" composite "$T/photo.exr" "${CAM[@]}" --light "$T/grid.shgrid" \
+  --proxy "$T/fus/proxy.obj" --object blob --at 0.6,0.4,0 --object-size 0.3 --triangles 2000 --out "$T/c18.exr"
+check object-reaches-outside-grid ok "reaches outside the SH grid's volume" -- "$BIN" composite "$T/photo.exr" "${CAM[@]}" \
+  --light "$T/grid.shgrid" --proxy "$T/fus/proxy.obj" --object blob --at 0.25,0.3,0 --object-size 0.3 --triangles 2000 --samples 4 \
+  --object-samples 4 --out "$T/c19.exr"
+# A probe set whose one probe is said to stand above the room's ceiling: fusion turns the proxy to face it (with
+# a warning), and the object then lies outside that proxy: an error, not a composite lit from the wrong side.
+python3 -c 'import json, sys; j = json.load(open(sys.argv[1])); j["probes"][0]["position"] = [0, 5, 0]; json.dump(j, open(sys.argv[2], "w"))' \
+  "$T/fus/probes.json" "$T/fus/above.json"
+check probe-set-outside fail "lies outside the proxy of" -- "$BIN" composite "$T/photo.exr" "${CAM[@]}" \
+  --probes "$T/fus/above.json" "${OBJ[@]}" --samples 4 --object-samples 4 --out "$T/c20.exr"
+
 echo "$pass passed, $fail failed, $skip skipped"
 [ $fail -eq 0 ]

@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "cli.h"
 #include "render_setup.h"
@@ -28,9 +29,10 @@ using ibl::Vec3;
 
 struct Opts {
   std::string photo, eye, target, up = "0,1,0", camera, probes, proxy, at_probe, probe_depth, object = "blob", at = "0,0.15,0",
-                                   albedo = "0.7,0.7,0.7", out = "composite.exr", layers, backend = "cpu", truth;
-  std::vector<std::string> light;
-  double fov = 40, object_size = 0.3;
+                                   albedo = "0.7,0.7,0.7", out = "composite.exr", layers, backend = "cpu";
+  std::vector<std::string> light, truth;
+  std::string lobe = "phong", texture;
+  double fov = 40, object_size = 0.3, gloss = 0, exponent = 20;
   int triangles = 20000, median_cut = 0;
   ibl::augment::CompositeDesc desc;
 #ifdef IBLKIT_HAVE_GL
@@ -91,9 +93,13 @@ void run(const Opts& o, const ibl::io::EnvReadDesc& read) {
   if (o.median_cut > 0) L.light = ibl::augment::as_median_cut(L.light, o.median_cut);
   ibl::augment::CompositeDesc d = o.desc;
   d.progress = iblcli::progress_bar();
+  const ibl::render::Material material = iblcli::object_material(o.albedo, o.gloss, o.exponent, o.lobe, o.texture);
   ibl::augment::CompositeResult r;
 #ifdef IBLKIT_HAVE_GL
   if (backend == "gl") {
+    if (!o.texture.empty() || o.gloss > 0)
+      ibl::fail(ibl::ErrorKind::Unsupported, "--texture/--gloss: the GL compositor shades the object Lambertian with one albedo; "
+                "use --backend cpu");
     ibl::augment::gl::GlCompositeDesc g = o.gl;
     g.albedo_samples = d.light_samples;
     g.seed = d.seed;
@@ -102,7 +108,7 @@ void run(const Opts& o, const ibl::io::EnvReadDesc& read) {
     r = ibl::augment::gl::composite(photo, cam, L.proxy, L.light, object, od.albedo, g);
   }
 #endif
-  if (backend == "cpu") r = ibl::augment::composite(photo, cam, L.proxy, L.light, object, od.albedo, d);
+  if (backend == "cpu") r = ibl::augment::composite(photo, cam, L.proxy, L.light, object, material, d);
   iblcli::progress_done();
   for (const auto& w : r.warnings) iblcli::info("warning: " + w);
   if (fs::path(o.out).extension() == ".png")
@@ -130,12 +136,18 @@ void run(const Opts& o, const ibl::io::EnvReadDesc& read) {
                       {"unlit_pixels", s.unlit},
                       {"warnings", r.warnings}};
   if (!o.layers.empty()) j["layers"] = o.layers;
-  ibl::augment::CompositeErrors e;
+  ibl::augment::CompositeErrors e, noise;
   if (!o.truth.empty()) {
-    e = ibl::augment::measure(photo, r.composite, ibl::io::read_image(o.truth), r.mask);
+    std::vector<ibl::Image> truths;
+    for (const auto& t : o.truth) truths.push_back(ibl::io::read_image(t));
+    ibl::augment::TruthErrors te = ibl::augment::measure_against(photo, r.composite, truths, r.mask);
+    e = te.errors;
+    noise = te.noise;
+    if (!o.layers.empty()) write_layer(o.layers, "truth_error", ibl::augment::error_picture(r.composite, te.mean));
     j["errors"] = {{"object", e.object},          {"shadow", e.shadow},       {"unchanged", e.unchanged},
                    {"object_pixels", e.object_pixels}, {"shadow_pixels", e.shadow_pixels}, {"unchanged_pixels", e.unchanged_pixels},
                    {"brightened_pixels", e.brightened_pixels}, {"shadow_signal", e.shadow_signal}};
+    if (o.truth.size() > 1) j["truth_noise"] = {{"object", noise.object}, {"shadow", noise.shadow}, {"unchanged", noise.unchanged}, {"truths", o.truth.size()}};
   }
   iblcli::emit(j, [&] {
     fmt::print("composited the object into {} ({}x{}, light: {}, backend {}) in {:.2f} s: {}\n", o.photo, cam.width, cam.height,
@@ -144,8 +156,11 @@ void run(const Opts& o, const ibl::io::EnvReadDesc& read) {
     if (!o.layers.empty()) fmt::print("  layers: {}/mask, difference, albedo, render_with, render_without (.exr)\n", o.layers);
     if (!o.truth.empty())
       fmt::print("  against {}: object {:.1f} % ({} px), shadow {:.1f} % of the shadow signal ({} px, {:.0f} % darker), unchanged {:.2f} % ({} px)\n",
-                 o.truth, 100 * e.object, e.object_pixels, 100 * e.shadow, e.shadow_pixels, 100 * e.shadow_signal, 100 * e.unchanged,
+                 fmt::join(o.truth, " + "), 100 * e.object, e.object_pixels, 100 * e.shadow, e.shadow_pixels, 100 * e.shadow_signal, 100 * e.unchanged,
                  e.unchanged_pixels);
+    if (o.truth.size() > 1)
+      fmt::print("  the truths' mean's own noise (from their spread): object {:.1f} %, shadow {:.1f} %, unchanged {:.2f} %\n", 100 * noise.object,
+                 100 * noise.shadow, 100 * noise.unchanged);
   });
 }
 
@@ -167,6 +182,10 @@ void setup(CLI::App& app) {
   app.add_option("--at", o->at, "where the object's centre goes")->capture_default_str();
   app.add_option("--object-size", o->object_size, "largest extent, metres (0 keeps a mesh file's own size and place)")->capture_default_str();
   app.add_option("--albedo", o->albedo, "the object's Lambertian albedo r,g,b")->capture_default_str();
+  app.add_option("--gloss", o->gloss, "weight of the object's glossy lobe (0..1)")->check(CLI::Range(0.0, 1.0));
+  app.add_option("--exponent", o->exponent, "exponent of the glossy lobe")->check(CLI::Range(1.0, 10000.0))->capture_default_str();
+  app.add_option("--lobe", o->lobe, "glossy lobe: phong, or blinn (Blinn-Phong)")->check(CLI::IsMember({"phong", "blinn"}))->capture_default_str();
+  app.add_option("--texture", o->texture, "albedo texture of the object (sRGB PNG/JPG or linear EXR) at its UVs (the blob's and sphere's own)");
   app.add_option("--triangles", o->triangles, "triangles of the blob")->check(CLI::Range(100, 5000000))->capture_default_str();
   app.add_option("--samples", o->desc.light_samples, "light samples per proxy pixel (albedo and shadows)")->check(CLI::Range(1, 65536))
       ->capture_default_str();
@@ -189,7 +208,8 @@ void setup(CLI::App& app) {
 #endif
   app.add_option("-o,--out", o->out, "the composite (.exr linear, .png tone mapped)")->capture_default_str();
   app.add_option("--layers", o->layers, "folder for mask, difference, albedo, render_with, render_without (.exr)");
-  app.add_option("--truth", o->truth, "a photograph with the object really there (iblkit lab photograph): print the errors");
+  app.add_option("--truth", o->truth, "a photograph with the object really there (iblkit lab photograph): print the errors; repeat with other seeds to "
+                 "measure against their mean and estimate its noise");
   app.footer(
       "Examples:\n  iblkit composite photo.exr --eye 0,1.2,2.4 --target 0,0.3,0 --fov 40 --probes fusion/probes.json --object blob "
       "--at 0,0.2,0 --out comp.exr --layers layers\n"

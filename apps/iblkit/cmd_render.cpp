@@ -147,11 +147,7 @@ void make_scene(const Opts& o, Scene* s) {
     s->floor = geometry::make_floor(o.floor_size, lo.y - 1e-3);  // just under the object's lowest point,
     s->floor.transform(1.0, {od.at.x, 0, od.at.z});              // centred under it
   }
-  Material mat{iblcli::parse_vec3(o.albedo, "--albedo"), Vec3{1, 1, 1} * o.gloss, o.exponent, o.lobe == "blinn" ? Lobe::BlinnPhong : Lobe::Phong};
-  if (!o.texture.empty()) {
-    mat.albedo = {1, 1, 1};
-    mat.texture = std::make_shared<Image>(io::read_image(o.texture).with_channels(3));
-  }
+  Material mat = iblcli::object_material(o.albedo, o.gloss, o.exponent, o.lobe, o.texture);
   d.objects = {{&s->object, mat}};
   if (o.floor_size > 0) d.objects.push_back({&s->floor, Material{{0.5, 0.5, 0.5}, {0, 0, 0}, 1}});
 }

@@ -4,6 +4,7 @@
 #ifdef IBLKIT_HAVE_GEOMETRY
 #include <fmt/format.h>
 
+#include "iblkit/io/image_io.h"
 #include "iblkit/render/objects.h"
 
 namespace iblcli {
@@ -42,6 +43,17 @@ ibl::augment::ObjectDesc inserted_object(const std::string& kind, double size, i
   od.at = parse_vec3(at, "--at");
   od.albedo = parse_vec3(albedo, "--albedo");
   return od;
+}
+
+ibl::render::Material object_material(const std::string& albedo, double gloss, double exponent, const std::string& lobe,
+                                      const std::string& texture) {
+  using ibl::render::Lobe;
+  ibl::render::Material m{parse_vec3(albedo, "--albedo"), ibl::Vec3{1, 1, 1} * gloss, exponent, lobe == "blinn" ? Lobe::BlinnPhong : Lobe::Phong};
+  if (!texture.empty()) {
+    m.albedo = {1, 1, 1};
+    m.texture = std::make_shared<ibl::Image>(ibl::io::read_image(texture).with_channels(3));
+  }
+  return m;
 }
 
 }  // namespace iblcli

@@ -37,5 +37,10 @@ std::string grid_bounds_warning(const ibl::render::Lighting& L, const ibl::geome
 ibl::augment::ObjectDesc inserted_object(const std::string& kind, double size, int triangles, const std::string& at,
                                          const std::string& albedo);
 
+// The object's surface from --albedo, --gloss, --exponent, --lobe (phong, blinn) and --texture (which then
+// replaces the albedo: white times the texture), as `render` and `composite` take them.
+ibl::render::Material object_material(const std::string& albedo, double gloss, double exponent, const std::string& lobe,
+                                      const std::string& texture);
+
 }  // namespace iblcli
 #endif

@@ -146,6 +146,106 @@ TEST(AugmentComposite, ObjectUnderTheWhiteFurnaceHasRadianceAlbedoTimesL) {
   EXPECT_GT(r.stats.changed_pixels, 0);  // it shadows and lights the floor around it
 }
 
+// Mean radiance (green) over the pixels the object covers wholly, and their count.
+std::pair<double, int> object_mean(const CompositeResult& r, int channel = 1) {
+  double sum = 0;
+  int n = 0;
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x)
+      if (r.mask.at(x, y, 0) >= 1) {
+        sum += r.composite.rgb(x, y)[channel];
+        ++n;
+      }
+  return {n > 0 ? sum / n : 0, n};
+}
+
+TEST(AugmentComposite, TextureMultipliesTheAlbedoAtTheObjectsUVs) {
+  constexpr double kL = 2.0;
+  Image photo = constant_photo(kFloorAlbedo * kL);
+  auto sky = constant_sky({kL, kL, kL}, {0, 0.5, 0});
+  // A constant texture: each channel's radiance is its texel times ρL.
+  render::Material m{{0.8, 0.8, 0.8}, {0, 0, 0}};
+  Image tex(4, 4, 3);
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 4; ++x) tex.set_rgb(x, y, {0.25, 0.5, 1.0});
+  m.texture = std::make_shared<Image>(tex);
+  auto r = composite(photo, top_camera(), floor_mesh(), sky, sphere_at({0, 0.5, 0}, 0.6), m);
+  constexpr double kObjectTol = 0.02;  // as the white furnace above
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(object_mean(r, c).first, 0.8 * tex.rgb(0, 0)[c] * kL, kObjectTol * 0.8 * kL) << c;
+  // Half black, half white around the sphere (u from +X): the sphere's −Z and +Z sides (u = ¼ and ¾,
+  // the two texel columns' centres) are black and white.
+  Image half(2, 1, 3);
+  half.set_rgb(1, 0, {1, 1, 1});
+  m.texture = std::make_shared<Image>(half);
+  r = composite(photo, top_camera(), floor_mesh(), sky, sphere_at({0, 0.5, 0}, 0.6), m);
+  auto [ax, ay] = pixel_of(0, 0.2);
+  auto [bx, by] = pixel_of(0, -0.2);
+  double a = r.composite.rgb(ax, ay).y, b = r.composite.rgb(bx, by).y;
+  ASSERT_EQ(r.mask.at(ax, ay, 0), 1.0f);
+  ASSERT_EQ(r.mask.at(bx, by, 0), 1.0f);
+  constexpr double kHalfTol = 0.1;  // the pixels are not exactly on the texel centres; the sphere is curved there
+  EXPECT_NEAR(std::min(a, b), 0.0, kHalfTol * 0.8 * kL) << a << " " << b;
+  EXPECT_NEAR(std::max(a, b), 0.8 * kL, 0.25 * 0.8 * kL) << a << " " << b;
+}
+
+TEST(AugmentComposite, GlossyLobeUnderTheWhiteFurnaceReflectsItsWeightTimesL) {
+  // The normalised Phong lobe (s+1)/2π (r·l)^s integrates to 1 over the hemisphere when r = n (the sphere's
+  // top, seen from straight above): a glossy object of weight k and no diffuse part has radiance k L there.
+  constexpr double kL = 2.0, kGloss = 0.5;
+  Image photo = constant_photo(kFloorAlbedo * kL);
+  render::Material m{{0, 0, 0}, {kGloss, kGloss, kGloss}, 8.0};
+  CompositeDesc d;
+  d.object_samples = 4096;
+  auto r = composite(photo, top_camera(), floor_mesh(), constant_sky({kL, kL, kL}, {0, 0.5, 0}), sphere_at({0, 0.5, 0}, 0.6), m, d);
+  // Pixels within 0.1 m of the sphere's top (normals within 20° of the view: the lobe stays in the hemisphere).
+  double sum = 0;
+  int n = 0;
+  for (double x = -0.1; x <= 0.1; x += 0.05)
+    for (double z = -0.1; z <= 0.1; z += 0.05) {
+      auto [px, py] = pixel_of(x, z);
+      sum += r.composite.rgb(px, py).y;
+      ++n;
+    }
+  constexpr double kGlossTol = 0.06;  // power sampling of a constant sky puts few samples into an exponent-8 lobe
+  EXPECT_NEAR(sum / n, kGloss * kL, kGlossTol * kGloss * kL);
+  // A Lambertian object of the same weight is as bright at the top: the lobe neither gains nor loses light.
+  auto lam = composite(photo, top_camera(), floor_mesh(), constant_sky({kL, kL, kL}, {0, 0.5, 0}), sphere_at({0, 0.5, 0}, 0.6),
+                       Vec3{kGloss, kGloss, kGloss}, d);
+  EXPECT_NEAR(object_mean(lam).first, kGloss * kL, kGlossTol * kGloss * kL);
+}
+
+TEST(AugmentComposite, WhiteObjectInTheWhiteFurnaceSendsBackWhatItBlocks) {
+  // Everything white under a constant sky: the object's light on the floor (one bounce object → proxy) makes up
+  // for the light it blocks, up to the second bounce the reference leaves out (the floor under it, darkened,
+  // lights its underside less). Without the bounce the floor under it is much darker.
+  constexpr double kL = 1.0;
+  Image photo = constant_photo(kL);  // a white floor: ρ = 1
+  auto sky = constant_sky({kL, kL, kL}, {0, 0.6, 0});
+  CompositeDesc d;
+  d.light_samples = 256;
+  d.bounce_samples = 64;
+  const geometry::TriMesh obj = sphere_at({0, 0.5, 0}, 0.6);
+  auto with = composite(photo, top_camera(), floor_mesh(), sky, obj, Vec3{1, 1, 1}, d);
+  d.bounce_samples = 0;
+  auto without = composite(photo, top_camera(), floor_mesh(), sky, obj, Vec3{1, 1, 1}, d);
+  // Floor pixels in a ring 0.35..0.5 m from the sphere's axis (just outside it as seen from above).
+  double dw = 0, dn = 0;
+  int n = 0;
+  for (int k = 0; k < 16; ++k) {
+    double a = 2 * kPi * k / 16;
+    auto [px, py] = pixel_of(0.42 * std::cos(a), 0.42 * std::sin(a));
+    if (with.mask.at(px, py, 0) > 0) continue;
+    dw += with.difference.rgb(px, py).y;
+    dn += without.difference.rgb(px, py).y;
+    ++n;
+  }
+  ASSERT_GT(n, 8);
+  dw /= n;
+  dn /= n;
+  EXPECT_LT(dn, -0.1 * kL);                 // the shadow alone: more than a tenth of the light gone
+  EXPECT_LT(std::abs(dw), 0.3 * std::abs(dn));  // the bounce gives most of it back
+}
+
 TEST(AugmentComposite, BadInputFailsWithAClearMessage) {
   Image photo = constant_photo(kFloorAlbedo);
   auto sky = constant_sky({1, 1, 1}, {0, 0.5, 0});

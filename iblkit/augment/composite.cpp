@@ -76,56 +76,120 @@ Vec3 irradiance(const Scene& s, const geometry::RayTracer& rt, Vec3 x, Vec3 n, i
   return e / count;
 }
 
-// E₀ and the irradiance the object blocks, from the same samples.
-void proxy_irradiance(const Scene& s, Vec3 y, Vec3 n, int count, Rng& rng, Vec3* e0, Vec3* blocked) {
-  Vec3 a, b;
+// The object's outgoing radiance towards v at z (normal n, diffuse albedo rho): ρ/π E + specular·G, E and G
+// from the same `count` patch samples, occluded by `rt` (proxy and object), the proxy's patches near the object
+// darkened by its shadow.
+Vec3 object_radiance(const Scene& s, Vec3 z, Vec3 n, Vec3 v, Vec3 rho, const render::Material& m, int count, Rng& rng) {
+  const bool glossy = max_component(m.specular) > 0;
+  const Vec3 r = normalize(n * (2 * dot(n, v)) - v);
+  Vec3 e, g;
   for (int k = 0; k < count; ++k) {
     double pmf;
     size_t i = s.light->sample((k + rng.uniform()) / count, &pmf);
     Vec3 w;
     double dist;
-    Vec3 c = s.light->contribution(i, y, n, &w, &dist);
+    Vec3 c = s.light->contribution(i, z, n, &w, &dist, true);
+    if (max_component(c) <= 0 || s.both_rt.occluded(z, w, kRayEpsilon, patch_tfar(dist))) continue;
+    c = c / pmf;
+    e += c;
+    if (glossy) g += c * (render::glossy_lobe(m, n, v, r, w) / dot(n, w));  // c / cos: the irradiance at normal incidence
+  }
+  return (rho * e / kPi + m.specular * g) / count;
+}
+
+// The diffuse albedo at a point of object triangle `tri` with barycentrics b1, b2 (the texture at its UVs).
+Vec3 object_albedo(const geometry::TriMesh& o, const render::Material& m, uint32_t tri, double b1, double b2) {
+  if (!m.texture) return m.albedo;
+  Vec2 uv{0, 0};
+  if (o.has_uvs()) {
+    const auto& t = o.triangles[tri];
+    uv = o.uvs[t[0]] * (1 - b1 - b2) + o.uvs[t[1]] * b1 + o.uvs[t[2]] * b2;
+  }
+  return m.albedo * render::texture_albedo(*m.texture, uv);
+}
+
+// The cone of directions from y (normal n) that can meet the object: its bounding sphere's, or the hemisphere
+// about n when y lies inside that sphere. Uniform in it: pdf 1/solid_angle.
+struct Cone {
+  Frame f;
+  double cos_max = 0, solid_angle = 0;
+  bool hemisphere = false;
+  Cone(const Sphere& b, Vec3 y, Vec3 n) : f(Frame::from_normal(n)) {
+    Vec3 axis = b.c - y;
+    double d = length(axis);
+    hemisphere = d <= b.r;
+    cos_max = hemisphere ? 0 : std::sqrt(std::max(0.0, 1 - (b.r / d) * (b.r / d)));
+    if (!hemisphere) f = Frame::from_normal(axis / d);
+    solid_angle = 2 * kPi * (1 - cos_max);
+  }
+  bool contains(Vec3 w) const { return dot(w, f.n) >= cos_max; }
+  Vec3 direction(double u1, double u2) const {
+    double ct = 1 - u1 * (1 - cos_max), st = std::sqrt(std::max(0.0, 1 - ct * ct)), phi = 2 * kPi * u2;
+    return f.from_local({st * std::cos(phi), st * std::sin(phi), ct});
+  }
+};
+
+// At proxy point y (normal n): E₀, the irradiance the object blocks, and (with tri_radiance) the object's
+// light on y. The blocked light is the integral over the object's silhouette of the patches' radiance; it is
+// estimated from two strategies with the balance heuristic (Veach 1997): the `count` patch samples E₀ uses
+// (good for the sun, lamps and any small bright source) and `cone` directions uniform in the cone towards the
+// object (good where the object covers a small share of a broad sky: a far pixel's faint soft shadow); lamps
+// (free emitters) come from patch samples alone. The cone samples also give the object's light on y. Only
+// samples that meet the object add to `blocked` and `bounce`.
+void proxy_terms(const Scene& s, const std::vector<Vec3>* tri_radiance, Vec3 y, Vec3 n, int count, int cone_count, Rng& rng,
+                 Vec3* e0, Vec3* blocked, Vec3* bounce) {
+  const LightField& L = *s.light;
+  const Cone cone(s.bound, y, n);
+  const double n1 = count, n2 = cone_count, pc = cone_count > 0 ? 1 / cone.solid_angle : 0;
+  Vec3 a, b;
+  for (int k = 0; k < count; ++k) {
+    double pmf;
+    size_t i = L.sample((k + rng.uniform()) / count, &pmf);
+    Vec3 w;
+    double dist;
+    Vec3 c = L.contribution(i, y, n, &w, &dist);
     double tfar = patch_tfar(dist);
     if (max_component(c) <= 0 || s.proxy_rt.occluded(y, w, kRayEpsilon, tfar)) continue;
     c = c / pmf;
     a += c;
-    if (s.bound.meets(y, w, tfar) && s.object_rt.occluded(y, w, kRayEpsilon, tfar)) b += c;
+    if (s.bound.meets(y, w, tfar) && s.object_rt.occluded(y, w, kRayEpsilon, tfar)) {
+      double weight = 1;
+      if (cone_count > 0 && !L.lamp(i) && cone.contains(w)) {
+        double pp = pmf / L.solid_angle_at(i, y);  // this sample's density per steradian
+        weight = n1 * pp / (n1 * pp + n2 * pc);
+      }
+      b += c * weight;
+    }
   }
-  *e0 = a / count;
-  *blocked = b / count;
-}
-
-// ∫ L_obj cos dω over the directions from y that meet the object first.
-Vec3 object_light(const Scene& s, const std::vector<Vec3>& tri_radiance, Vec3 y, Vec3 n, int count, Rng& rng) {
-  if (count <= 0) return {};
-  Vec3 axis = s.bound.c - y;
-  double d = length(axis);
-  bool inside = d <= s.bound.r;
-  double cos_max = inside ? 0 : std::sqrt(std::max(0.0, 1 - (s.bound.r / d) * (s.bound.r / d)));
-  Frame f = Frame::from_normal(inside ? n : axis / d);
-  Vec3 sum;
-  auto m = static_cast<int>(std::lround(std::sqrt(static_cast<double>(count))));
-  for (int k = 0; k < count; ++k) {
+  *e0 = a / n1;
+  *blocked = b / n1;
+  Vec3 bl, li;
+  auto m = static_cast<int>(std::lround(std::sqrt(n2)));
+  for (int k = 0; k < cone_count; ++k) {
     double u1 = rng.uniform(), u2 = rng.uniform();
-    if (m * m == count) {
+    if (m * m == cone_count) {
       u1 = (k % m + u1) / m;
       u2 = (k / m + u2) / m;
     }
-    double ct = 1 - u1 * (1 - cos_max), st = std::sqrt(std::max(0.0, 1 - ct * ct)), phi = 2 * kPi * u2;
-    Vec3 w = f.from_local({st * std::cos(phi), st * std::sin(phi), ct});
+    Vec3 w = cone.direction(u1, u2);
     double cn = dot(w, n);
     if (cn <= 0) continue;
     geometry::Hit h = s.both_rt.intersect(y, w, kRayEpsilon);
-    if (!h.hit || h.mesh != 1) continue;
-    sum += tri_radiance[h.triangle] * cn;
+    if (!h.hit || h.mesh != 1) continue;  // the object is not in front along w
+    if (tri_radiance) li += (*tri_radiance)[h.triangle] * cn;
+    long i = L.patch_along(y, w, s.proxy_rt);
+    if (i < 0) continue;
+    double pp = L.pmf(static_cast<size_t>(i)) / std::max(L.solid_angle_at(static_cast<size_t>(i), y), 1e-300);
+    bl += L.radiance(static_cast<size_t>(i)) * (cn / (n1 * pp + n2 * pc));
   }
-  return sum * (2 * kPi * (1 - cos_max) / count);  // uniform in the cone (a hemisphere when inside)
+  *blocked += bl;
+  *bounce = cone_count > 0 ? li / (n2 * pc) : Vec3{};
 }
 
 // The object's shadow on the proxy patches near it (within kShadowReach bounding radii of its centre),
 // as factors E_with / E₀ of their radiance: the floor under an object does not light its underside.
 constexpr double kShadowReach = 4;
-void shadow_patches(const Scene& s, LightField& field, int count, uint64_t seed) {
+void shadow_patches(const Scene& s, LightField& field, int count, int cone_count, uint64_t seed) {
   std::vector<size_t> near;
   for (size_t i = 0; i < field.size(); ++i)
     if (field.local(i) && length(field.point(i) - s.bound.c) < kShadowReach * s.bound.r) near.push_back(i);
@@ -134,7 +198,8 @@ void shadow_patches(const Scene& s, LightField& field, int count, uint64_t seed)
     size_t i = near[static_cast<size_t>(k)];
     Vec3 n = field.normal(i), e0, blocked;
     Rng rng(seed, 0x706174 /* "pat" */, i);
-    proxy_irradiance(s, field.point(i) + n * kRayEpsilon, n, count, rng, &e0, &blocked);
+    Vec3 unused;
+    proxy_terms(s, nullptr, field.point(i) + n * kRayEpsilon, n, count, cone_count, rng, &e0, &blocked, &unused);
     for (int c = 0; c < 3; ++c)
       if (e0[c] > kUnlitIrradiance) factor[static_cast<size_t>(k)][c] = std::clamp(1 - blocked[c] / e0[c], 0.0, 1.0);
   }, 64);
@@ -174,7 +239,8 @@ void check_geometry(const Scene& s, const geometry::Camera& cam) {
 }  // namespace
 
 CompositeResult composite(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy,
-                          const LocalLight& light, const geometry::TriMesh& object, Vec3 albedo, const CompositeDesc& desc) {
+                          const LocalLight& light, const geometry::TriMesh& object, const render::Material& material,
+                          const CompositeDesc& desc) {
   auto t0 = std::chrono::steady_clock::now();
   const int W = photo.width(), H = photo.height(), n = desc.pixel_samples;
   if (photo.channels() < 3) fail(ErrorKind::Value, "the photograph has {} channels; an RGB image is needed", photo.channels());
@@ -185,6 +251,13 @@ CompositeResult composite(const Image& photo, const geometry::Camera& cam, const
     fail(ErrorKind::Value, "sample counts must be ≥ 1 (bounce samples ≥ 0)");
   if (proxy.triangle_count() == 0) fail(ErrorKind::Value, "the proxy has no triangles");
   if (object.triangle_count() == 0) fail(ErrorKind::Value, "the object has no triangles");
+  for (int c = 0; c < 3; ++c)
+    if (!(material.albedo[c] >= 0 && material.albedo[c] <= 1 && material.specular[c] >= 0 && material.specular[c] <= 1))
+      fail(ErrorKind::Value, "object albedo ({}, {}, {}) and gloss ({}, {}, {}) must lie in [0, 1]", material.albedo.x,
+           material.albedo.y, material.albedo.z, material.specular.x, material.specular.y, material.specular.z);
+  if (!(material.exponent >= 1 && material.exponent <= 1e4)) fail(ErrorKind::Value, "glossy exponent {} must lie in 1..10000", material.exponent);
+  if (material.texture && (material.texture->empty() || material.texture->channels() < 3))
+    fail(ErrorKind::Value, "the object's texture must be an RGB image");
   Scene s{proxy, object, {}, {}, {}, {}, nullptr};
   s.proxy_rt.add(proxy);
   s.proxy_rt.commit();
@@ -201,7 +274,7 @@ CompositeResult composite(const Image& photo, const geometry::Camera& cam, const
   if (desc.check_geometry) check_geometry(s, cam);
   LightField field(light, proxy, s.proxy_rt);
   s.light = &field;
-  if (desc.shadows) shadow_patches(s, field, desc.light_samples, desc.seed);
+  if (desc.shadows) shadow_patches(s, field, desc.light_samples, desc.bounce_samples, desc.seed);
 
   // The object's radiance per triangle (for its light on the proxy).
   std::vector<Vec3> tri_radiance(object.triangle_count());
@@ -211,7 +284,7 @@ CompositeResult composite(const Image& photo, const geometry::Camera& cam, const
       Vec3 nn = object.normal(static_cast<size_t>(ti));
       Vec3 c = (object.positions[t[0]] + object.positions[t[1]] + object.positions[t[2]]) / 3.0;
       Rng rng(desc.seed, 0x747269 /* "tri" */, static_cast<uint64_t>(ti));
-      tri_radiance[static_cast<size_t>(ti)] = albedo * irradiance(s, s.both_rt, c + nn * kRayEpsilon, nn, desc.triangle_samples, rng, true) / kPi;
+      tri_radiance[static_cast<size_t>(ti)] = object_albedo(object, material, static_cast<uint32_t>(ti), 1.0 / 3, 1.0 / 3) * irradiance(s, s.both_rt, c + nn * kRayEpsilon, nn, desc.triangle_samples, rng, true) / kPi;
     }, 256);
   report(desc.progress, "object", 1.0);
 
@@ -244,7 +317,8 @@ CompositeResult composite(const Image& photo, const geometry::Camera& cam, const
           if (dot(nn, d) > 0) nn = -nn;
           Vec3 z = cam.eye + d * h.t;
           Rng rng(desc.seed, 0x6f626a /* "obj" */, pixel * 64 + static_cast<uint64_t>(kk));
-          obj_sum += albedo * irradiance(s, s.both_rt, z + nn * kRayEpsilon, nn, obj_per_ray, rng, true) / kPi;
+          obj_sum += object_radiance(s, z + nn * kRayEpsilon, nn, -d, object_albedo(object, material, h.triangle, h.b1, h.b2), material,
+                                     obj_per_ray, rng);
           ++obj_hits;
         } else if (!have_proxy) {
           have_proxy = true;
@@ -261,9 +335,9 @@ CompositeResult composite(const Image& photo, const geometry::Camera& cam, const
         if (dot(nn, proxy_dir) > 0) nn = -nn;
         Vec3 yp = cam.eye + proxy_dir * proxy_t + nn * kRayEpsilon;
         Rng rng(desc.seed, 0x707278 /* "prx" */, pixel);
-        Vec3 e0, blocked;
-        proxy_irradiance(s, yp, nn, desc.light_samples, rng, &e0, &blocked);
-        Vec3 dE = object_light(s, tri_radiance, yp, nn, desc.bounce_samples, rng) - blocked;
+        Vec3 e0, blocked, bounce;
+        proxy_terms(s, &tri_radiance, yp, nn, desc.light_samples, desc.bounce_samples, rng, &e0, &blocked, &bounce);
+        Vec3 dE = bounce - blocked;
         bool bad = false, lit = true;
         for (int c = 0; c < 3; ++c) {
           if (e0[c] > kUnlitIrradiance) {

@@ -14,9 +14,10 @@
 // (ρ > 1 means the captured light misses some of the light the photograph shows; the change is then
 // limited to what a white surface would show.)
 //
-// Both sums are estimated with the same patch samples (power-and-solid-angle sampling, light.h); only
-// sample rays that meet the object add to ΔE, so a pixel from which no ray meets the object keeps the
-// photograph's value exactly. The bounce term samples the cone of the object's bounding sphere; the
+// E₀ is estimated with patch samples (power-and-solid-angle sampling, light.h); the blocked light with
+// the same patch samples and directions in the cone of the object's bounding sphere, combined by the balance
+// heuristic (multiple importance sampling); only sample rays that meet the object add to ΔE, so a pixel from
+// which no ray meets the object keeps the photograph's value exactly. The bounce term uses the cone samples; the
 // object's radiance L_obj = ρ_obj/π · E_obj is computed once per triangle. Pixels that see the object
 // (camera ray's first hit: the depth test against the proxy) show its render, ρ_obj/π · E_obj(z), with E_obj
 // from all patches (so the proxy's light reaches it) occluded by the proxy and the object itself; edge
@@ -34,12 +35,13 @@
 #include "iblkit/core/progress.h"
 #include "iblkit/geometry/camera.h"
 #include "iblkit/geometry/mesh.h"
+#include "iblkit/render/shading.h"
 
 namespace ibl::augment {
 
 struct CompositeDesc {
   int light_samples = 64;      // patch samples per proxy pixel (albedo and shadow)
-  int object_samples = 256;    // patch samples per object pixel (split over its camera rays)
+  int object_samples = 1024;   // patch samples per object pixel (split over its camera rays)
   int bounce_samples = 16;     // cone samples per proxy pixel for the object's light on it (0: no bounce)
   int triangle_samples = 64;   // patch samples per object triangle (its radiance for the bounce)
   int pixel_samples = 2;       // n: n×n camera rays per pixel (object coverage at its edges)
@@ -73,7 +75,17 @@ struct CompositeResult {
 // scene (open or closed; its triangles face the camera's side); `object` the virtual object (world space)
 // of Lambertian albedo `albedo`. Throws ibl::Error on sizes that disagree, the camera inside the proxy or
 // the object intersecting it.
+// The object's surface is render's Material (the shading model of `iblkit render`): its albedo, times its
+// texture at the mesh's UVs (the blob's and sphere's own parameterisation) where it has one, and a glossy lobe
+// of weight `specular` and exponent `exponent` (render::glossy_lobe) lit by the same patch samples. The
+// object's light on the proxy carries its diffuse part (the glossy part, seen from the proxy, is left out).
 CompositeResult composite(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy,
-                          const LocalLight& light, const geometry::TriMesh& object, Vec3 albedo, const CompositeDesc& desc = {});
+                          const LocalLight& light, const geometry::TriMesh& object, const render::Material& material,
+                          const CompositeDesc& desc = {});
+// A Lambertian object of albedo `albedo`.
+inline CompositeResult composite(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy,
+                                 const LocalLight& light, const geometry::TriMesh& object, Vec3 albedo, const CompositeDesc& desc = {}) {
+  return composite(photo, cam, proxy, light, object, render::Material{albedo, {0, 0, 0}}, desc);
+}
 
 }  // namespace ibl::augment

@@ -10,6 +10,7 @@
 #include "iblkit/core/parallel.h"
 #include "iblkit/fusion/fuse.h"
 #include "iblkit/lights/cut.h"
+#include "iblkit/sh/convolve.h"
 
 namespace ibl::augment {
 
@@ -29,15 +30,33 @@ LocalLight light_from_grid(const ilf::SHGrid& grid, Vec3 at, int size) {
   LocalLight l;
   l.map = sphere::EnvMap(Image(2 * size, size, 3), sphere::Mapping(sphere::MappingKind::LatLong, 2 * size, size));
   l.centre = at;
-  l.source = "SH grid";
+  // A radiance map from band-limited coefficients rings: a bright lamp's few bands swing negative around it.
+  // Light is never negative; evaluated as they are and clamped, the rings lit the object from every side
+  // (docs/augment.md: low-scene2's object error 48 %). So the
+  // coefficients are Hanning-windowed first (smaller rings, sh::apply_window), the rest is clamped, and the map
+  // is scaled per channel back to the grid's own power (its DC term: ∫L dω = √(4π)·c₀₀, which the window keeps).
+  sh::WindowDesc wd;
+  wd.kind = sh::Window::Hanning;
+  const sh::Coeffs c = sh::apply_window(grid.coeffs_at(at), wd);
+  std::vector<Vec3> row_sum(static_cast<size_t>(size));
   parallel_for(0, size, [&](int64_t y) {
     for (int x = 0; x < 2 * size; ++x) {
       Vec3 d;
       l.map.mapping.to_direction(x + 0.5, y + 0.5, &d);
-      Vec3 L = grid.radiance(at, d);
-      l.map.image.set_rgb(x, static_cast<int>(y), {std::max(0.0, L.x), std::max(0.0, L.y), std::max(0.0, L.z)});
+      Vec3 L = c.evaluate(d);
+      L = {std::max(0.0, L.x), std::max(0.0, L.y), std::max(0.0, L.z)};
+      l.map.image.set_rgb(x, static_cast<int>(y), L);
+      row_sum[static_cast<size_t>(y)] += L * l.map.mapping.solid_angle(x, static_cast<int>(y));
     }
   });
+  Vec3 clamped;
+  for (const Vec3& r : row_sum) clamped += r;
+  const Vec3 power = c.c[0] * std::sqrt(4 * kPi);
+  Vec3 scale{1, 1, 1};
+  for (int k = 0; k < 3; ++k) scale[k] = clamped[k] > 0 && power[k] > 0 ? power[k] / clamped[k] : 1.0;
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < 2 * size; ++x) l.map.image.set_rgb(x, y, l.map.image.rgb(x, y) * scale);
+  l.source = fmt::format("SH grid (Hanning-windowed, rings clamped: power x{:.2f}, scaled back)", luminance(clamped) / std::max(luminance(power), 1e-300));
   return l;
 }
 
@@ -96,6 +115,7 @@ LightField::LightField(const LocalLight& light, const geometry::TriMesh& proxy, 
         p.point = light.centre + d * depth;  // something in front of the proxy (a lamp): it faces the centre
         p.normal = -d;
         p.area = sa * depth * depth;
+        p.lamp = true;
       } else if (h.hit) {
         p.point = light.centre + d * h.t;
         Vec3 n = proxy.normal(h.triangle);
@@ -108,11 +128,18 @@ LightField::LightField(const LocalLight& light, const geometry::TriMesh& proxy, 
         p.area = sa;
         p.distant = true;
       }
+      p.texel = static_cast<long>(y) * W + x;
       rows[y].push_back(p);
     }
   });
+  mapping_ = mp;
+  centre_ = light.centre;
+  texel_patch_.assign(static_cast<size_t>(W) * H, -1);
   for (auto& r : rows)
-    for (auto& p : r) patches_.push_back(p);
+    for (auto& p : r) {
+      texel_patch_[static_cast<size_t>(p.texel)] = static_cast<long>(patches_.size());
+      patches_.push_back(p);
+    }
   if (patches_.empty()) fail(ErrorKind::Value, "the {} light is black: nothing to light the scene with", light.source);
   double power = 0, solid = 0;
   for (const auto& p : patches_) {
@@ -136,6 +163,39 @@ size_t LightField::sample(double u, double* pmf) const {
   size_t i = static_cast<size_t>(std::upper_bound(cdf_.begin(), cdf_.end(), u) - cdf_.begin());
   if (i >= cdf_.size()) i = cdf_.size() - 1;
   *pmf = cdf_[i] - (i > 0 ? cdf_[i - 1] : 0.0);
+  return i;
+}
+
+double LightField::solid_angle_at(size_t i, Vec3 x) const {
+  const Patch& p = patches_[i];
+  if (p.distant) return p.area;
+  Vec3 v = p.point - x;
+  double r2 = dot(v, v);
+  if (!(r2 > 0)) return 0;
+  double cq = -dot(p.normal, v) / std::sqrt(r2);
+  return cq > 0 ? p.area * cq / std::max(r2, p.area) : 0;  // as contribution()
+}
+
+long LightField::patch_along(Vec3 x, Vec3 w, const geometry::RayTracer& proxy_tracer) const {
+  constexpr double kRayStart = 1e-4;    // metres, as the composite's secondary rays
+  constexpr double kDepthMatch = 0.05;  // the texel's patch within 5 % of the hit's distance from the centre
+  geometry::Hit h = proxy_tracer.intersect(x, w, kRayStart);
+  Vec3 d = w;
+  double dist = 0;
+  if (h.hit) {
+    d = x + w * h.t - centre_;
+    dist = length(d);
+    if (!(dist > 0)) return -1;
+    d = d / dist;
+  }
+  double px, py;
+  if (!mapping_.to_pixel(d, &px, &py)) return -1;
+  int tx = std::clamp(static_cast<int>(px), 0, mapping_.width() - 1), ty = std::clamp(static_cast<int>(py), 0, mapping_.height() - 1);
+  long i = texel_patch_[static_cast<size_t>(ty) * mapping_.width() + tx];
+  if (i < 0) return -1;
+  const Patch& p = patches_[static_cast<size_t>(i)];
+  if (p.lamp || p.distant != !h.hit) return -1;
+  if (h.hit && std::abs(length(p.point - centre_) - dist) > kDepthMatch * dist) return -1;  // hidden from the centre
   return i;
 }
 

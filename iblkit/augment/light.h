@@ -29,7 +29,8 @@ struct LocalLight {
   std::string source;  // "probe", "SH grid", "fused probes": for messages
 };
 
-// The grid's radiance at `at` as a lat-long map of 2·size × size (negative SH ringing clamped to 0).
+// The grid's radiance at `at` as a lat-long map of 2·size × size: Hanning-windowed, negative ringing clamped to
+// 0, then scaled per channel to the grid's own power there (clamping alone adds light).
 LocalLight light_from_grid(const ilf::SHGrid& grid, Vec3 at, int size = 64);
 // The probe set fused at `at` (fusion::fuse, footprint blend) as a lat-long map of 2·size × size.
 LocalLight light_from_probes(const fusion::ProbeSet& set, Vec3 at, int size = 128);
@@ -60,6 +61,18 @@ class LightField {
   // ∫ mean(R, G, B) dω over the map, W/m²: for messages and tests.
   double total_power() const { return total_; }
 
+  // For estimators that sample directions themselves (multiple importance sampling with sample()):
+  // the probability sample() picks patch i; its solid angle seen from x (0 when it faces away); whether it
+  // is a free emitter (a lamp in front of the proxy, from the depth map) rather than the proxy or the sky.
+  double pmf(size_t i) const { return cdf_[i] - (i > 0 ? cdf_[i - 1] : 0.0); }
+  double solid_angle_at(size_t i, Vec3 x) const;
+  bool lamp(size_t i) const { return patches_[i].lamp; }
+  // The patch a ray from x along unit w sees first (the proxy hit's texel seen from the centre, when that texel's
+  // patch is that surface; the map's texel of w where the ray leaves the proxy), or −1: the radiance the patches
+  // give that ray, lamps left out. `proxy_tracer` as in the constructor.
+  long patch_along(Vec3 x, Vec3 w, const geometry::RayTracer& proxy_tracer) const;
+  Vec3 radiance(size_t i) const { return patches_[i].radiance; }
+
  private:
   struct Patch {
     Vec3 point;       // world point on the proxy, or the unit direction of a distant patch
@@ -68,9 +81,14 @@ class LightField {
     double area = 0;  // local: m²; distant: solid angle, sr
     double omega = 0; // solid angle seen from the centre, sr
     bool distant = false;
+    bool lamp = false;     // placed by the depth map in front of the proxy
+    long texel = 0;        // its texel, row-major
     Vec3 shadow{1, 1, 1};  // the object's shadow on it (set_shadow)
   };
   std::vector<Patch> patches_;
+  sphere::Mapping mapping_{sphere::MappingKind::LatLong, 2, 1};
+  Vec3 centre_;
+  std::vector<long> texel_patch_;  // the patch of each texel (row-major), −1 for none
   std::vector<double> cdf_;
   double total_ = 0;
 };

@@ -48,6 +48,24 @@ sphere::EnvMap to_world(const sphere::EnvMap& m, const Mat3& rotation) {
   return sphere::EnvMap(sphere::resample(m, m.mapping, rd), m.mapping);
 }
 
+// The object's centre must lie inside the proxy (where the captured light describes the scene).
+void require_inside(const geometry::TriMesh& proxy, Vec3 centre, const std::string& what) {
+  double back = backface_share(proxy, centre);
+  if (back > kOutsideShare)
+    fail(ErrorKind::Value,
+         "the object's centre ({:.3g}, {:.3g}, {:.3g}) lies outside the proxy of {} ({:.0f} % of its rays meet back faces): the "
+         "captured light says nothing about it there; move it (at)",
+         centre.x, centre.y, centre.z, what, 100 * back);
+}
+
+std::string probe_outside(const geometry::TriMesh& proxy, Vec3 p) {
+  double back = backface_share(proxy, p);
+  if (back <= kOutsideShare) return {};
+  return fmt::format("the probe at ({:.3g}, {:.3g}, {:.3g}) lies outside the proxy ({:.0f} % of its rays meet back "
+                     "faces): its light is projected onto the proxy from there all the same",
+                     p.x, p.y, p.z, 100 * back);
+}
+
 }  // namespace
 
 LoadedLight load_light(const LightInput& in, Vec3 lo, Vec3 hi) {
@@ -65,6 +83,7 @@ LoadedLight load_light(const LightInput& in, Vec3 lo, Vec3 hi) {
       out.light.centre = p.position;
       if (p.depth_source == fusion::DepthSource::File && is_identity(p.rotation)) out.light.depth = p.depth;
       out.light.source = "probe";
+      require_inside(out.proxy, centre, in.probes);  // (a set's probes outside its proxy: fusion::prepare's check)
     } else {
       fusion::PointCheck pc = fusion::check_point(set, centre);
       if (pc.backface > kOutsideShare)
@@ -77,6 +96,7 @@ LoadedLight load_light(const LightInput& in, Vec3 lo, Vec3 hi) {
   if (in.proxy.empty()) fail(ErrorKind::Value, "{}: a light file needs a proxy mesh (the local scene)", in.light);
   out.proxy = geometry::read_mesh(in.proxy);
   if (out.proxy.triangle_count() == 0) fail(ErrorKind::Value, "{}: the proxy has no triangles", in.proxy);
+  require_inside(out.proxy, centre, in.proxy);
   if (ends_with(in.light, ".shgrid")) {
     if (in.at_probe) fail(ErrorKind::Value, "{}: an SH grid has no probe position; leave at_probe out", in.light);
     ilf::SHGrid g = ilf::read_shgrid(in.light);
@@ -108,11 +128,7 @@ LoadedLight load_light(const LightInput& in, Vec3 lo, Vec3 hi) {
       for (int x = 0; x < d.width(); ++x) one.at(x, y, 0) = d.at(x, y, 0);
     out.light.depth = std::move(one);
   }
-  double back = backface_share(out.proxy, *in.at_probe);
-  if (back > kOutsideShare)
-    out.warnings.push_back(fmt::format("the probe at ({:.3g}, {:.3g}, {:.3g}) lies outside the proxy ({:.0f} % of its rays meet back "
-                                       "faces): its light is projected onto the proxy from there all the same",
-                                       in.at_probe->x, in.at_probe->y, in.at_probe->z, 100 * back));
+  if (auto w = probe_outside(out.proxy, *in.at_probe); !w.empty()) out.warnings.push_back(w);
   return out;
 }
 

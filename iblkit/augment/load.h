@@ -32,7 +32,7 @@ struct LoadedLight {
 };
 
 // object_lo/hi: the object's bounds (world). Throws ibl::Error when the inputs disagree, the object's
-// centre lies outside the grid's volume, or (fused probes) outside the proxy.
+// centre lies outside the grid's volume or outside the proxy (any light); a probe outside the proxy is a warning.
 LoadedLight load_light(const LightInput& in, Vec3 object_lo, Vec3 object_hi);
 
 }  // namespace ibl::augment

@@ -1,5 +1,6 @@
 #include "iblkit/augment/measure.h"
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -71,6 +72,38 @@ CompositeErrors measure(const Image& photo, const Image& comp, const Image& trut
   e.unchanged = ud > 0 ? un / ud : 0;
   e.shadow_signal = e.shadow_pixels > 0 ? rel / e.shadow_pixels : 0;
   return e;
+}
+
+Image error_picture(const Image& comp, const Image& truth) {
+  Image out(comp.width(), comp.height(), 3);
+  for (int y = 0; y < comp.height(); ++y)
+    for (int x = 0; x < comp.width(); ++x) {
+      double t = luminance(truth.rgb(x, y)), d = t > 0 ? (luminance(comp.rgb(x, y)) - t) / t : 0;
+      out.set_rgb(x, y, {std::max(0.0, d), std::max(0.0, -d), 0});
+    }
+  return out;
+}
+
+TruthErrors measure_against(const Image& photo, const Image& comp, const std::vector<Image>& truths, const Image& mask, double tau) {
+  if (truths.empty()) fail(ErrorKind::Value, "measure: no truth");
+  const Image& t1 = truths.front();
+  TruthErrors r;
+  r.mean = Image(t1.width(), t1.height(), 3);
+  for (const Image& t : truths) {
+    if (t.width() != t1.width() || t.height() != t1.height() || t.channels() < 3)
+      fail(ErrorKind::Value, "measure: truths of {}x{} and {}x{} (RGB) differ", t1.width(), t1.height(), t.width(), t.height());
+    for (int y = 0; y < t1.height(); ++y)
+      for (int x = 0; x < t1.width(); ++x) r.mean.set_rgb(x, y, r.mean.rgb(x, y) + t.rgb(x, y) / static_cast<double>(truths.size()));
+  }
+  r.errors = measure(photo, comp, r.mean, mask, tau);
+  if (truths.size() > 1) {
+    r.noise = measure(photo, t1, r.mean, mask, tau);
+    const double s = 1 / std::sqrt(static_cast<double>(truths.size() - 1));
+    r.noise.object *= s;
+    r.noise.shadow *= s;
+    r.noise.unchanged *= s;
+  }
+  return r;
 }
 
 }  // namespace ibl::augment

@@ -8,6 +8,7 @@
 // a path-traced truth's grain is not a shadow); the sums are over single pixels.
 #pragma once
 #include <cstdint>
+#include <vector>
 
 #include "iblkit/core/image.h"
 
@@ -21,5 +22,23 @@ struct CompositeErrors {
 
 // All four images of one size (mask: 1 channel, the object's coverage). τ = threshold.
 CompositeErrors measure(const Image& photo, const Image& composite, const Image& truth, const Image& mask, double threshold = 0.02);
+
+// A Monte Carlo truth is noisy; K ≥ 2 truths of different seeds measure how much. The composite is measured
+// against their mean T̄, and the mean's own noise is estimated on the same pixels as
+//   noise = measure(photo, T_1, T̄) / √(K − 1)
+// (T_1 − T̄ has (K − 1)/K of one truth's variance, T̄ − T* has 1/K of it; for zero-mean noise the mean absolute
+// values scale alike): the error a perfect composite would still show against T̄. errors − noise bounds the
+// composite's own error from below, errors + noise from above (the triangle inequality, per pixel).
+struct TruthErrors {
+  CompositeErrors errors;  // the composite against the truths' mean
+  CompositeErrors noise;   // the mean's own error, estimated (all zero for one truth)
+  Image mean;              // T̄
+};
+// For looking at: red = luminance the composite has too much, green = too little, relative to the truth
+// ((c − t)/t per pixel; 1 = 100 %).
+Image error_picture(const Image& composite, const Image& truth);
+
+TruthErrors measure_against(const Image& photo, const Image& composite, const std::vector<Image>& truths, const Image& mask,
+                            double threshold = 0.02);
 
 }  // namespace ibl::augment

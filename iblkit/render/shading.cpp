@@ -9,6 +9,17 @@
 
 namespace ibl::render {
 
+double glossy_lobe(const Material& m, Vec3 n, Vec3 v, Vec3 r, Vec3 l) {
+  double ndl = dot(n, l);
+  if (ndl <= 0) return 0;
+  if (m.lobe == Lobe::BlinnPhong) {
+    double ndh = dot(n, normalize(l + v));
+    return ndh > 0 ? (m.exponent + 8) / (8 * kPi) * std::pow(ndh, m.exponent) * ndl : 0;
+  }
+  double rdl = dot(r, l);
+  return rdl > 0 ? (m.exponent + 1) / kTwoPi * std::pow(rdl, m.exponent) : 0;
+}
+
 Vec3 shade(const Lighting& lighting, const Material& m, Vec3 p, Vec3 n, Vec3 v, const VisibilityFn& visible) {
   Vec3 r = normalize(n * (2 * dot(n, v)) - v);
   Vec3 E, G;
@@ -37,21 +48,13 @@ Vec3 shade(const Lighting& lighting, const Material& m, Vec3 p, Vec3 n, Vec3 v, 
         if (!gmap) G += c->c[k] * (glossy[l] * yr[k]);
       }
   }
-  const bool blinn = m.lobe == Lobe::BlinnPhong;
-  const double lobe_norm = blinn ? (m.exponent + 8) / (8 * kPi) : (m.exponent + 1) / kTwoPi;
   auto add_light = [&](Vec3 l, Vec3 irradiance, bool shadow, double distance) {
     double ndl = dot(n, l);
     if (ndl <= 0) return;
     if (irradiance.x == 0 && irradiance.y == 0 && irradiance.z == 0) return;  // no shadow ray for no light
     if (shadow && visible && !visible(p, l, distance)) return;
     E += irradiance * ndl;
-    if (blinn) {
-      double ndh = dot(n, normalize(l + v));
-      if (ndh > 0) G += irradiance * (lobe_norm * std::pow(ndh, m.exponent) * ndl);
-    } else {
-      double rdl = dot(r, l);
-      if (rdl > 0) G += irradiance * (lobe_norm * std::pow(rdl, m.exponent));
-    }
+    G += irradiance * glossy_lobe(m, n, v, r, l);
   };
   for (const DirectionalLight& L : lighting.lights) add_light(L.direction, L.irradiance, L.shadow, std::numeric_limits<double>::infinity());
   for (const PointLight& L : lighting.point_lights) {

@@ -50,6 +50,11 @@ struct Material {
 // The albedo texture's value at uv (the lookup both renderers make).
 Vec3 texture_albedo(const Image& texture, Vec2 uv);
 
+// The glossy lobe for light arriving along unit l (towards the light) at a point of normal n seen along v
+// (towards the eye; r = reflect(−v, n)), per unit irradiance at normal incidence: Phong (s+1)/2π max(0, r·l)^s,
+// Blinn-Phong (s+8)/8π max(0, n·h)^s (n·l); 0 where n·l ≤ 0. What shade() adds for each light, times `specular`.
+double glossy_lobe(const Material& m, Vec3 n, Vec3 v, Vec3 r, Vec3 l);
+
 struct DirectionalLight {
   Vec3 direction;       // unit direction towards the light
   Vec3 irradiance;      // W/m² delivered at normal incidence (RGB)
