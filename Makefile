@@ -56,3 +56,8 @@ fuzz: | $(STAMP)
 
 clean:
 	rm -rf $(BUILD) $(DEMO_OUT)
+
+# The Python module's pytest suite (python/tests) against build/python; `make test` runs it too (CTest "python").
+.PHONY: python-test
+python-test: build
+	python/run-tests $(BUILD) $(BUILD)/iblkit

@@ -163,14 +163,19 @@ and the proxy (for load_probe_set). Returns the manifest's path.)doc");
       [](const Scene& scene, const ibl::geometry::Camera& camera, py::object object, py::handle albedo, int samples, int bounces,
          int area_samples, int env_samples, int seed, bool surface, py::object progress) -> py::object {
         ibl::augment::validate_camera(camera, "photograph: camera");
-        Scene sc = scene;
-        if (!object.is_none()) {  // the object goes into a fresh, unbuilt copy of the scene
+        const Scene* use = &scene;
+        Scene with_object;
+        if (!object.is_none()) {  // the object goes into a fresh, unbuilt copy of the scene (as the CLI does)
           if (scene.source.empty()) ibl::fail(ibl::ErrorKind::Value, "photograph: an object needs a scene loaded from a file");
-          sc = ibl::lab::load_scene(scene.source, false);
           ibl::Vec3 a = to_vec3(albedo, "photograph: albedo");
-          ibl::lab::add_object(sc, "object", object.cast<ibl::geometry::TriMesh>(), a);
-          sc.build();
+          for (int c = 0; c < 3; ++c)
+            if (!(a[c] >= 0 && a[c] <= 1)) ibl::fail(ibl::ErrorKind::Value, "photograph: albedo must lie in [0, 1]");
+          with_object = ibl::lab::load_scene(scene.source, false);
+          ibl::lab::add_object(with_object, "object", object.cast<ibl::geometry::TriMesh>(), a);
+          with_object.build();
+          use = &with_object;
         }
+        const Scene& sc = *use;
         ibl::lab::ViewDesc vd;
         vd.width = camera.width;
         vd.height = camera.height;

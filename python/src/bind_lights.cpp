@@ -160,7 +160,8 @@ region it stands for. The array properties are copies; build a new set to change
       [](py::handle img, const std::string& method, int count, const std::string& mapping, double min_separation, int normals_level,
          int iterations, double tolerance, const std::string& init, double dead_angle, py::object progress) {
         ibl::lights::check_method(method);
-        ibl::sphere::EnvMap env = probe_arg(img, mapping, dead_angle, "lights: img");
+        EnvArg arg(img, mapping, dead_angle, "lights: img", false);  // extract() validates the pixels itself
+        const ibl::sphere::EnvMap& env = arg.env();
         ibl::lights::ExtractDesc d;
         d.method = method;
         d.count = count;

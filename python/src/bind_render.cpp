@@ -58,7 +58,7 @@ void add_lighting(py::handle light, int bands, int shadows, const std::string& m
 void init_render(py::module_& m) {
   m.def(
       "render",
-      [](py::handle light, py::object mesh, py::object camera, py::handle at, double size, int triangles, py::handle albedo,
+      [](py::handle light, py::object mesh, py::object camera, const std::string& object_kind, py::handle at, double size, int triangles, py::handle albedo,
          double gloss, double exponent, const std::string& lobe, double floor_size, int shadows, int bands, int width, int height,
          double fov, py::handle background, const std::string& mapping, bool coverage, py::object progress) -> py::object {
         if (lobe != "phong" && lobe != "blinn") ibl::fail(ibl::ErrorKind::Value, "render: lobe must be phong or blinn (got {})", lobe);
@@ -69,6 +69,7 @@ void init_render(py::module_& m) {
         ibl::require_number("render: floor_size", floor_size, 0, 1000);
         rd::FrameDesc d;
         rd::ObjectDesc od;
+        od.scene = object_kind;
         od.size = size;
         od.triangles = triangles;
         od.at = to_vec3(at, "render: at");
@@ -88,7 +89,8 @@ void init_render(py::module_& m) {
         {
           py::gil_scoped_release nogil;
           if (mesh.is_none()) {
-            if (!(size > 0)) ibl::fail(ibl::ErrorKind::Value, "render: size must be > 0 for the blob");
+            if (!(size > 0) && (object_kind == "blob" || object_kind == "sphere"))
+              ibl::fail(ibl::ErrorKind::Value, "render: size must be > 0 for the {}", object_kind);
             object = rd::make_object(od);
           }
         }
@@ -122,7 +124,7 @@ void init_render(py::module_& m) {
         if (coverage) return py::make_tuple(to_array(std::move(r.color)), to_array(std::move(r.coverage), true));
         return to_array(std::move(r.color));
       },
-      py::arg("light"), py::arg("mesh") = py::none(), py::arg("camera") = py::none(), py::arg("at") = py::make_tuple(0, 0, 0),
+      py::arg("light"), py::arg("mesh") = py::none(), py::arg("camera") = py::none(), py::arg("object") = "blob", py::arg("at") = py::make_tuple(0, 0, 0),
       py::arg("size") = 0.8, py::arg("triangles") = 100000, py::arg("albedo") = py::make_tuple(0.75, 0.75, 0.75), py::arg("gloss") = 0.0,
       py::arg("exponent") = 20.0, py::arg("lobe") = "phong", py::arg("floor_size") = 6.0, py::arg("shadows") = 4, py::arg("bands") = 5,
       py::arg("width") = 1024, py::arg("height") = 768, py::arg("fov") = 40.0, py::arg("background") = py::make_tuple(0, 0, 0),
@@ -133,7 +135,8 @@ an (H, W, 3) float32 radiance array (with coverage=True also the (H, W) coverage
 light: a lighting file path (.shgrid, iblkit.sh/1, iblkit.lights/1, iblkit.nearfield/1 or a probe
 image), an SHCoeffs / (K, 3) array, an ilf.SHGrid, a LightSet (its first `shadows` lights cast
 shadows), a probe image array (projected to `bands` SH bands, in `mapping`), or a list of them.
-mesh: a TriMesh (default: the blob of `triangles` triangles, `size` metres, centred at `at`), on a
+mesh: a TriMesh (with normals, or given them); default the CLI's object: `object` = "blob" (of
+`triangles` triangles), "sphere" or a mesh file, `size` metres, centred at `at`; both on a
 grey floor of floor_size metres (0: none). camera: a Camera (default: the CLI's, looking at `at` from
 at + (0, 0.5, 1.6), width × height, fov degrees). Material: albedo, gloss (the Phong lobe's weight),
 exponent, lobe phong|blinn. Releases the GIL; progress(stage, fraction).)doc");

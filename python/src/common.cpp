@@ -2,6 +2,7 @@
 #include "common.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cstring>
 #include <mutex>
 
@@ -45,13 +46,66 @@ std::string shape_text(const py::array& a) {
 
 // ---- images -------------------------------------------------------------------------------------
 
+// The base of every image array the module returns: the library's Image, and whether a call holds it.
+struct OwnedImage {
+  ibl::Image img;
+  float* data = nullptr;  // where the pixels are (img is empty while lent)
+  int width = 0, height = 0, channels = 0;
+  std::atomic<bool> lent{false};
+};
+
+namespace {
+constexpr const char* kOwnedName = "iblkit.Image";
+}  // namespace
+
 py::array to_array(ibl::Image img, bool squeeze) {
-  auto* owned = new ibl::Image(std::move(img));
-  py::capsule base(owned, [](void* p) { delete static_cast<ibl::Image*>(p); });
-  const py::ssize_t h = owned->height(), w = owned->width(), c = owned->channels();
+  auto* owned = new OwnedImage;
+  owned->img = std::move(img);
+  owned->data = owned->img.data();
+  owned->width = owned->img.width();
+  owned->height = owned->img.height();
+  owned->channels = owned->img.channels();
+  py::capsule base(owned, kOwnedName, [](PyObject* cap) {
+    delete static_cast<OwnedImage*>(PyCapsule_GetPointer(cap, kOwnedName));
+  });
+  const py::ssize_t h = owned->height, w = owned->width, c = owned->channels;
   const py::ssize_t f = sizeof(float);
-  if (squeeze && c == 1) return py::array_t<float>({h, w}, {w * f, f}, owned->data(), base);
-  return py::array_t<float>({h, w, c}, {w * c * f, c * f, f}, owned->data(), base);
+  if (squeeze && c == 1) return py::array_t<float>({h, w}, {w * f, f}, owned->data, base);
+  return py::array_t<float>({h, w, c}, {w * c * f, c * f, f}, owned->data, base);
+}
+
+EnvArg::EnvArg(py::handle img, const std::string& mapping, double dead_angle, const char* what, bool check) {
+  if (!check && py::isinstance<py::array>(img)) {
+    py::array a = py::reinterpret_borrow<py::array>(img);
+    py::object b = a.base();
+    PyObject* base = b.ptr();
+    if (base && PyCapsule_CheckExact(base) && PyCapsule_IsValid(base, kOwnedName)) {
+      auto* o = static_cast<OwnedImage*>(PyCapsule_GetPointer(base, kOwnedName));
+      const py::ssize_t f = sizeof(float);
+      bool whole = a.dtype().is(py::dtype::of<float>()) && a.data() == o->data && a.ndim() == 3 && a.shape(0) == o->height &&
+                   a.shape(1) == o->width && a.shape(2) == o->channels && a.strides(2) == f && a.strides(1) == o->channels * f &&
+                   a.strides(0) == o->width * o->channels * f;
+      bool expected = false;
+      std::optional<ibl::sphere::Mapping> m;
+      if (whole) m = mapping_of(mapping, o->width, o->height, dead_angle);  // before the lend: it may throw
+      if (whole && o->lent.compare_exchange_strong(expected, true)) {
+        keep_ = py::reinterpret_borrow<py::object>(img);
+        owned_ = o;
+        env_.emplace(std::move(o->img), *m);  // sizes agree: the constructor does not throw
+        return;
+      }
+    }
+  }
+  ibl::Image im = check ? to_checked_image(img, what) : to_image(img, what);
+  ibl::sphere::Mapping m = mapping_of(mapping, im.width(), im.height(), dead_angle);
+  env_.emplace(std::move(im), m);
+}
+
+EnvArg::~EnvArg() {
+  if (owned_) {
+    owned_->img = std::move(env_->image);  // the same buffer: the array never saw it move
+    owned_->lent.store(false);
+  }
 }
 
 py::array_t<float> image_array(py::handle obj, const char* what, int channels) {

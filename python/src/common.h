@@ -18,6 +18,7 @@
 #include "iblkit/core/image.h"
 #include "iblkit/core/progress.h"
 #include "iblkit/core/vec.h"
+#include "iblkit/sphere/envmap.h"
 #include "iblkit/sphere/mapping.h"
 
 namespace iblpy {
@@ -39,6 +40,27 @@ ibl::ImageView view_of(const py::array_t<float>& a);
 ibl::Image to_image(py::handle obj, const char* what, int channels = 0);
 // to_image, then the library's pixel check (io::check_pixels: NaN/Inf/negative raise ValueError).
 ibl::Image to_checked_image(py::handle obj, const char* what);
+
+// An environment map over an image argument for one library call (constructed with the GIL held, used
+// without it, destroyed with it). When the argument is an array this module returned (a whole image:
+// float32, its own shape and strides) that no other call holds, its ibl::Image is lent to the map —
+// moved in, and moved back by the destructor; moves keep the pixels where they are, so the array stays
+// valid throughout — else the pixels are copied. The library call validates the pixels itself (lights/
+// does); `check` copies and runs io::check_pixels first for calls that do not.
+class EnvArg {
+ public:
+  EnvArg(py::handle img, const std::string& mapping, double dead_angle, const char* what, bool check);
+  ~EnvArg();
+  EnvArg(const EnvArg&) = delete;
+  EnvArg& operator=(const EnvArg&) = delete;
+  const ibl::sphere::EnvMap& env() const { return *env_; }
+  bool lent() const { return owned_ != nullptr; }
+
+ private:
+  py::object keep_;
+  struct OwnedImage* owned_ = nullptr;
+  std::optional<ibl::sphere::EnvMap> env_;
+};
 
 // The mapping named `name` ("latlong", "mirrorball", …; "auto" detects from the shape) of a w × h image.
 ibl::sphere::Mapping mapping_of(const std::string& name, int w, int h, double dead_angle_deg = 0.0);
@@ -76,6 +98,7 @@ class Progress {
 // ---- registration (one function per binding file, called by module.cpp) --------------------------
 
 void init_errors(py::module_& m);
+void init_core(py::module_& m);
 void init_io(py::module_& m);
 void init_sh(py::module_& m);
 void init_lights(py::module_& m);

@@ -5,6 +5,7 @@
 PYBIND11_MODULE(_iblkit, m) {
   m.doc() = "iblkit: image-based lighting from numpy (the C++ library's Python bindings; docs/python.md).";
   iblpy::init_errors(m);
+  iblpy::init_core(m);
   iblpy::init_io(m);
   iblpy::init_sh(m);
   iblpy::init_lights(m);

@@ -1,0 +1,76 @@
+"""ilf/: SH grids and the ILF build, from a sequence file and from arrays, against `iblkit ilf build`."""
+import json
+import math
+
+import numpy as np
+import pytest
+
+import iblkit
+from iblkit import ilf
+from conftest import run_cli
+
+
+@pytest.fixture(scope="module")
+def sequence(tmp_path_factory):
+    """A synthetic mirror-ball sequence of the closed-form three-spheres field (`iblkit ilf synth`)."""
+    d = tmp_path_factory.mktemp("seq")
+    run_cli("ilf", "synth", "--out", d, "--probes", 40, "--size", 16, "--supersample", 1, "--pfm")
+    return d / "sequence.json"
+
+
+def test_build_from_file_matches_cli(tmp_path, sequence):
+    out = tmp_path / "cli.shgrid"
+    run_cli("ilf", "build", sequence, "--grid", 4, "--bands", 3, "--out", out, "--buckets", tmp_path / "b1")
+    cli = ilf.SHGrid.load(str(out))
+    seen = []
+    grid, report = ilf.build(str(sequence), grid=4, bands=3, work_dir=str(tmp_path / "b2"), progress=lambda s, f: seen.append(s))
+    assert grid.resolution == (4, 4, 4) and grid.bands == 3
+    assert grid.coefficients.shape == (4, 4, 4, 9, 3) and grid.coefficients.dtype == np.float32
+    assert np.array_equal(grid.coefficients, cli.coefficients)
+    assert grid.min == cli.min and grid.max == cli.max
+    assert report["probes_used"] == 40 and report["samples"] > 0 and report["t_total"] > 0
+    assert seen
+
+
+def test_build_from_arrays_equals_the_file_build(tmp_path, sequence):
+    seq = json.loads(sequence.read_text())
+    frames = np.stack([iblkit.read_image(str(sequence.parent / p["image"])) for p in seq["probes"]])
+    positions = np.array([p["position"] for p in seq["probes"]])
+    g_file, _ = ilf.build(str(sequence), grid=(4, 3, 4), bands=2, volume=(seq["volume"]["min"], seq["volume"]["max"]),
+                          work_dir=str(tmp_path / "b"))
+    g_mem, rep = ilf.build(frames, positions=positions, grid=(4, 3, 4), bands=2, mapping="mirrorball",
+                           dead_angle=seq["dead_angle_deg"], volume=(seq["volume"]["min"], seq["volume"]["max"]),
+                           work_dir=str(tmp_path))
+    assert np.array_equal(g_mem.coefficients, g_file.coefficients)
+    assert rep["probes_in"] == 40
+    assert list(tmp_path.glob("iblkit-ilf-*")) == []  # the temporary frames are gone
+    g_list, _ = ilf.build(list(frames), positions=positions, grid=2, bands=1, mapping="mirrorball", dead_angle=seq["dead_angle_deg"])
+    assert g_list.coefficients.shape == (2, 2, 2, 1, 3)
+    with pytest.raises(ValueError):
+        ilf.build(frames, positions=positions[:3], grid=2)
+    with pytest.raises(ValueError):
+        ilf.build(frames, grid=2)
+
+
+def test_shgrid_queries(tmp_path):
+    # A grid whose every point holds the white furnace (c00 = √(4π)): irradiance π, radiance 1, glossy 1.
+    K = 9
+    c = np.zeros((2, 3, 4, K, 3), np.float32)
+    c[..., 0, :] = math.sqrt(4 * math.pi)
+    g = ilf.SHGrid(c, (0, 0, 0), (1, 2, 3))
+    pts = np.array([[0.5, 1.0, 1.5], [0.2, 0.1, 2.9]])
+    assert np.allclose(g.irradiance(pts, [0, 1, 0]), math.pi, rtol=1e-6)
+    assert np.allclose(g.radiance(pts, [[1, 0, 0], [0, 0, 1]]), 1, rtol=1e-6)
+    assert np.allclose(g.glossy(pts, [0, 1, 0], 20.0), 1, rtol=1e-5)
+    e = g.eval(pts)
+    assert e.shape == (2, K, 3) and np.allclose(e[:, 0], math.sqrt(4 * math.pi), rtol=1e-6)
+    assert isinstance(g.coeffs_at([0.5, 0.5, 0.5]), iblkit.SHCoeffs)
+    g.coefficients[0, 0, 0, 0, 0] = 7  # a view
+    g.save(str(tmp_path / "g.shgrid"))
+    back = ilf.SHGrid.load(str(tmp_path / "g.shgrid"))
+    assert np.array_equal(back.coefficients, g.coefficients) and back.resolution == (4, 3, 2)
+    run_cli("ilf", "info", tmp_path / "g.shgrid")
+    with pytest.raises(ValueError):
+        ilf.SHGrid(np.zeros((2, 2, 2, 8, 3), np.float32), (0, 0, 0), (1, 1, 1))
+    with pytest.raises(ValueError):
+        ilf.SHGrid(c, (0, 0, 0), (0, 1, 1))
