@@ -12,6 +12,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <thread>
 #include <vector>
 
@@ -71,13 +72,17 @@ void respond(int fd, int code, const char* reason, const std::string& type, cons
   if (send_all(fd, h.data(), h.size()) && !head) send_all(fd, body.data(), body.size());
 }
 
-void handle(int fd, const std::string& root) {
-  // Read the request head (up to 16 KiB, 5 s).
+void handle(int fd, const std::string& root, const std::atomic<bool>* stop) {
+  // Read the request head (up to 16 KiB). A browser opens connections ahead of its requests and may
+  // use one after seconds: wait up to 60 s, or until the server stops.
   std::string req;
   char buf[4096];
   while (req.find("\r\n\r\n") == std::string::npos && req.size() < 16384) {
     pollfd p{fd, POLLIN, 0};
-    if (::poll(&p, 1, 5000) <= 0) return;
+    int waited = 0, ready = 0;
+    while ((ready = ::poll(&p, 1, 100)) == 0 && (waited += 100) < 60000)
+      if (stop && stop->load()) return;
+    if (ready <= 0) return;
     ssize_t r = ::recv(fd, buf, sizeof buf, 0);
     if (r <= 0) return;
     req.append(buf, size_t(r));
@@ -151,19 +156,35 @@ void serve_static(const StaticServerDesc& d, const std::atomic<bool>* stop, cons
   int port = ntohs(bound.ss_family == AF_INET ? reinterpret_cast<sockaddr_in*>(&bound)->sin_port
                                               : reinterpret_cast<sockaddr_in6*>(&bound)->sin6_port);
   if (on_ready) on_ready(port);
-  std::vector<std::thread> workers;
+  struct Worker {
+    std::thread t;
+    std::shared_ptr<std::atomic<bool>> done;
+  };
+  std::vector<Worker> workers;
   while (!(stop && stop->load())) {
     pollfd p{s, POLLIN, 0};
     if (::poll(&p, 1, 100) <= 0) continue;
     int c = ::accept(s, nullptr, nullptr);
     if (c < 0) continue;
     // One thread a connection: a browser opens speculative connections that send nothing for a while.
-    workers.emplace_back([c, root = d.root] {
-      handle(c, root);
-      ::close(c);
-    });
+    auto done = std::make_shared<std::atomic<bool>>(false);
+    workers.push_back({std::thread([c, root = d.root, stop, done] {
+                         handle(c, root, stop);
+                         ::close(c);
+                         *done = true;
+                       }),
+                       done});
+    // Reap the connections already served, so that a long session keeps no finished threads.
+    for (size_t i = 0; i < workers.size();)
+      if (*workers[i].done) {
+        workers[i].t.join();
+        workers[i] = std::move(workers.back());
+        workers.pop_back();
+      } else {
+        ++i;
+      }
   }
-  for (auto& w : workers) w.join();  // each ends within its 5 s read timeout
+  for (auto& w : workers) w.t.join();  // each ends within 100 ms of the stop
   ::close(s);
 }
 

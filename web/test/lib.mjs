@@ -80,6 +80,7 @@ export async function openViewer(browser, url, query, w = 256, h = 256) {
   page.on('console', (m) => { if (m.type() === 'error') errors.push(`console: ${m.text()}`); });
   page.on('pageerror', (e) => errors.push(`page error: ${e.message}`));
   page.on('requestfailed', (r) => errors.push(`request failed: ${r.url()} ${r.failure() && r.failure().errorText}`));
+  if (process.env.IBLKIT_WEB_TRACE) page.on('request', (r) => console.log(`request ${r.url()}`));
   page.on('response', (r) => { if (r.status() >= 400) errors.push(`HTTP ${r.status()}: ${r.url()}`); });
   await page.goto(`${url}index.html?ui=0&size=${w}x${h}&${query}`, { waitUntil: 'load' });
   await page.waitForFunction(() => window.iblkitReady === true || window.iblkitError !== undefined, { timeout: 30000 });
