@@ -100,6 +100,19 @@ void handle(int fd, const std::string& root, const std::atomic<bool>* stop) {
   respond(fd, 200, "OK", content_type(file), body, head);
 }
 
+// Half-closes and drains what the client still sends (up to 2 s) before closing: closing a socket
+// with unread input sends a reset, which can destroy the response's tail in the client.
+void lingering_close(int fd) {
+  ::shutdown(fd, SHUT_WR);
+  char buf[1024];
+  for (int i = 0; i < 20; ++i) {
+    pollfd p{fd, POLLIN, 0};
+    if (::poll(&p, 1, 100) <= 0) continue;
+    if (::recv(fd, buf, sizeof buf, 0) <= 0) break;
+  }
+  ::close(fd);
+}
+
 }  // namespace
 
 std::string resolve_request(const std::string& root, const std::string& target) {
@@ -170,7 +183,7 @@ void serve_static(const StaticServerDesc& d, const std::atomic<bool>* stop, cons
     auto done = std::make_shared<std::atomic<bool>>(false);
     workers.push_back({std::thread([c, root = d.root, stop, done] {
                          handle(c, root, stop);
-                         ::close(c);
+                         lingering_close(c);
                          *done = true;
                        }),
                        done});
