@@ -221,6 +221,11 @@ async function apply() {
     object.geometry = new THREE.SphereGeometry(0.12 * span, 128, 64);
     object.position.fromArray(state.position || c);
     if (!state.position) state.position = [...c];
+    if (!params.has('eye') && !params.has('target')) {  // frame the grid's box when the URL names no view
+      controls.target.fromArray(c);
+      camera.position.set(c[0], c[1] + 0.35 * span, c[2] + 1.6 * span);
+      controls.update();
+    }
     exposure = 1;  // set below from the irradiance three computes at the object
   }
   scene.add(lit);
