@@ -31,9 +31,40 @@ Image irradiance_image(const sh::Coeffs& radiance, int height) {
 
 nlohmann::json rgb(Vec3 v) { return {v.x, v.y, v.z}; }
 
+// The face images of a pattern with {level} and {face}, level by level while all six exist; URIs
+// relative to the folder of the glTF written to `out`.
+sh::GltfSpecular specular_images(const std::string& pattern, const std::string& out) {
+  if (pattern.find("{level}") == std::string::npos || pattern.find("{face}") == std::string::npos)
+    fail(ErrorKind::Value, "--specular-images {}: the pattern needs {{level}} and {{face}}", pattern);
+  auto name = [&](int level, const char* face) {
+    std::string s = pattern;
+    s.replace(s.find("{level}"), 7, std::to_string(level));
+    s.replace(s.find("{face}"), 6, face);
+    return s;
+  };
+  static const char* kFaces[6] = {"px", "nx", "py", "ny", "pz", "nz"};
+  fs::path base = out.empty() ? fs::current_path() : fs::absolute(out).parent_path();
+  sh::GltfSpecular spec;
+  for (int level = 0; level < 31; ++level) {
+    std::array<std::string, 6> faces;
+    bool all = true;
+    for (int f = 0; f < 6 && all; ++f) {
+      std::string p = name(level, kFaces[f]);
+      all = fs::exists(p);
+      if (!all) break;
+      if (level == 0 && f == 0) spec.size = io::read_image_spec(p).width;
+      faces[f] = fs::relative(fs::absolute(p), base).generic_string();
+    }
+    if (!all) break;
+    spec.levels.push_back(faces);
+  }
+  if (spec.levels.empty()) fail(ErrorKind::Io, "--specular-images {}: no level 0 with all six faces ({} missing)", pattern, name(0, "px"));
+  return spec;
+}
+
 void setup(CLI::App& app) {
   struct Opts {
-    std::string probe, window = "none", format = "iblkit", out, irradiance_map;
+    std::string probe, window = "none", format = "iblkit", out, irradiance_map, specular_images;
     int bands = 3, irradiance_size = 64;
   };
   auto* o = iblcli::app_owned<Opts>();
@@ -46,6 +77,9 @@ void setup(CLI::App& app) {
   app.add_option("-o,--out", o->out, "write the coefficients here (default: print them on stdout)");
   app.add_option("--irradiance-map", o->irradiance_map, "also render the SH irradiance E(n) as a lat-long image (.exr …)");
   app.add_option("--irradiance-size", o->irradiance_size, "height of the irradiance map (width is twice)")->capture_default_str();
+  app.add_option("--specular-images", o->specular_images,
+                 "--format gltf: the prefiltered cube's face images (EXT_lights_image_based RGBD PNGs) as a pattern with {level} "
+                 "and {face} (px nx py ny pz nz), e.g. spec/m{level}_{face}.png; levels 0, 1, … while all six exist");
   auto& rd = iblcli::add_probe_read_options(app);
   app.footer(
       "Examples:\n"
@@ -74,6 +108,10 @@ void setup(CLI::App& app) {
     c = sh::apply_window(c, wd, &wr);
 
     std::string text = sh::export_text(c, format);
+    if (!o->specular_images.empty()) {
+      if (format != sh::ExportFormat::Gltf) fail(ErrorKind::Value, "--specular-images goes with --format gltf");
+      text = sh::gltf_ibl_text(c, specular_images(o->specular_images, o->out));
+    }
     if (!o->out.empty()) write_file_atomically(o->out, text);
     if (!o->irradiance_map.empty()) io::write_image(o->irradiance_map, irradiance_image(c, o->irradiance_size));
 

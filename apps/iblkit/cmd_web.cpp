@@ -74,7 +74,7 @@ void demo_step(iblcli::DemoContext& ctx) {
   if (!iblcli::find_chromium().empty()) {
     std::vector<std::pair<std::string, std::string>> views = {{"sh", "mode=sh&eye=0,0.3,1.6"}};
     if (!d.lights.empty()) views.push_back({"lights", "mode=lights&eye=0,1.2,2.4"});
-    if (!d.grids.empty()) views.push_back({"grid", "mode=grid&eye=0.5,0.9,2.2&target=0.5,0.5,0.5"});
+    if (!d.grids.empty()) views.push_back({"grid", "mode=grid"});  // the viewer frames the grid's box
     for (auto& [name, q] : views) {
       std::string png = (out / ("screenshot_" + name + ".png")).string();
       if (iblcli::screenshot_page(out.string(), q, png, 640, 480) == 0 && fs::exists(png)) {

@@ -12,6 +12,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <thread>
 #include <vector>
 
@@ -71,13 +72,17 @@ void respond(int fd, int code, const char* reason, const std::string& type, cons
   if (send_all(fd, h.data(), h.size()) && !head) send_all(fd, body.data(), body.size());
 }
 
-void handle(int fd, const std::string& root) {
-  // Read the request head (up to 16 KiB, 5 s).
+void handle(int fd, const std::string& root, const std::atomic<bool>* stop) {
+  // Read the request head (up to 16 KiB). A browser opens connections ahead of its requests and may
+  // use one after seconds: wait up to 60 s, or until the server stops.
   std::string req;
   char buf[4096];
   while (req.find("\r\n\r\n") == std::string::npos && req.size() < 16384) {
     pollfd p{fd, POLLIN, 0};
-    if (::poll(&p, 1, 5000) <= 0) return;
+    int waited = 0, ready = 0;
+    while ((ready = ::poll(&p, 1, 100)) == 0 && (waited += 100) < 60000)
+      if (stop && stop->load()) return;
+    if (ready <= 0) return;
     ssize_t r = ::recv(fd, buf, sizeof buf, 0);
     if (r <= 0) return;
     req.append(buf, size_t(r));
@@ -93,6 +98,19 @@ void handle(int fd, const std::string& root) {
   std::string body((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   if (!in.good() && !in.eof()) return respond(fd, 500, "Internal Server Error", "text/plain", "read error\n", head);
   respond(fd, 200, "OK", content_type(file), body, head);
+}
+
+// Half-closes and drains what the client still sends (up to 2 s) before closing: closing a socket
+// with unread input sends a reset, which can destroy the response's tail in the client.
+void lingering_close(int fd) {
+  ::shutdown(fd, SHUT_WR);
+  char buf[1024];
+  for (int i = 0; i < 20; ++i) {
+    pollfd p{fd, POLLIN, 0};
+    if (::poll(&p, 1, 100) <= 0) continue;
+    if (::recv(fd, buf, sizeof buf, 0) <= 0) break;
+  }
+  ::close(fd);
 }
 
 }  // namespace
@@ -151,19 +169,35 @@ void serve_static(const StaticServerDesc& d, const std::atomic<bool>* stop, cons
   int port = ntohs(bound.ss_family == AF_INET ? reinterpret_cast<sockaddr_in*>(&bound)->sin_port
                                               : reinterpret_cast<sockaddr_in6*>(&bound)->sin6_port);
   if (on_ready) on_ready(port);
-  std::vector<std::thread> workers;
+  struct Worker {
+    std::thread t;
+    std::shared_ptr<std::atomic<bool>> done;
+  };
+  std::vector<Worker> workers;
   while (!(stop && stop->load())) {
     pollfd p{s, POLLIN, 0};
     if (::poll(&p, 1, 100) <= 0) continue;
     int c = ::accept(s, nullptr, nullptr);
     if (c < 0) continue;
     // One thread a connection: a browser opens speculative connections that send nothing for a while.
-    workers.emplace_back([c, root = d.root] {
-      handle(c, root);
-      ::close(c);
-    });
+    auto done = std::make_shared<std::atomic<bool>>(false);
+    workers.push_back({std::thread([c, root = d.root, stop, done] {
+                         handle(c, root, stop);
+                         lingering_close(c);
+                         *done = true;
+                       }),
+                       done});
+    // Reap the connections already served, so that a long session keeps no finished threads.
+    for (size_t i = 0; i < workers.size();)
+      if (*workers[i].done) {
+        workers[i].t.join();
+        workers[i] = std::move(workers.back());
+        workers.pop_back();
+      } else {
+        ++i;
+      }
   }
-  for (auto& w : workers) w.join();  // each ends within its 5 s read timeout
+  for (auto& w : workers) w.t.join();  // each ends within 100 ms of the stop
   ::close(s);
 }
 

@@ -92,15 +92,41 @@ std::string export_text(const Coeffs& radiance, ExportFormat f) {
                          c.c[i].z, band_of(i), order_of(i));
       return s;
     }
-    case ExportFormat::Gltf: {
-      Coeffs c = to_gltf(radiance);
-      nlohmann::json arr = nlohmann::json::array();
-      for (const Vec3& v : c.c) arr.push_back({v.x, v.y, v.z});
-      nlohmann::json light = {{"name", "iblkit"}, {"intensity", 1.0}, {"rotation", {0.0, 0.0, 0.0, 1.0}}, {"irradianceCoefficients", arr}};
-      return nlohmann::json{{"extensions", {{"EXT_lights_image_based", {{"lights", {light}}}}}}}.dump(2) + "\n";
-    }
+    case ExportFormat::Gltf: return gltf_ibl_text(radiance);
   }
   return {};
+}
+
+std::string gltf_ibl_text(const Coeffs& radiance, const GltfSpecular& specular) {
+  radiance.validate("SH coefficients");
+  Coeffs c = to_gltf(radiance);
+  nlohmann::json arr = nlohmann::json::array();
+  for (const Vec3& v : c.c) arr.push_back({v.x, v.y, v.z});
+  nlohmann::json light = {{"name", "iblkit"}, {"intensity", 1.0}, {"rotation", {0.0, 0.0, 0.0, 1.0}}, {"irradianceCoefficients", arr}};
+  nlohmann::json doc = {{"asset", {{"version", "2.0"}, {"generator", "iblkit sh"}}},
+                        {"extensionsUsed", {"EXT_lights_image_based"}},
+                        {"scene", 0},
+                        {"scenes", {{{"name", "iblkit"}, {"extensions", {{"EXT_lights_image_based", {{"light", 0}}}}}}}}};
+  if (!specular.levels.empty()) {
+    if (specular.size < 1 || (specular.size & (specular.size - 1)) != 0)
+      fail(ErrorKind::Value, "EXT_lights_image_based: specular image size {} must be a power of two", specular.size);
+    if (specular.levels.size() > 31) fail(ErrorKind::Value, "EXT_lights_image_based: {} specular levels (at most 31)", specular.levels.size());
+    nlohmann::json images = nlohmann::json::array(), levels = nlohmann::json::array();
+    for (const auto& faces : specular.levels) {
+      nlohmann::json idx = nlohmann::json::array();
+      for (const std::string& uri : faces) {
+        if (uri.empty()) fail(ErrorKind::Value, "EXT_lights_image_based: a specular face image has no URI");
+        idx.push_back(images.size());
+        images.push_back({{"uri", uri}, {"mimeType", "image/png"}});
+      }
+      levels.push_back(idx);
+    }
+    light["specularImageSize"] = specular.size;
+    light["specularImages"] = levels;
+    doc["images"] = images;
+  }
+  doc["extensions"] = {{"EXT_lights_image_based", {{"lights", {light}}}}};
+  return doc.dump(2) + "\n";
 }
 
 }  // namespace ibl::sh

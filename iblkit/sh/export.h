@@ -18,7 +18,9 @@
 //  [3] KhronosGroup/glTF extensions/2.0/Vendor/EXT_lights_image_based; Babylon.js
 //      sphericalPolynomial (SH3ylmBasisConstants) and its EXT_lights_image_based loader.
 #pragma once
+#include <array>
 #include <string>
+#include <vector>
 
 #include "iblkit/sh/coeffs.h"
 
@@ -41,7 +43,19 @@ Coeffs from_gltf(const Coeffs& gltf);
 // The file text of each layout: iblkit.sh/1 JSON (all bands), three.js JSON
 // {"type":"SphericalHarmonics3","coefficients":[27 numbers]}, Filament sh.txt lines
 // "( r, g, b); // L00, irradiance, pre-scaled base", glTF JSON fragment
-// {"extensions":{"EXT_lights_image_based":{"lights":[{…,"irradianceCoefficients":[[r,g,b]×9]}]}}}.
+// a whole glTF 2.0 document (asset, extensionsUsed, the EXT_lights_image_based light with its
+// "irradianceCoefficients" [[r,g,b]×9], and scene 0 referring to it) — see gltf_ibl_text.
 std::string export_text(const Coeffs& radiance, ExportFormat f);
+
+// The prefiltered specular cube EXT_lights_image_based also requires: per mip level the URIs of its six
+// face images (+X −X +Y −Y +Z −Z; the extension's RGBD PNGs, flipped about the vertical axis as it
+// specifies), level 0 of `size` pixels. Empty: the light carries the irradiance alone.
+struct GltfSpecular {
+  std::vector<std::array<std::string, 6>> levels;
+  int size = 0;
+};
+// The glTF document of export_text(…, Gltf), with the specular images listed in "images" and
+// referenced from the light's "specularImages" (N×6 image indices) and "specularImageSize" when given.
+std::string gltf_ibl_text(const Coeffs& radiance, const GltfSpecular& specular = {});
 
 }  // namespace ibl::sh

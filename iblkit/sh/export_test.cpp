@@ -105,3 +105,33 @@ TEST(ShJson, RoundTripAndBadInput) {
 
 }  // namespace
 }  // namespace ibl::sh
+
+namespace ibl::sh {
+
+// A whole glTF document: asset, extensionsUsed, scene 0 → light 0; specular images listed once each
+// and referenced level by level, face by face.
+TEST(ShExport, GltfDocumentWithSpecularImages) {
+  Coeffs r(3);
+  r.c[0] = {1, 1, 1};
+  GltfSpecular spec;
+  spec.size = 64;
+  for (int m = 0; m < 2; ++m) {
+    std::array<std::string, 6> faces;
+    for (int f = 0; f < 6; ++f) faces[f] = "spec_m" + std::to_string(m) + "_" + std::to_string(f) + ".png";
+    spec.levels.push_back(faces);
+  }
+  auto j = nlohmann::json::parse(gltf_ibl_text(r, spec));
+  EXPECT_EQ(j["asset"]["version"], "2.0");
+  EXPECT_EQ(j["extensionsUsed"][0], "EXT_lights_image_based");
+  EXPECT_EQ(j["scenes"][j["scene"].get<int>()]["extensions"]["EXT_lights_image_based"]["light"], 0);
+  const auto& light = j["extensions"]["EXT_lights_image_based"]["lights"][0];
+  EXPECT_EQ(light["specularImageSize"], 64);
+  ASSERT_EQ(light["specularImages"].size(), 2u);
+  EXPECT_EQ(light["specularImages"][1][5], 11);
+  EXPECT_EQ(j["images"][11]["uri"], "spec_m1_5.png");
+  EXPECT_FALSE(nlohmann::json::parse(export_text(r, ExportFormat::Gltf))["extensions"]["EXT_lights_image_based"]["lights"][0].contains("specularImages"));
+  spec.size = 48;
+  EXPECT_THROW(gltf_ibl_text(r, spec), Error);
+}
+
+}  // namespace ibl::sh

@@ -79,7 +79,22 @@ function loadSpecular(i) {
     const loader = new KTX2Loader().setTranscoderPath('./three/examples/jsm/libs/basis/').detectSupport(renderer);
     const tex = await loader.loadAsync(manifest.probes[i].specular);
     loader.dispose();
-    return tex;
+    if (tex.isCubeTexture) return tex;
+    // three r187's KTX2Loader turns an uncompressed cube map (faceCount 6, e.g. RGBA16F) into a 2D
+    // DataTexture whose levels hold the six faces one after the other; rebuild the cube from them as
+    // its compressed path does (a CompressedCubeTexture of RGBAFormat uploads with texImage2D).
+    const w = tex.image.width, h = tex.image.height, levels = tex.mipmaps || [];
+    if (!levels.length || levels[0].data.length !== 6 * w * h * 4) throw new Error(`${manifest.probes[i].specular}: not a cube map`);
+    const faces = [0, 1, 2, 3, 4, 5].map((f) => ({
+      width: w, height: h,
+      mipmaps: levels.map((m) => { const n = m.data.length / 6; return { data: m.data.subarray(f * n, (f + 1) * n), width: m.width, height: m.height }; }),
+    }));
+    const cube = new THREE.CompressedCubeTexture(faces, tex.format, tex.type);
+    Object.assign(cube, { colorSpace: tex.colorSpace, generateMipmaps: false, magFilter: THREE.LinearFilter,
+                          minFilter: levels.length > 1 ? THREE.LinearMipmapLinearFilter : THREE.LinearFilter });
+    cube.needsUpdate = true;
+    tex.dispose();
+    return cube;
   });
 }
 function loadLights(i) {
@@ -139,7 +154,9 @@ const meanLum = (sh) => 0.282095 * (0.2125 * sh.coefficients[0].x + 0.7154 * sh.
 // The specular material: the KTX2's GGX levels read directly, level m = roughness·(N−1) (iblkit's
 // convention, docs/conventions.md), plus the SH diffuse term for a dielectric.
 function specularMaterial(cube, sh, metal) {
-  const levels = cube.mipmaps && cube.mipmaps.length ? cube.mipmaps.length : 1;
+  // KTX2Loader gives a CompressedCubeTexture: its faces (image[f]) carry the mip levels.
+  const face0 = Array.isArray(cube.image) ? cube.image[0] : null;
+  const levels = face0 && face0.mipmaps ? face0.mipmaps.length : cube.mipmaps && cube.mipmaps.length ? cube.mipmaps.length : 1;
   return new THREE.ShaderMaterial({
     uniforms: { env: { value: cube }, lod: { value: state.roughness * (levels - 1) }, sh: { value: sh.coefficients },
                 metal: { value: metal ? 1 : 0 } },
@@ -204,6 +221,11 @@ async function apply() {
     object.geometry = new THREE.SphereGeometry(0.12 * span, 128, 64);
     object.position.fromArray(state.position || c);
     if (!state.position) state.position = [...c];
+    if (!params.has('eye') && !params.has('target')) {  // frame the grid's box when the URL names no view
+      controls.target.fromArray(c);
+      camera.position.set(c[0], c[1] + 0.35 * span, c[2] + 1.6 * span);
+      controls.update();
+    }
     exposure = 1;  // set below from the irradiance three computes at the object
   }
   scene.add(lit);
