@@ -73,7 +73,7 @@ void setup(CLI::App& app) {
     sh::WindowReport wr;
     c = sh::apply_window(c, wd, &wr);
 
-    std::string text = sh::export_text(c, format);
+    std::string text = sh::export_text(c, format, sh::filament_frame(env.mapping.kind()));
     if (!o->out.empty()) write_file_atomically(o->out, text);
     if (!o->irradiance_map.empty()) io::write_image(o->irradiance_map, irradiance_image(c, o->irradiance_size));
 
