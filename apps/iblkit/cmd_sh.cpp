@@ -107,7 +107,7 @@ void setup(CLI::App& app) {
     sh::WindowReport wr;
     c = sh::apply_window(c, wd, &wr);
 
-    std::string text = sh::export_text(c, format);
+    std::string text = sh::export_text(c, format, sh::filament_frame(env.mapping.kind()));
     if (!o->specular_images.empty()) {
       if (format != sh::ExportFormat::Gltf) fail(ErrorKind::Value, "--specular-images goes with --format gltf");
       text = sh::gltf_ibl_text(c, specular_images(o->specular_images, o->out));

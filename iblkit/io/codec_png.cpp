@@ -28,7 +28,7 @@ void on_png_error(png_structp png, png_const_charp msg) {
 void on_png_warning(png_structp, png_const_charp) {}
 
 // The libpng calls; false (and `why`) on a libpng error. Nothing local changes after setjmp.
-bool encode(std::FILE* f, int w, int h, int color_type, png_bytep* rows, std::string* why) {
+bool encode(std::FILE* f, int w, int h, int color_type, png_bytep* rows, bool srgb, std::string* why) {
   png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, why, on_png_error, on_png_warning);
   if (!png) return false;
   png_infop info = png_create_info_struct(png);
@@ -43,7 +43,7 @@ bool encode(std::FILE* f, int w, int h, int color_type, png_bytep* rows, std::st
   png_init_io(png, f);
   png_set_IHDR(png, info, static_cast<png_uint_32>(w), static_cast<png_uint_32>(h), 8, color_type, PNG_INTERLACE_NONE,
                PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
-  png_set_sRGB_gAMA_and_cHRM(png, info, PNG_sRGB_INTENT_ABSOLUTE);
+  if (srgb) png_set_sRGB_gAMA_and_cHRM(png, info, PNG_sRGB_INTENT_ABSOLUTE);
   png_write_info(png, info);
   png_write_image(png, rows);
   png_write_end(png, info);
@@ -52,7 +52,7 @@ bool encode(std::FILE* f, int w, int h, int color_type, png_bytep* rows, std::st
 }
 }  // namespace
 
-void write_png(const std::string& path, const Image& img) {
+void write_png(const std::string& path, const Image& img, bool srgb) {
   const int w = img.width(), h = img.height(), nc = img.channels();
   if (nc != 1 && nc != 3) fail(ErrorKind::Internal, "{}: write_png takes 1 or 3 channels (got {})", path, nc);
   // Converted up front: nothing below may throw while libpng holds the jump buffer.
@@ -67,7 +67,7 @@ void write_png(const std::string& path, const Image& img) {
   std::FILE* f = std::fopen(path.c_str(), "wb");
   if (!f) fail(ErrorKind::Io, "{}: cannot write ({})", path, std::strerror(errno));
   std::string why;
-  bool ok = encode(f, w, h, nc == 1 ? PNG_COLOR_TYPE_GRAY : PNG_COLOR_TYPE_RGB, rows.data(), &why);
+  bool ok = encode(f, w, h, nc == 1 ? PNG_COLOR_TYPE_GRAY : PNG_COLOR_TYPE_RGB, rows.data(), srgb, &why);
   ok = (std::fclose(f) == 0) && ok;
   if (!ok) fail(ErrorKind::Io, "{}: write failed ({})", path, why.empty() ? "libpng" : why);
 }

@@ -50,7 +50,8 @@ void write_exr(const std::string& path, const Image& img, bool half);  // every 
 void write_rgbe(const std::string& path, const Image& img);            // 3 channels
 // 8 bits per channel, grey or RGB; `img` holds values in [0, 1] already encoded (sRGB): each
 // becomes round(255·v).
-void write_png(const std::string& path, const Image& img);
+// srgb: tag the file as sRGB-encoded (pictures); false for data textures.
+void write_png(const std::string& path, const Image& img, bool srgb = true);
 
 // OpenImageIO's side, provided by the oiio plugin (io/codec_oiio.cpp).
 struct OiioCodec {

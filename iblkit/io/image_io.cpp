@@ -144,11 +144,12 @@ void write_pfm(const std::string& file, const std::string& path, const Image& im
 
 // Our own writers where they write what OpenImageIO would; OpenImageIO (a plugin) for the rest (PNG
 // with alpha among them: OpenImageIO divides colour by alpha on writing it).
-void write_encoded(const std::string& file, const std::string& ext, const Image& src, bool ldr, bool half) {
+void write_encoded(const std::string& file, const std::string& ext, const Image& src, bool ldr, bool half, bool data) {
   const int nc = src.channels();
   if (ext == ".exr" && nc <= 4) return detail::write_exr(file, src, half);
   if (ext == ".hdr" && nc == 3) return detail::write_rgbe(file, src);
-  if (ext == ".png" && (nc == 1 || nc == 3)) return detail::write_png(file, src);
+  if (ext == ".png" && (nc == 1 || nc == 3)) return detail::write_png(file, src, !data);
+  if (data) fail(ErrorKind::Value, "{}: a data image is written as .png with 1 or 3 channels (got {} channels)", file, nc);
   detail::oiio_codec.get().write(file, src, ldr, half && ext == ".exr");
 }
 }  // namespace
@@ -161,7 +162,7 @@ void write_image(const std::string& path, const Image& img, const WriteDesc& des
   int nc = img.channels();
   if (ext == ".hdr" || ext == ".jpg" || ext == ".jpeg") nc = std::min(nc, 3);
   Image src = nc == img.channels() ? img : img.with_channels(nc);
-  if (ldr) {
+  if (ldr && !desc.data) {
     int color = std::min(nc, 3);
     for (size_t i = 0; i < src.pixel_count(); ++i)
       for (int c = 0; c < nc; ++c) {
@@ -174,7 +175,7 @@ void write_image(const std::string& path, const Image& img, const WriteDesc& des
   AtomicFile file(path);
   try {
     if (ext == ".pfm") write_pfm(file.temp_path(), path, img);
-    else write_encoded(file.temp_path(), ext, src, ldr, desc.half);
+    else write_encoded(file.temp_path(), ext, src, ldr, desc.half, desc.data);
   } catch (const Error& e) {
     std::string msg = e.what();
     for (size_t at; (at = msg.find(file.temp_path())) != std::string::npos;) msg.replace(at, file.temp_path().size(), path);

@@ -8,6 +8,7 @@
 #include "iblkit/core/error.h"
 #include "iblkit/sh/basis.h"
 #include "iblkit/sh/convolve.h"
+#include "iblkit/sh/rotate.h"
 
 namespace ibl::sh {
 
@@ -42,18 +43,26 @@ ExportFormat parse_export_format(const std::string& name) { return parse_enum(kE
 
 Coeffs to_threejs(const Coeffs& radiance) { return radiance.resized(3); }
 
-Coeffs to_filament(const Coeffs& radiance) {
-  Coeffs c = radiance.resized(3);
+Mat3 filament_from_iblkit() { return Mat3::rows({0, 0, -1}, {0, 1, 0}, {1, 0, 0}); }
+
+Mat3 filament_frame(sphere::MappingKind k) {
+  using K = sphere::MappingKind;
+  if (k == K::CubeHCross || k == K::CubeVCross || k == K::CubeStrip) return Mat3::rows({-1, 0, 0}, {0, 1, 0}, {0, 0, 1});
+  return filament_from_iblkit();
+}
+
+Coeffs to_filament(const Coeffs& radiance, const Mat3& frame) {
+  Coeffs c = rotate(radiance.resized(3), frame);
   auto a = clamped_cosine_zh(3);
   for (int i = 0; i < 9; ++i) c.c[i] *= a[band_of(i)] / kPi * poly_constant(i);
   return c;
 }
 
-Coeffs from_filament(const Coeffs& f) {
+Coeffs from_filament(const Coeffs& f, const Mat3& frame) {
   Coeffs c = f.resized(3);
   auto a = clamped_cosine_zh(3);
   for (int i = 0; i < 9; ++i) c.c[i] *= kPi / (a[band_of(i)] * poly_constant(i));
-  return c;
+  return rotate(c, frame.transposed());
 }
 
 Coeffs to_gltf(const Coeffs& radiance) {
@@ -70,7 +79,7 @@ Coeffs from_gltf(const Coeffs& g) {
   return c;
 }
 
-std::string export_text(const Coeffs& radiance, ExportFormat f) {
+std::string export_text(const Coeffs& radiance, ExportFormat f, const Mat3& filament_frame) {
   radiance.validate("SH coefficients");
   switch (f) {
     case ExportFormat::Iblkit: return to_json_text(radiance);
@@ -85,7 +94,7 @@ std::string export_text(const Coeffs& radiance, ExportFormat f) {
       return nlohmann::json{{"type", "SphericalHarmonics3"}, {"coefficients", arr}}.dump(2) + "\n";
     }
     case ExportFormat::Filament: {
-      Coeffs c = to_filament(radiance);
+      Coeffs c = to_filament(radiance, filament_frame);
       std::string s;
       for (int i = 0; i < 9; ++i)
         s += fmt::format("({:18.15f}, {:18.15f}, {:18.15f}); // L{}{}, irradiance, pre-scaled base\n", c.c[i].x, c.c[i].y,
