@@ -15,7 +15,8 @@ using namespace ibl::ilf;
 void BM_IlfAccumulateBlock64(benchmark::State& state) {
   int D = int(state.range(0)), K = 25;
   int64_t rows = 3 * 64 * 64 * 64;
-  std::vector<float> R(size_t(rows) * D, 0.5f), B(size_t(D) * K, 0.01f), C(size_t(rows) * K, 0.0f);
+  std::vector<float> R(size_t(rows) * D, 0.5f), B(size_t(D) * K, 0.01f);
+  std::vector<double> C(size_t(rows) * K, 0.0);
   double flops = 0;
   for (auto _ : state) {
     flops += accumulate_block(R.data(), rows, D, B.data(), K, C.data());

@@ -51,8 +51,10 @@ Bar& bar() {
 }
 }  // namespace
 
-ibl::ProgressFn progress_bar() {
-  if (globals().quiet || !isatty(STDERR_FILENO)) return {};
+ibl::ProgressFn progress_bar() { return progress_bar(isatty(STDERR_FILENO)); }
+
+ibl::ProgressFn progress_bar(bool terminal) {
+  if (globals().quiet || !terminal) return {};
   bar().start = std::chrono::steady_clock::now();
   return [](std::string_view stage, double f) {
     Bar& b = bar();

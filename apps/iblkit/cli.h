@@ -67,6 +67,8 @@ std::vector<DemoEntry>& demo_registry();
 
 // A progress callback that draws a bar on stderr when it is a terminal and not --quiet.
 ibl::ProgressFn progress_bar();
+// … when `terminal` (the caller knows where stderr ends up: an MPI rank's goes through mpirun) and not --quiet.
+ibl::ProgressFn progress_bar(bool terminal);
 // Ends the bar line (call when the work is done).
 void progress_done();
 

@@ -1,5 +1,8 @@
 // iblkit ilf build|query|slice|info|synth: incident light fields — probe sequences resampled into SH
 // grids (Löw et al. 2009, docs/ilf.md).
+#include <unistd.h>
+
+#include <chrono>
 #include <filesystem>
 
 #include <fmt/format.h>
@@ -10,6 +13,7 @@
 #include "iblkit/ilf/analytic.h"
 #include "iblkit/ilf/build.h"
 #include "iblkit/ilf/threejs_grid.h"
+#include "iblkit/ilf/distributed.h"
 #include "iblkit/io/image_io.h"
 #include "iblkit/io/tonemap.h"
 
@@ -64,7 +68,7 @@ nlohmann::json report_json(const ilf::BuildReport& r) {
   return {{"probes_in", r.probes_in}, {"probes_used", r.probes_used}, {"skipped", r.skipped}, {"subsampled_out", r.subsampled_out},
           {"buckets", r.buckets}, {"blocks", r.blocks}, {"octahedral", r.octahedral}, {"samples", r.samples},
           {"fraction_uncovered", r.fraction_uncovered}, {"buckets_reused", r.buckets_reused},
-          {"seconds", {{"subsample", r.t_subsample}, {"sort", r.t_sort}, {"project", r.t_project},
+          {"seconds", {{"subsample", r.t_subsample}, {"sort", r.t_sort}, {"project", r.t_project}, {"repair", r.t_repair},
                        {"accumulate", r.t_accumulate}, {"total", r.t_total}}},
           {"gemm_gflop", r.gemm_flops * 1e-9}, {"resolution", {r.nx, r.ny, r.nz}}, {"kernel", r.kernel_cells},
           {"ball_radius", r.ball_radius},
@@ -95,6 +99,15 @@ void add_crossval_json(nlohmann::json& j, const ilf::BuildReport& r) {
 // "--grid auto" or a resolution; "--kernel auto" or a width.
 bool is_auto(const std::string& s) { return s == "auto"; }
 
+
+nlohmann::json mpi_json(const ilf::DistributedReport& d) {
+  return {{"ranks", d.ranks}, {"chunk", d.chunk}, {"blocks_per_rank", {d.blocks_min, d.blocks_max}},
+          {"seconds", {{"subsample", d.t_subsample}, {"read", d.t_read}, {"exchange", d.t_exchange}, {"project", d.t_project},
+                       {"repair", d.t_repair}, {"accumulate", d.t_accumulate}, {"reduce", d.t_reduce}}},
+          {"bytes_sent", d.bytes_sent}, {"bytes_received", d.bytes_received}, {"bytes_reduced", d.bytes_reduced},
+          {"peak_rss_bytes", d.peak_rss_bytes}};
+}
+
 // Inverse of parse_bytes for the --memory default: whole gibibytes or mebibytes as "2G", "512M".
 std::string format_bytes(size_t bytes) {
   if (bytes % (size_t(1) << 30) == 0) return fmt::format("{}G", bytes >> 30);
@@ -115,19 +128,92 @@ std::string positive_number(const std::string& v) {
   return d > 0 ? "" : "must be > 0, got " + v;
 }
 
+// Defaults come from BuildDesc (and the descs it holds); the strings are their parsed forms.
+struct BuildOptions {
+  ilf::BuildDesc bd;
+  std::string seq, out, volume, buckets, vdb, error_grid, kernel = "auto";
+  std::string grid = bd.nx == bd.ny && bd.ny == bd.nz ? std::to_string(bd.nx) : fmt::format("{},{},{}", bd.nx, bd.ny, bd.nz);
+  std::string repair = ilf::repair_name(bd.project.repair), memory = format_bytes(bd.buckets.memory_bytes);
+  std::string directions = directions_name(bd.buckets.octahedral);
+  double subsample = -1, subsample_dist = ilf::SubsampleDesc{}.max_distance;  // off unless given
+  CLI::Option* subsample_opt = nullptr;
+  bool no_reuse = !bd.buckets.reuse, drop_buckets = false;
+  bool no_parallax = !bd.ball_parallax;
+  bool mpi = false;
+};
+
+// The build and its report; job: this rank of an MPI job (rank 0 writes and prints), or none.
+void run_build(const BuildOptions& opts, const ilf::SequenceReadDesc& rd, const ilf::BuildDesc& bd, ilf::MpiJob* job) {
+  const BuildOptions* o = &opts;
+  ilf::SequenceReport srep;
+  ilf::Sequence seq;
+  ilf::BuildReport rep;
+  ilf::DistributedReport drep;
+  ilf::SHGrid g;
+  double t_write = 0;
+  if (job) {
+    job->agree([&] { seq = ilf::read_sequence(o->seq, rd, &srep); });
+    // Rank 0 draws the one bar of the job; under mpirun its stderr is a pipe and its stdout the terminal.
+    auto bar = job->rank() == 0 ? iblcli::progress_bar(isatty(STDERR_FILENO) || isatty(STDOUT_FILENO)) : ibl::ProgressFn{};
+    g = job->build(seq, bd, bar, &rep, &drep);
+    iblcli::progress_done();
+    if (job->rank() != 0) return;
+  } else {
+    seq = ilf::read_sequence(o->seq, rd, &srep);
+    g = ilf::build_shgrid(seq, bd, iblcli::progress_bar(), &rep);
+    iblcli::progress_done();
+  }
+  {
+    auto tw = std::chrono::steady_clock::now();
+    ilf::write_shgrid(o->out, g);
+    if (!o->vdb.empty()) ilf::write_vdb(o->vdb, g);
+    if (!o->error_grid.empty()) ilf::write_shgrid(o->error_grid, ilf::error_volume(*rep.crossval, g.grid()));
+    t_write = std::chrono::duration<double>(std::chrono::steady_clock::now() - tw).count();
+  }
+  if (o->drop_buckets) ilf::remove_bucket_cache(bd.buckets.dir);
+  rep.skipped += srep.skipped;
+  for (auto& r : srep.reasons) rep.skip_reasons.insert(rep.skip_reasons.begin(), r);
+  for (auto& r : rep.skip_reasons) iblcli::info("skipped: " + r);
+  auto j = report_json(rep);
+  j["out"] = o->out;
+  j["seconds"]["write"] = t_write;
+  if (job) j["mpi"] = mpi_json(drep);
+  add_crossval_json(j, rep);
+  if (!o->error_grid.empty()) j["error_grid"] = o->error_grid;
+  iblcli::emit(j, [&] {
+    fmt::print("wrote {} ({}x{}x{}, {} coefficients)\n", o->out, g.grid().nx, g.grid().ny, g.grid().nz, bd.bands * bd.bands);
+    fmt::print("kernel    {:g} grid cells{}{}\n", rep.choice ? rep.kernel_cells : bd.project.kernel_cells,
+               rep.choice ? fmt::format(" (chosen of {} cross-validated trials on {} buckets in {:.1f}s{})", rep.choice->trials.size(),
+                                        rep.choice->buckets_used, rep.choice->seconds, bd.auto_grid ? ", with the grid" : "") : "",
+               rep.ball_radius > 0 ? fmt::format("; rays start on the ball (radius {:g} m)", rep.ball_radius) : "");
+    if (rep.crossval) {
+      const auto& c = *rep.crossval;
+      fmt::print("cv error  {:.4f} relative ({}-fold, {} probes; median probe {:.4f})\n", c.rel_error, c.folds, c.evaluated, c.median_probe_error);
+      std::string regs;
+      for (size_t i = 0; i < c.region_error.size(); ++i)
+        regs += std::isfinite(c.region_error[i]) ? fmt::format(" {:.3f}", c.region_error[i]) : " -";
+      fmt::print("  regions {}³ (x fastest, then y, z):{}\n", c.regions, regs);
+    }
+    if (!o->error_grid.empty()) fmt::print("wrote {} (cross-validated error volume)\n", o->error_grid);
+    fmt::print("probes    {} used of {} in the manifest{}{}\n", rep.probes_used, rep.probes_in + srep.skipped,
+               rep.skipped ? fmt::format(", {} skipped as bad", rep.skipped) : "",
+               rep.subsampled_out ? fmt::format(", {} dropped by --subsample", rep.subsampled_out) : "");
+    fmt::print("buckets   {} ({}), {} blocks{}\n", rep.buckets, rep.octahedral ? fmt::format("{0}x{0} octahedral", rep.octahedral) : "one per pixel",
+               rep.blocks, rep.buckets_reused ? ", reused" : "");
+    fmt::print("samples   {} ({:.3g}/s), {:.2f}% of grid point × bucket pairs repaired\n", rep.samples,
+               rep.samples / std::max(rep.t_total, 1e-9), 100 * rep.fraction_uncovered);
+    fmt::print("time      sort {:.1f}s, project+repair {:.1f}s, SH products {:.1f}s ({:.1f} GFLOP/s), total {:.1f}s\n", rep.t_sort,
+               rep.t_project, rep.t_accumulate, rep.gemm_flops * 1e-9 / std::max(rep.t_accumulate, 1e-9), rep.t_total);
+    if (job)
+      fmt::print("ranks     {}: read {:.1f}s, exchange {:.1f}s ({:.3g} MB sent by the busiest rank), project {:.1f}s "
+                 "(repair {:.1f}s), SH {:.1f}s, reduce {:.1f}s, write {:.1f}s; peak memory {:.0f} MB per rank\n",
+                 drep.ranks, drep.t_read, drep.t_exchange, drep.bytes_sent * 1e-6, drep.t_project, drep.t_repair,
+                 drep.t_accumulate, drep.t_reduce, t_write, drep.peak_rss_bytes * 1e-6);
+  });
+}
+
 void setup_build(CLI::App& app) {
-  // Defaults come from BuildDesc (and the descs it holds); the strings are their parsed forms.
-  struct Opts {
-    ilf::BuildDesc bd;
-    std::string seq, out, volume, buckets, vdb, error_grid, kernel = "auto";
-    std::string grid = bd.nx == bd.ny && bd.ny == bd.nz ? std::to_string(bd.nx) : fmt::format("{},{},{}", bd.nx, bd.ny, bd.nz);
-    std::string repair = ilf::repair_name(bd.project.repair), memory = format_bytes(bd.buckets.memory_bytes);
-    std::string directions = directions_name(bd.buckets.octahedral);
-    double subsample = -1, subsample_dist = ilf::SubsampleDesc{}.max_distance;  // off unless given
-    CLI::Option* subsample_opt = nullptr;
-    bool no_reuse = !bd.buckets.reuse, drop_buckets = false;
-    bool no_parallax = !bd.ball_parallax;
-  };
+  using Opts = BuildOptions;
   auto* o = iblcli::app_owned<Opts>();
   auto& bd0 = o->bd;
   app.add_option("sequence", o->seq, "iblkit.sequence/1 manifest")->required();
@@ -164,8 +250,10 @@ void setup_build(CLI::App& app) {
   app.add_flag("--no-reuse", o->no_reuse, "rebuild the direction buckets even when an earlier run's match");
   app.add_flag("--drop-buckets", o->drop_buckets, "remove the direction buckets once the grid is written (a re-run sorts again)");
   app.add_flag("--no-parallax", o->no_parallax, "ignore the manifest's ball_radius: every ray through the probe position (single viewpoint)");
-  app.footer("Example:\n  iblkit ilf build cap/sequence.json --grid 8 --bands 5 --out room8.shgrid");
-  app.callback([o] {
+  app.add_flag("--mpi", o->mpi, "build as a rank of an MPI job (the default under mpirun): mpirun -np N iblkit ilf build …");
+  app.footer("Examples:\n  iblkit ilf build cap/sequence.json --grid 8 --bands 5 --out room8.shgrid\n"
+             "  mpirun -np 4 iblkit ilf build captures/sequence.json --grid 32 --out room.shgrid   (docs/ilf.md, \"On a cluster\")");
+  app.callback([o, &app] {
     bool grid_auto = is_auto(o->grid);
     auto grid = grid_auto ? std::vector<int>{16, 16, 16} : parse_grid(o->grid);
     if (!o->vdb.empty() && !ilf::have_vdb()) ilf::write_vdb(o->vdb, ilf::SHGrid());  // fails now, not after the build
@@ -191,46 +279,23 @@ void setup_build(CLI::App& app) {
     if (o->subsample_opt->count() > 0) bd.subsample = ilf::SubsampleDesc{o->subsample, o->subsample_dist};
     ilf::SequenceReadDesc rd;
     rd.skip_bad = bd.buckets.skip_bad;
-    ilf::SequenceReport srep;
-    auto seq = ilf::read_sequence(o->seq, rd, &srep);
-    ilf::BuildReport rep;
-    auto g = ilf::build_shgrid(seq, bd, iblcli::progress_bar(), &rep);
-    iblcli::progress_done();
-    ilf::write_shgrid(o->out, g);
-    if (!o->vdb.empty()) ilf::write_vdb(o->vdb, g);
-    if (o->drop_buckets) ilf::remove_bucket_cache(bd.buckets.dir);
-    if (!o->error_grid.empty()) ilf::write_shgrid(o->error_grid, ilf::error_volume(*rep.crossval, g.grid()));
-    rep.skipped += srep.skipped;
-    for (auto& r : srep.reasons) rep.skip_reasons.insert(rep.skip_reasons.begin(), r);
-    for (auto& r : rep.skip_reasons) iblcli::info("skipped: " + r);
-    auto j = report_json(rep);
-    j["out"] = o->out;
-    add_crossval_json(j, rep);
-    if (!o->error_grid.empty()) j["error_grid"] = o->error_grid;
-    iblcli::emit(j, [&] {
-      fmt::print("wrote {} ({}x{}x{}, {} coefficients)\n", o->out, rep.nx, rep.ny, rep.nz, bd.bands * bd.bands);
-      fmt::print("kernel    {:g} grid cells{}{}\n", rep.kernel_cells, rep.choice ? fmt::format(" (chosen of {} cross-validated trials on {} buckets in {:.1f}s{})",
-                 rep.choice->trials.size(), rep.choice->buckets_used, rep.choice->seconds, bd.auto_grid ? ", with the grid" : "") : "",
-                 rep.ball_radius > 0 ? fmt::format("; rays start on the ball (radius {:g} m)", rep.ball_radius) : "");
-      if (rep.crossval) {
-        const auto& c = *rep.crossval;
-        fmt::print("cv error  {:.4f} relative ({}-fold, {} probes; median probe {:.4f})\n", c.rel_error, c.folds, c.evaluated, c.median_probe_error);
-        std::string regs;
-        for (size_t i = 0; i < c.region_error.size(); ++i)
-          regs += std::isfinite(c.region_error[i]) ? fmt::format(" {:.3f}", c.region_error[i]) : " -";
-        fmt::print("  regions {}³ (x fastest, then y, z):{}\n", c.regions, regs);
+    if (o->mpi || ilf::launched_by_mpi()) {
+      // The cross-validated choice and error need the whole bucket store on one rank: not distributed yet.
+      auto given = [&](const char* name) { return app.get_option(name)->count() > 0; };
+      if ((bd.auto_kernel && given("--kernel")) || (bd.auto_grid && given("--grid")) || !o->error_grid.empty() ||
+          (bd.crossval.folds >= 2 && given("--cv-folds")))
+        fail(ErrorKind::Unsupported, "under MPI the build does not cross-validate yet: give --kernel W and --grid N (no --error-grid, "
+             "--cv-folds 0), or build on one machine");
+      if (bd.auto_kernel) {
+        bd.auto_kernel = false;
+        bd.project.kernel_cells = ilf::BuildDesc{}.project.kernel_cells;
+        iblcli::info(fmt::format("under MPI the kernel is not cross-validated: {:g} grid cells (--kernel to choose)", bd.project.kernel_cells));
       }
-      if (!o->error_grid.empty()) fmt::print("wrote {} (cross-validated error volume)\n", o->error_grid);
-      fmt::print("probes    {} used of {} in the manifest{}{}\n", rep.probes_used, rep.probes_in + srep.skipped,
-                 rep.skipped ? fmt::format(", {} skipped as bad", rep.skipped) : "",
-                 rep.subsampled_out ? fmt::format(", {} dropped by --subsample", rep.subsampled_out) : "");
-      fmt::print("buckets   {} ({}), {} blocks{}\n", rep.buckets, rep.octahedral ? fmt::format("{0}x{0} octahedral", rep.octahedral) : "one per pixel",
-                 rep.blocks, rep.buckets_reused ? ", reused" : "");
-      fmt::print("samples   {} ({:.3g}/s), {:.2f}% of grid point × bucket pairs repaired\n", rep.samples,
-                 rep.samples / std::max(rep.t_total, 1e-9), 100 * rep.fraction_uncovered);
-      fmt::print("time      sort {:.1f}s, project+repair {:.1f}s, SH products {:.1f}s ({:.1f} GFLOP/s), total {:.1f}s\n", rep.t_sort,
-                 rep.t_project, rep.t_accumulate, rep.gemm_flops * 1e-9 / std::max(rep.t_accumulate, 1e-9), rep.t_total);
-    });
+      bd.crossval.folds = 0;
+      ilf::run_mpi_job([&](ilf::MpiJob& job) { run_build(*o, rd, bd, &job); });
+    } else {
+      run_build(*o, rd, bd, nullptr);
+    }
   });
 }
 

@@ -20,15 +20,20 @@ using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 }  // namespace
 
-double accumulate_block(const float* R, int64_t rows, int D, const float* B, int K, float* C) {
+double accumulate_block(const float* R, int64_t rows, int D, const float* B, int K, double* C) {
   using MatF = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor>;
+  using MatD = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor>;
   Eigen::Map<const MatF, 0, Eigen::OuterStride<>> Rm(R, rows, D, Eigen::OuterStride<>(rows));
   Eigen::Map<const MatF> Bm(B, D, K);
-  Eigen::Map<MatF, 0, Eigen::OuterStride<>> Cm(C, rows, K, Eigen::OuterStride<>(rows));
+  Eigen::Map<MatD, 0, Eigen::OuterStride<>> Cm(C, rows, K, Eigen::OuterStride<>(rows));
   constexpr int64_t kChunk = 2048;  // rows per task: (2048 × D + 2048 × K) floats stay in L2
   parallel_for(0, (rows + kChunk - 1) / kChunk, [&](int64_t c) {
     int64_t r0 = c * kChunk, n = std::min(kChunk, rows - r0);
-    Cm.middleRows(r0, n).noalias() += Rm.middleRows(r0, n) * Bm;
+    // The block's product in float (the GEMM), its sum over blocks in double: every block's product is
+    // the same bits whichever process makes it, and a sum in double does not depend on the order of
+    // the blocks to float precision, so a distributed build equals the serial one (docs/ilf.md).
+    MatF P = Rm.middleRows(r0, n) * Bm;
+    Cm.middleRows(r0, n) += P.cast<double>();
   });
   return 2.0 * double(rows) * D * K;
 }
@@ -131,14 +136,14 @@ BlockStats project_block(const BucketStore& store, int k, const std::vector<uint
   return bs;
 }
 
-void store_coefficients(const float* C, SHGrid& out) {
+void store_coefficients(const double* C, SHGrid& out) {
   // C(c·G + g, k) → data[(g·K + k)·3 + c].
   int K = out.coeff_count();
   int64_t G = out.grid().count(), rows = 3 * G;
   auto& data = out.data();
   parallel_for(0, G, [&](int64_t g) {
     for (int kk = 0; kk < K; ++kk)
-      for (int c = 0; c < 3; ++c) data[(size_t(g) * K + kk) * 3 + c] = C[size_t(kk) * rows + size_t(c) * G + g];
+      for (int c = 0; c < 3; ++c) data[(size_t(g) * K + kk) * 3 + c] = float(C[size_t(kk) * rows + size_t(c) * G + g]);
   }, 1024);
 }
 
@@ -204,7 +209,8 @@ SHGrid build_shgrid(const Sequence& seq_in, const BuildDesc& desc, const Progres
   // Resample, block by block.
   int K = desc.bands * desc.bands;
   int64_t G = grid.count(), rows = 3 * G;
-  std::vector<float> C(size_t(rows) * K, 0.0f), R;
+  std::vector<double> C(size_t(rows) * K, 0.0);
+  std::vector<float> R;
   std::vector<uint16_t> buf;
   BlockScratch scratch;
   double repair_s = 0, busy_s = 0;

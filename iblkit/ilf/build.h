@@ -65,8 +65,9 @@ struct BuildReport {
 };
 
 // SH accumulation of one block: C (rows × K, column-major) += R (rows × D, column-major) · B (D × K,
-// column-major), in parallel over row chunks (Eigen for the products). Returns the flop count.
-double accumulate_block(const float* R, int64_t rows, int D, const float* B, int K, float* C);
+// column-major), in parallel over row chunks (Eigen for the products). The product is taken in float,
+// the sum over blocks in double (so that it does not depend on the blocks' order). Returns the flop count.
+double accumulate_block(const float* R, int64_t rows, int D, const float* B, int K, double* C);
 
 // Basis rows of buckets [b0, b1): B(j, k) = Σ_{q ∈ bucket b0+j} Ω_q·Y_k(ω_q), column-major (D × K).
 std::vector<float> bucket_basis(const DirectionTable& t, int b0, int b1, int bands);
@@ -91,6 +92,6 @@ BlockStats project_block(const BucketStore& store, int k, const std::vector<uint
                          const ProjectDesc& desc, const std::vector<Vec3>& origins, float* R, BlockScratch& scratch,
                          bool ball_parallax = true);  // rays start on the ball when the table has starts
 // C (3·G × K, column-major, as accumulate_block leaves it) into the grid's coefficient layout.
-void store_coefficients(const float* C, SHGrid& out);
+void store_coefficients(const double* C, SHGrid& out);
 
 }  // namespace ibl::ilf

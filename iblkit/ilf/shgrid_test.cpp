@@ -148,7 +148,8 @@ TEST(IlfAccumulate, BlockProductMatchesNaiveSum) {
   int D = 7, K = 9;
   std::mt19937 rng(5);
   std::uniform_real_distribution<float> U(-1, 1);
-  std::vector<float> R(size_t(rows) * D), B(size_t(D) * K), C(size_t(rows) * K, 0.5f);
+  std::vector<float> R(size_t(rows) * D), B(size_t(D) * K);
+  std::vector<double> C(size_t(rows) * K, 0.5);
   for (auto& v : R) v = U(rng);
   for (auto& v : B) v = U(rng);
   double flops = accumulate_block(R.data(), rows, D, B.data(), K, C.data());

@@ -1,0 +1,55 @@
+#!/usr/bin/env bash
+# End-to-end faults of the distributed ILF build (issue 18; CTest cli_mpi, seconds): a rank killed
+# mid-build ends the whole job through mpirun (no hang) and leaves no grid and no temporary file; the
+# re-run reuses the buckets the killed run had finished and gives the grid of an undisturbed run;
+# rank 0 prints one report; `--mpi` without mpirun runs as a job of one rank. Skips without mpirun or
+# without the MPI plugin. Open MPI refuses root unless told: the allowance is given to mpirun here only.
+set -u
+source "$(dirname "$0")/cli_check.sh" "$1"
+if ! command -v mpirun >/dev/null 2>&1; then echo "cli_mpi: mpirun is absent (install openmpi-bin): skipped"; exit 0; fi
+if [ ! -f "$(dirname "$(readlink -f "$BIN")")/libiblkit_mpi.so" ]; then echo "cli_mpi: this build has no MPI plugin: skipped"; exit 0; fi
+MPIRUN=(env OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 mpirun --oversubscribe)
+
+"$BIN" --quiet ilf synth --out "$T/seq" --probes 300 --size 32 --supersample 1 >/dev/null || { echo "FAIL synth"; exit 1; }
+S="$T/seq/sequence.json"
+ARGS=(--grid 24 --directions pixel --buckets "$T/b")
+
+# An undisturbed run: one report, from rank 0.
+check run ok "ranks     2:" -- timeout 300 "${MPIRUN[@]}" -np 2 "$BIN" ilf build "$S" "${ARGS[@]}" --out "$T/ref.shgrid"
+n=$(timeout 300 "${MPIRUN[@]}" -np 2 "$BIN" ilf build "$S" "${ARGS[@]}" --out "$T/ref2.shgrid" | grep -c "^wrote ")
+if [ "$n" = 1 ]; then pass=$((pass+1)); else echo "FAIL one-report: $n reports"; fail=$((fail+1)); fi
+
+# Kill rank 1 while it projects (the buckets reused from above make the sort instant).
+timeout 300 "${MPIRUN[@]}" -np 2 "$BIN" --quiet ilf build "$S" "${ARGS[@]}" --out "$T/killed.shgrid" >"$T/killed.log" 2>&1 &
+job=$!
+victim=""
+for _ in $(seq 1 200); do
+  # the ranks are the iblkit children of this mpirun
+  for p in $(pgrep -P "$job"; for c in $(pgrep -P "$job"); do pgrep -P "$c"; done); do
+    if [ "$(cat /proc/$p/comm 2>/dev/null)" = iblkit ] && grep -q "^OMPI_COMM_WORLD_RANK=1$" <(tr '\0' '\n' < /proc/$p/environ 2>/dev/null); then victim=$p; fi
+  done
+  [ -n "$victim" ] && break
+  sleep 0.05
+done
+sleep 0.3
+if [ -n "$victim" ] && kill -0 "$victim" 2>/dev/null; then
+  kill -9 "$victim"
+  wait $job; rc=$?
+  if [ $rc -ne 0 ] && [ $rc -ne 124 ]; then pass=$((pass+1)); else echo "FAIL kill: mpirun exit $rc (124 = hung): $(cat "$T/killed.log")"; fail=$((fail+1)); fi
+  if ! ls -a "$T" | grep -qE "^killed\.(shgrid|tmp-)"; then pass=$((pass+1)); else echo "FAIL kill: a grid or temporary file was left: $(ls -a "$T")"; fail=$((fail+1)); fi
+  grep -qiE "killed|signal 9|exited on signal" "$T/killed.log" && pass=$((pass+1)) || { echo "FAIL kill: mpirun did not say a rank died: $(cat "$T/killed.log")"; fail=$((fail+1)); }
+else
+  wait $job
+  echo "FAIL kill: rank 1 was not found running (the build was too quick to interrupt)"; fail=$((fail+1))
+fi
+# The re-run reuses the finished buckets and gives the undisturbed grid.
+check rerun-reuses ok "reused" -- timeout 300 "${MPIRUN[@]}" -np 2 "$BIN" ilf build "$S" "${ARGS[@]}" --out "$T/again.shgrid"
+if cmp -s "$T/ref.shgrid" "$T/again.shgrid"; then pass=$((pass+1)); else echo "FAIL rerun: the grid differs from the undisturbed run's"; fail=$((fail+1)); fi
+
+# --mpi without mpirun: a job of one rank (MPI's singleton start), the serial build's grid.
+check singleton ok "ranks     1:" -- env OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 timeout 120 "$BIN" ilf build "$S" --grid 8 --mpi --out "$T/one.shgrid" --buckets "$T/b1"
+check serial ok "" -- "$BIN" --quiet ilf build "$S" --grid 8 --out "$T/serial.shgrid" --buckets "$T/b0"
+if cmp -s "$T/one.shgrid" "$T/serial.shgrid"; then pass=$((pass+1)); else echo "FAIL singleton: its grid differs from the serial build's"; fail=$((fail+1)); fi
+
+echo "cli_mpi: $pass passed, $fail failed"
+[ $fail -eq 0 ]
