@@ -57,7 +57,8 @@ class CrossValidator {
   std::vector<float> frac_;
   std::vector<int> eval_;                  // evaluated probe ids
   std::vector<Vec3> pos_;
-  std::vector<float> pred_, own_, Cpred_, Cown_;
+  std::vector<float> pred_, own_;
+  std::vector<double> Cpred_, Cown_;  // accumulate_block sums over blocks in double
 };
 
 // The error volume beside a grid (`ilf build --error-grid`): at each of its points (the build grid's

@@ -188,7 +188,7 @@ grid's storage (no copy); point (i, j, k) sits at min + (max − min)·(i/(nx−
           "Normalised Phong-lobe response around reflection directions r (Löw et al. §4).")
       .def("save", [](const SHGrid& g, const std::string& p) { ibl::ilf::write_shgrid(p, g); }, py::arg("path"),
            "Writes a .shgrid file (atomically).")
-      .def_static("load", &ibl::ilf::read_shgrid, py::arg("path"), "Reads a .shgrid file.");
+      .def_static("load", [](const std::string& p) { return ibl::ilf::read_shgrid(p); }, py::arg("path"), "Reads a .shgrid file.");
 
   m.def(
       "build",
