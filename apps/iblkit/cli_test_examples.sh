@@ -28,7 +28,7 @@ cat > path.json <<'EOF'
  {"position": [0, 1.5, 4], "time": 2}]}
 EOF
 cat > cam.json <<'EOF'
-{"format": "iblkit.camera/1", "eye": [0, 1.2, 2.4], "target": [0, 0.3, 0], "up": [0, 1, 0], "fov_y_deg": 40}
+{"format": "iblkit.camera/1", "eye": [0, 1.2, 1.8], "target": [0, 0.3, 0], "up": [0, 1, 0], "fov_y_deg": 40}
 EOF
 printf 'v -2 0 -2\nv 2 0 -2\nv 2 0 2\nv -2 0 2\nf 1 3 2\nf 1 4 3\n' > floor.obj
 { for v in "-2 0 -2" "2 0 -2" "2 0 2" "-2 0 2" "-2 3 -2" "2 3 -2" "2 3 2" "-2 3 2"; do echo "v $v"; done
@@ -47,6 +47,8 @@ run_example() {
   seen[$line]=1
   cmd=${line%%#*}  # a trailing comment
   case "$cmd" in
+    *" serve "*)  # a server that runs until Ctrl-C (cli_test_web.sh starts and stops one)
+      echo "skip ($where, a server until Ctrl-C): $line"; skip=$((skip+1)); return ;;
     *" view "*)
       if [[ "$cmd" != *--frames* ]]; then echo "skip ($where, interactive window): $line"; skip=$((skip+1)); return; fi ;;
   esac

@@ -47,8 +47,8 @@ check rerun-reuses ok "reused" -- timeout 300 "${MPIRUN[@]}" -np 2 "$BIN" ilf bu
 if cmp -s "$T/ref.shgrid" "$T/again.shgrid"; then pass=$((pass+1)); else echo "FAIL rerun: the grid differs from the undisturbed run's"; fail=$((fail+1)); fi
 
 # --mpi without mpirun: a job of one rank (MPI's singleton start), the serial build's grid.
-check singleton ok "ranks     1:" -- env OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 timeout 120 "$BIN" ilf build "$S" --grid 8 --mpi --out "$T/one.shgrid" --buckets "$T/b1"
-check serial ok "" -- "$BIN" --quiet ilf build "$S" --grid 8 --out "$T/serial.shgrid" --buckets "$T/b0"
+check singleton ok "ranks     1:" -- env OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 timeout 120 "$BIN" ilf build "$S" --grid 8 --kernel 3 --mpi --out "$T/one.shgrid" --buckets "$T/b1"
+check serial ok "" -- "$BIN" --quiet ilf build "$S" --grid 8 --kernel 3 --out "$T/serial.shgrid" --buckets "$T/b0"
 if cmp -s "$T/one.shgrid" "$T/serial.shgrid"; then pass=$((pass+1)); else echo "FAIL singleton: its grid differs from the serial build's"; fail=$((fail+1)); fi
 
 echo "cli_mpi: $pass passed, $fail failed"

@@ -20,7 +20,7 @@ def sequence(tmp_path_factory):
 
 def test_build_from_file_matches_cli(tmp_path, sequence):
     out = tmp_path / "cli.shgrid"
-    run_cli("ilf", "build", sequence, "--grid", 4, "--bands", 3, "--out", out, "--buckets", tmp_path / "b1")
+    run_cli("ilf", "build", sequence, "--grid", 4, "--bands", 3, "--kernel", 3, "--out", out, "--buckets", tmp_path / "b1")
     cli = ilf.SHGrid.load(str(out))
     seen = []
     grid, report = ilf.build(str(sequence), grid=4, bands=3, work_dir=str(tmp_path / "b2"), progress=lambda s, f: seen.append(s))

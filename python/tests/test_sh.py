@@ -32,7 +32,10 @@ def test_solid_angles_sum_to_four_pi():
     for m, w, h in [("latlong", 64, 32), ("mirrorball", 33, 33), ("hcross", 64, 48), ("octahedral", 32, 32)]:
         s = iblkit.solid_angles(m, w, h)
         assert s.shape == (h, w)
-        assert abs(s.sum(dtype=np.float64) - 4 * math.pi) < 1e-4
+        # The mirror ball's Jacobian is singular at the rim (the back direction), so pixel-centre solid
+        # angles of a small ball fall short there (33²: 1 %); the other mappings sum to 4π.
+        tol = 0.02 * 4 * math.pi if m == "mirrorball" else 1e-4
+        assert abs(s.sum(dtype=np.float64) - 4 * math.pi) < tol
     assert iblkit.detect_mapping(200, 100) == "latlong"
 
 
