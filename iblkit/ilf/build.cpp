@@ -96,33 +96,15 @@ BlockStats project_block(const BucketStore& store, int k, const std::vector<uint
                          const ProjectDesc& desc, const std::vector<Vec3>& origins, float* R, BlockScratch& scratch,
                          bool ball_parallax) {
   const DirectionTable& t = store.table();
-  int P = store.probe_count();
   int64_t G = grid.count(), rows = 3 * G;
   int b0 = t.block_begin[k], b1 = t.block_begin[k + 1], D = b1 - b0;
-  struct Ctx { const float* data; int64_t stride; };
   std::atomic<int64_t> rays_n{0}, uncovered{0};
   std::mutex mu;
   BlockStats bs;
   parallel_for(0, D, [&](int64_t j) {
     auto tb = Clock::now();
-    int b = b0 + int(j);
-    int nb = int(t.bucket_begin[b + 1] - t.bucket_begin[b]);
-    std::vector<float> rad(size_t(P) * nb * 3);
-    for (int p = 0; p < P; ++p) halves_to_floats(store.samples(buf, k, b, p), rad.data() + size_t(p) * nb * 3, size_t(nb) * 3);
-    Ctx ctx{rad.data(), int64_t(nb) * 3};
-    BucketRays rays;
-    rays.dirs = t.dir.data() + t.bucket_begin[b] * 3;
-    rays.weights = t.weight.data() + t.bucket_begin[b];
-    if (ball_parallax && !t.start.empty()) rays.starts = t.start.data() + t.bucket_begin[b] * 3;
-    rays.n_dirs = nb;
-    rays.origins = origins.data();
-    rays.valid = store.valid().data();
-    rays.n_probes = P;
-    rays.ctx = &ctx;
-    rays.radiance = [](const void* c, int p) {
-      auto* x = static_cast<const Ctx*>(c);
-      return x->data + p * x->stride;
-    };
+    BucketRadiance rad;
+    BucketRays rays = bucket_rays(store, buf, k, b0 + int(j), origins, ball_parallax, rad);
     auto st = project_bucket(grid, rays, desc, R + size_t(j) * rows, G, scratch.local());
     rays_n += st.rays;
     uncovered += st.uncovered;
@@ -134,6 +116,26 @@ BlockStats project_block(const BucketStore& store, int k, const std::vector<uint
   bs.rays = rays_n;
   bs.uncovered = uncovered;
   return bs;
+}
+
+BlockWork resample_block(const BucketStore& store, int k, const GridDesc& grid, const ProjectDesc& desc, const std::vector<Vec3>& origins,
+                         int bands, bool ball_parallax, std::vector<uint16_t>& buf, std::vector<float>& R, BlockScratch& scratch,
+                         double* C) {
+  const DirectionTable& t = store.table();
+  int64_t rows = 3 * grid.count();
+  int K = bands * bands;
+  BlockWork w;
+  auto tp = Clock::now();
+  store.load_block(k, buf);
+  int b0 = t.block_begin[k], b1 = t.block_begin[k + 1], D = b1 - b0;
+  R.resize(size_t(rows) * D);  // no clearing: project_bucket writes every (point, channel) of its column
+  w.stats = project_block(store, k, buf, grid, desc, origins, R.data(), scratch, ball_parallax);
+  w.project_seconds = since(tp);
+  auto ta = Clock::now();
+  auto B = bucket_basis(t, b0, b1, bands);
+  w.gemm_flops = accumulate_block(R.data(), rows, D, B.data(), K, C);
+  w.accumulate_seconds = since(ta);
+  return w;
 }
 
 void store_coefficients(const double* C, SHGrid& out) {
@@ -215,20 +217,14 @@ SHGrid build_shgrid(const Sequence& seq_in, const BuildDesc& desc, const Progres
   BlockScratch scratch;
   double repair_s = 0, busy_s = 0;
   for (int k = 0; k < t.blocks(); ++k) {
-    auto tp = Clock::now();
-    store.load_block(k, buf);
-    int b0 = t.block_begin[k], b1 = t.block_begin[k + 1], D = b1 - b0;
-    R.resize(size_t(rows) * D);  // no clearing: project_bucket writes every (point, channel) of its column
-    auto bs = project_block(store, k, buf, grid, pd, origins, R.data(), scratch, desc.ball_parallax);
-    rep.samples += bs.rays;
-    rep.uncovered += bs.uncovered;
-    repair_s += bs.repair_seconds;
-    busy_s += bs.busy_seconds;
-    rep.t_project += since(tp);
-    auto ta = Clock::now();
-    auto B = bucket_basis(t, b0, b1, desc.bands);
-    rep.gemm_flops += accumulate_block(R.data(), rows, D, B.data(), K, C.data());
-    rep.t_accumulate += since(ta);
+    auto w = resample_block(store, k, grid, pd, origins, desc.bands, desc.ball_parallax, buf, R, scratch, C.data());
+    rep.samples += w.stats.rays;
+    rep.uncovered += w.stats.uncovered;
+    repair_s += w.stats.repair_seconds;
+    busy_s += w.stats.busy_seconds;
+    rep.t_project += w.project_seconds;
+    rep.gemm_flops += w.gemm_flops;
+    rep.t_accumulate += w.accumulate_seconds;
     ibl::report(progress, "resample", double(k + 1) / t.blocks());
   }
   store_coefficients(C.data(), out);

@@ -91,6 +91,15 @@ using BlockScratch = tbb::enumerable_thread_specific<ProjectScratch>;
 BlockStats project_block(const BucketStore& store, int k, const std::vector<uint16_t>& buf, const GridDesc& grid,
                          const ProjectDesc& desc, const std::vector<Vec3>& origins, float* R, BlockScratch& scratch,
                          bool ball_parallax = true);  // rays start on the ball when the table has starts
+// One block of the resampling, as the serial and the distributed build both run it: load block k,
+// project its buckets (project_block) into R, and add its SH products into C (3·G × K, double).
+struct BlockWork {
+  BlockStats stats;
+  double project_seconds = 0, accumulate_seconds = 0, gemm_flops = 0;
+};
+BlockWork resample_block(const BucketStore& store, int k, const GridDesc& grid, const ProjectDesc& desc, const std::vector<Vec3>& origins,
+                         int bands, bool ball_parallax, std::vector<uint16_t>& buf, std::vector<float>& R, BlockScratch& scratch,
+                         double* C);
 // C (3·G × K, column-major, as accumulate_block leaves it) into the grid's coefficient layout.
 void store_coefficients(const double* C, SHGrid& out);
 

@@ -355,20 +355,14 @@ SHGrid Job::build(const Sequence& seq_in, const BuildDesc& desc, const ProgressF
     std::vector<uint16_t> buf;
     BlockScratch scratch;
     for (int k = kb0; k < kb1; ++k) {
-      auto tp = Clock::now();
-      store.load_block(k, buf);
-      int b0 = t.block_begin[k], b1 = t.block_begin[k + 1], D = b1 - b0;
-      R.resize(size_t(rows) * D);
-      auto bs = project_block(store, k, buf, grid, desc.project, origins, R.data(), scratch, desc.ball_parallax);
-      counts[0] += bs.rays;
-      counts[1] += bs.uncovered;
-      busy_s += bs.busy_seconds;
-      repair_s += bs.repair_seconds;
-      dr.t_project += since(tp);
-      auto ta = Clock::now();
-      auto B = bucket_basis(t, b0, b1, desc.bands);
-      rep.gemm_flops += accumulate_block(R.data(), rows, D, B.data(), K, C.data());
-      dr.t_accumulate += since(ta);
+      auto w = resample_block(store, k, grid, desc.project, origins, desc.bands, desc.ball_parallax, buf, R, scratch, C.data());
+      counts[0] += w.stats.rays;
+      counts[1] += w.stats.uncovered;
+      busy_s += w.stats.busy_seconds;
+      repair_s += w.stats.repair_seconds;
+      dr.t_project += w.project_seconds;
+      rep.gemm_flops += w.gemm_flops;
+      dr.t_accumulate += w.accumulate_seconds;
       if (root) ibl::report(progress, "resample", double(k - kb0 + 1) / std::max(kb1 - kb0, 1));
     }
   });
