@@ -67,6 +67,26 @@ void write_at(const std::string& path, const uint16_t* data, size_t n, int64_t o
   ::close(fd);
 }
 
+// What a call ended in: nothing, an error of this rank, or an error every rank already agreed on.
+struct Outcome {
+  bool failed = false, agreed = false;
+  ErrorKind kind = ErrorKind::Internal;
+  std::string msg;
+};
+Outcome run_caught(const std::function<void()>& f) {
+  Outcome r;
+  try {
+    f();
+  } catch (const AgreedError& e) {
+    r = {true, true, e.kind(), e.what()};
+  } catch (const Error& e) {
+    r = {true, false, e.kind(), e.what()};
+  } catch (const std::exception& e) {
+    r = {true, false, ErrorKind::Internal, e.what()};
+  }
+  return r;
+}
+
 class Job final : public MpiJob {
  public:
   Job() {
@@ -77,20 +97,8 @@ class Job final : public MpiJob {
   int ranks() const override { return size_; }
 
   void agree(const std::function<void()>& f) override {
-    bool failed = false;
-    ErrorKind kind = ErrorKind::Internal;
-    std::string msg;
-    try {
-      f();
-    } catch (const Error& e) {
-      failed = true;
-      kind = e.kind();
-      msg = e.what();
-    } catch (const std::exception& e) {
-      failed = true;
-      msg = e.what();
-    }
-    settle(failed, kind, msg);
+    Outcome r = run_caught(f);
+    settle(r.failed, r.kind, r.msg);
   }
 
   // Collective: when any rank failed, every rank throws the lowest failing rank's error.
@@ -427,20 +435,11 @@ void run(const std::function<void(MpiJob&)>& body) {
   Job job;
   {
     tbb::global_control gc(tbb::global_control::max_allowed_parallelism, size_t(threads));
-    try {
-      body(job);
-    } catch (const AgreedError& e) {
-      failed = agreed = true;
-      kind = e.kind();
-      msg = e.what();
-    } catch (const Error& e) {
-      failed = true;
-      kind = e.kind();
-      msg = e.what();
-    } catch (const std::exception& e) {
-      failed = true;
-      msg = e.what();
-    }
+    Outcome r = run_caught([&] { body(job); });
+    failed = r.failed;
+    agreed = r.agreed;
+    kind = r.kind;
+    msg = r.msg;
     if (!agreed) {
       try {
         job.settle(failed, kind, msg);
