@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include "iblkit/augment/testing.h"
 #include "iblkit/augment/camera_io.h"
 #include "iblkit/augment/composite.h"
 #include "iblkit/augment/measure.h"
@@ -49,20 +50,8 @@ LocalLight constant_sky(Vec3 L, Vec3 centre) {
   return l;
 }
 
-Image constant_photo(double v) {
-  Image p(kW, kH, 3);
-  for (int y = 0; y < kH; ++y)
-    for (int x = 0; x < kW; ++x) p.set_rgb(x, y, {v, v, v});
-  return p;
-}
-
-geometry::TriMesh sphere_at(Vec3 c, double size) {
-  ObjectDesc d;
-  d.kind = "sphere";
-  d.size = size;
-  d.at = c;
-  return make_object(d);
-}
+Image constant_photo(double v) { return testing::constant_photo(kW, kH, v); }
+using testing::sphere_at;
 
 TEST(AugmentComposite, WhiteFurnaceFloorGivesItsAlbedoAndAHiddenObjectChangesNothing) {
   // Photo: ρ L on a floor under a constant sky L = 1. The object sits below the floor: no ray meets it.

@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "iblkit/augment/testing.h"
 #include "iblkit/augment/gl/compositor.h"
 #include "iblkit/augment/object.h"
 #include "iblkit/core/error.h"
@@ -35,20 +36,8 @@ geometry::Camera top_camera() {
 
 geometry::TriMesh floor_mesh() { return geometry::make_quad({0, 0, 0}, {0, 1, 0}, {0, 0, -1}, 6, 6); }
 
-Image constant_photo(double v) {
-  Image p(kW, kH, 3);
-  for (int y = 0; y < kH; ++y)
-    for (int x = 0; x < kW; ++x) p.set_rgb(x, y, {v, v, v});
-  return p;
-}
-
-geometry::TriMesh sphere_at(Vec3 c, double size) {
-  ObjectDesc d;
-  d.kind = "sphere";
-  d.size = size;
-  d.at = c;
-  return make_object(d);
-}
+Image constant_photo(double v) { return testing::constant_photo(kW, kH, v); }
+using testing::sphere_at;
 
 LocalLight sky(Vec3 L, Vec3 sun, Vec3 centre) {
   Image img(64, 32, 3);
