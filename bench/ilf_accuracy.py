@@ -19,6 +19,9 @@ Everything is cached in WORK: a re-run only does what is missing.
 import json, math, os, random, struct, subprocess, sys, time, zlib
 
 BIN, WORK = sys.argv[1], sys.argv[2]
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from ilf_common import cached, cli, fmt3, log, rel_l2  # noqa: E402
+run = cli(BIN)
 env = os.environ.get
 SCENES = env("SCENES", "low-scene1 low-scene2").split()
 DENSITIES = [int(v) for v in env("DENSITIES", "500 2000 4397").split()]
@@ -56,35 +59,6 @@ TRUTH_SH = ["--size", "128", "--samples", "4", "--area-samples", "64"]        # 
 TRUTH_PLANE = ["--size", "64", "--samples", "2", "--area-samples", "16"]      # irradiance only: cheaper
 TRUTH_FINE = ["--size", "256", "--samples", "4", "--area-samples", "64", "--seed", "2"]
 PROBES_MAX = max(DENSITIES)
-
-
-def run(*args):
-    return json.loads(subprocess.check_output([BIN, "--quiet", "--json", *map(str, args)]))
-
-
-def log(*a):
-    print(time.strftime("%H:%M:%S"), *a, file=sys.stderr, flush=True)
-
-
-def cached(path, make):
-    if os.path.exists(path):
-        return json.load(open(path))
-    v = make()
-    json.dump(v, open(path + ".tmp", "w"))
-    os.replace(path + ".tmp", path)
-    return v
-
-
-def fmt3(p):
-    return ",".join("%.9g" % v for v in p)
-
-
-def rel_l2(pairs):
-    num = den = 0.0
-    for a, b in pairs:
-        num += (a - b) ** 2
-        den += b * b
-    return math.sqrt(num / den) if den > 0 else float("nan")
 
 
 def flat(sh):

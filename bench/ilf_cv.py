@@ -10,35 +10,17 @@
   density   error against probe count and layout (random, parallel tracked lines, clusters).
 Everything is cached in WORK (delete WORK/<study>/*.json to re-measure). Writes WORK/<study>.md.
 """
-import json, math, os, random, struct, subprocess, sys, time
+import json, os, random, struct, subprocess, sys, time
 
 BIN, WORK, STUDY = sys.argv[1], sys.argv[2], sys.argv[3]
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from ilf_common import cached, cli, fmt3, log, rel_l2  # noqa: E402
+run = cli(BIN)
 env = os.environ.get
 POINTS = int(env("POINTS", "40"))
 SIZE, SAMPLES = int(env("SIZE", "48")), int(env("SAMPLES", "2"))
 TRUTH = ["--size", "96", "--samples", "2", "--area-samples", "32"]
 LOOK = "0,1,0"
-
-
-def run(*args):
-    return json.loads(subprocess.check_output([BIN, "--quiet", "--json", *map(str, args)]))
-
-
-def log(*a):
-    print(time.strftime("%H:%M:%S"), *a, file=sys.stderr, flush=True)
-
-
-def cached(path, make):
-    if os.path.exists(path):
-        return json.load(open(path))
-    v = make()
-    json.dump(v, open(path + ".tmp", "w"))
-    os.replace(path + ".tmp", path)
-    return v
-
-
-def fmt3(p):
-    return ",".join("%.9g" % v for v in p)
 
 
 class Grid:
@@ -77,12 +59,6 @@ class Grid:
             for q in range(self.K * 3):
                 out[q] += w * self.v[base + q]
         return out
-
-
-def rel_l2(pairs):
-    num = sum((a - b) ** 2 for a, b in pairs)
-    den = sum(b * b for a, b in pairs)
-    return math.sqrt(num / den) if den > 0 else float("nan")
 
 
 def truth_points(scene, sdir, lo, hi, blind=None):
