@@ -49,7 +49,7 @@ if not os.path.exists(os.path.join(CAP, "sequence.json")):
 seq = os.path.join(CAP, "sequence.json")
 nprobes = len(json.load(open(seq))["probes"])
 builds = {}
-common = ["ilf", "build", seq, "--grid", ",".join(map(str, GRID)), "--bands", "5", "--skip-bad"]
+common = ["ilf", "build", seq, "--grid", ",".join(map(str, GRID)), "--bands", "5", "--kernel", "3", "--cv-folds", "0", "--skip-bad"]
 for name, pre in [("serial", [])] + [("mpi_%s" % n, MPIRUN + ["-np", n]) for n in RANKS]:
     out = os.path.join(WORK, "building_%s.shgrid" % name)
     t0 = time.time()

@@ -90,7 +90,7 @@ IesProfile parse_ies(const std::string& text, const std::string& what) {
   const double mult = nums[2];
   // Counts and the type are checked as numbers before they become ints (a cast of 1e30 is undefined).
   if (!(nums[3] >= 1 && nums[4] >= 1 && nums[3] <= 10000 && nums[4] <= 10000))
-    fail(ErrorKind::Value, "{}: {} vertical and {} horizontal angles", what, nums[3], nums[4]);
+    fail(ErrorKind::Value, "{}: the counts of vertical angles ({}) and horizontal angles ({}) must each lie in 1..10000", what, nums[3], nums[4]);
   const int nv = static_cast<int>(nums[3]), nh = static_cast<int>(nums[4]);
   if (std::trunc(nums[5]) != 1) fail(ErrorKind::Unsupported, "{}: photometric type {} (only type C = 1)", what, nums[5]);
   p.photometric_type = 1;
@@ -102,15 +102,17 @@ IesProfile parse_ies(const std::string& text, const std::string& what) {
   for (int i = 0; i < nh; ++i) p.horizontal.push_back(nums[k++]);
   for (size_t i = 0; i < static_cast<size_t>(nv) * nh; ++i) {
     const double c = nums[k++] * mult * ballast;
-    if (!(c >= 0)) fail(ErrorKind::Value, "{}: candela value {} at index {} is negative", what, c, i);
+    if (!(c >= 0)) fail(ErrorKind::Value, "{}: candela value {} at index {} (× multiplier {} × ballast {}) is negative or not a number", what, nums[k - 1], i, mult, ballast);
     p.candela.push_back(c);
   }
   for (size_t i = 1; i < p.vertical.size(); ++i)
-    if (!(p.vertical[i] > p.vertical[i - 1])) fail(ErrorKind::Format, "{}: vertical angles are not increasing", what);
+    if (!(p.vertical[i] > p.vertical[i - 1]))
+      fail(ErrorKind::Format, "{}: vertical angle {} ({}°) is not greater than the one before it ({}°)", what, i, p.vertical[i], p.vertical[i - 1]);
   for (size_t i = 1; i < p.horizontal.size(); ++i)
-    if (!(p.horizontal[i] > p.horizontal[i - 1])) fail(ErrorKind::Format, "{}: horizontal angles are not increasing", what);
+    if (!(p.horizontal[i] > p.horizontal[i - 1]))
+      fail(ErrorKind::Format, "{}: horizontal angle {} ({}°) is not greater than the one before it ({}°)", what, i, p.horizontal[i], p.horizontal[i - 1]);
   if (p.vertical.front() < 0 || p.vertical.back() > 180)
-    fail(ErrorKind::Value, "{}: vertical angles {}..{} outside 0..180", what, p.vertical.front(), p.vertical.back());
+    fail(ErrorKind::Value, "{}: vertical angles {}°..{}° lie outside 0..180°", what, p.vertical.front(), p.vertical.back());
   return p;
 }
 

@@ -229,6 +229,27 @@ TEST(NearfieldIes, RotationallySymmetricCosineLobe) {
   EXPECT_THROW(parse_ies("TILT=NONE\n1 -1 1 19 1 1 2 0 0 0\n1 1 10\n0 10\n", "short.ies"), Error);
 }
 
+TEST(NearfieldIes, MessagesNameTheFileTheFieldAndTheValue) {
+  auto message = [](const std::string& text) {
+    try {
+      parse_ies(text, "lamp.ies");
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  const std::string head = "TILT=NONE\n1 -1 1 ";
+  auto has = [](const std::string& m, std::initializer_list<const char*> parts) {
+    for (const char* p : parts) EXPECT_NE(m.find(p), std::string::npos) << "'" << p << "' missing from: " << m;
+    EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+  };
+  has(message(head + "0 1 1 2 0 0 0\n1 1 10\n"), {"lamp.ies", "vertical angles (0)", "1..10000"});
+  has(message(head + "3 1 1 2 0 0 0\n1 1 10\n0 40 20 0 1 1 1\n"), {"lamp.ies", "vertical angle 2 (20°)", "(40°)"});
+  has(message(head + "2 1 1 2 0 0 0\n1 1 10\n0 90 0 5 -3\n"), {"lamp.ies", "candela value -3 at index 1", "negative"});
+  has(message(head + "2 1 1 2 0 0 0\n1 1 10\n0 200 0 5 3\n"), {"lamp.ies", "0°..200°", "0..180°"});
+  has(message(head + "2 1 3 2 0 0 0\n1 1 10\n0 90 0 5 3\n"), {"lamp.ies", "photometric type 3"});
+}
+
 TEST(NearfieldRender, CryptWithShadowsAgainstTheExactLuminaire) {
   auto scene = lab::load_scene("crypt");
   SceneView sv(lab::diffuse_surfaces(scene), scene.name);
