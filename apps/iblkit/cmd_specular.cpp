@@ -25,7 +25,7 @@ void setup(CLI::App& app) {
     std::string probe, out, faces, latlong, irradiance, dfg, lod = "linear", frame = "iblkit";
     int size = 256, levels = 0, samples = 1024, irradiance_size = 32, dfg_size = 128;
   };
-  auto* o = new Opts();
+  auto* o = iblcli::app_owned<Opts>();
   app.add_option("probe", o->probe, "HDR probe image (or a folder of six cube faces); not needed for --dfg alone");
   app.add_option("-o,--out", o->out, "write the prefiltered cube map, every level, as KTX2 (RGBA16F)");
   app.add_option("-s,--size", o->size, "face size of level 0 (power of two, 8..4096)")->capture_default_str();
