@@ -135,6 +135,8 @@ def _rss_kb():
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
 
 
+@pytest.mark.skipif("libasan" in __import__("os").environ.get("LD_PRELOAD", ""),
+                    reason="AddressSanitizer keeps freed memory in quarantine, so the peak RSS grows by design")
 def test_memory_stays_flat_over_1000_calls(probe):
     def work():
         img = iblkit.convert(probe, "latlong", "latlong", size=16)
