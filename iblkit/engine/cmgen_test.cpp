@@ -300,7 +300,7 @@ std::string spot_probe(const fs::path& dir) {
 // difference is cmgen's lookup (CmgenModel): the model with Filament's offset 0, fed iblkit's own
 // level 0, reproduces cmgen to ≤ 1.3 %, and the same model with texel-centred reads reproduces
 // iblkit to ≤ 5.4 % (FIS against iblkit's exact sums). cmgen's offset moves its rough levels by half
-// a texel of the coarse level each sample reads — degrees — towards +s, +t of every face, and breaks
+// a texel of the coarse level each sample reads — degrees — towards −s, −t of every face, and breaks
 // two things every GGX prefilter keeps: ∫L̄ dω = ∫L dω (the normalised kernel is symmetric in r, l),
 // and agreement with the brute-force convolution (1). iblkit keeps both and stays texel-centred;
 // it does not reproduce the offset. Measured: bench/RESULTS.md ("Engine maps against Filament's cmgen").
