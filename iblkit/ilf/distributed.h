@@ -27,9 +27,11 @@ struct DistributedReport {
   double t_repair = 0;      // the repair's share of t_project
   double t_accumulate = 0;  // SH products of the own blocks
   double t_reduce = 0;      // MPI_Reduce of the partial SH sums onto rank 0
+  double t_crossval = 0;    // the cross-validated choice and error (own blocks' sampled buckets, their sums' reduce)
   int64_t bytes_sent = 0;       // samples this rank sent to other ranks (half floats), largest rank
   int64_t bytes_received = 0;   // samples this rank received from other ranks, largest rank
   int64_t bytes_reduced = 0;    // partial SH sums a rank sends in the reduce (8 bytes per value)
+  int64_t bytes_crossval = 0;   // partial cross-validation sums a rank sends in their reduce (8 bytes per value)
   int64_t peak_rss_bytes = 0;   // the largest rank's peak resident memory (VmHWM)
   int blocks_min = 0, blocks_max = 0;  // direction blocks per rank
   int chunk = 0;                // probes per read-and-exchange round of one rank
