@@ -85,9 +85,11 @@ class IlfMpi : public ::testing::Test {
     rd.skip_bad = skip_bad;
     return build_shgrid(read_sequence(manifest_, rd), bd);
   }
-  void expect_same(const SHGrid& a, const std::string& path, const std::string& what, bool error_volume = false) {
+  // Returns the worst relative difference (−1 when the sizes differ).
+  double expect_same(const SHGrid& a, const std::string& path, const std::string& what, bool error_volume = false) {
     SHGrid b = read_shgrid(path, error_volume);
-    ASSERT_EQ(a.data().size(), b.data().size()) << what;
+    EXPECT_EQ(a.data().size(), b.data().size()) << what;
+    if (a.data().size() != b.data().size()) return -1;
     int bad = 0;
     double worst = 0;
     for (size_t i = 0; i < a.data().size(); ++i) {
@@ -96,6 +98,7 @@ class IlfMpi : public ::testing::Test {
       if (x != 0) worst = std::max(worst, d / std::abs(x));
     }
     EXPECT_EQ(bad, 0) << what << ": " << bad << " of " << a.data().size() << " coefficients differ by more than 1e-6 (worst " << worst << ")";
+    return worst;
   }
   std::string dir_, manifest_;
 };
@@ -143,9 +146,10 @@ TEST_F(IlfMpi, CrossValidationAndChoiceAsSerial) {
   fixed.crossval.folds = 4;
   BuildDesc both = kauto;  // and the grid: two rounds of candidates, the second chosen by the first
   both.auto_grid = true;
+  both.buckets.memory_bytes = size_t(64) << 20;  // grids 8-24 (finer ones need more than half of it)
   std::vector<Case> cases = {{24, "--grid 6", kauto, {1, 2, 3}},
                              {24, "--grid 6 --kernel 2 --cv-folds 4", fixed, {3}},
-                             {24, "--grid auto", both, {3}},
+                             {24, "--grid auto --memory 64M", both, {3}},
                              {64, "--grid 6", kauto, {3}}};
   std::map<int, std::string> seqs;
   for (int size : {24, 64}) {
@@ -173,7 +177,7 @@ TEST_F(IlfMpi, CrossValidationAndChoiceAsSerial) {
       auto r = mpirun(n, fmt::format("{} {} --json --out {} --error-grid {} --buckets {}/cvb{}_{}", seqs[c.size], c.args, out, err,
                                      dir_, c.size, n));
       ASSERT_EQ(r.status, 0) << what << ":\n" << r.out;
-      std::printf("[ilf] mpi cv: %s: %.1f s\n", what.c_str(), std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+      double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       nlohmann::json j;
       ASSERT_NO_THROW(j = nlohmann::json::parse(r.out.substr(r.out.find('{')))) << r.out;
       ASSERT_TRUE(j.contains("crossval")) << what << ": " << r.out;
@@ -193,8 +197,10 @@ TEST_F(IlfMpi, CrossValidationAndChoiceAsSerial) {
           EXPECT_LT(std::abs(e - w), kRelTol * w) << what << ", trial " << i;
         }
       }
-      expect_same(grid, out, what);
-      expect_same(ev, err, what + " (error volume)", true);
+      double dg = expect_same(grid, out, what), de = expect_same(ev, err, what + " (error volume)", true);
+      std::printf("[ilf] mpi cv: %s (kernel %g, %dx%dx%d): cv error %.9f, relative difference to serial %.1e; grid %.1e, "
+                  "error volume %.1e (worst value); %.1f s\n", what.c_str(), want.kernel_cells, want.nx, want.ny, want.nz,
+                  want.crossval->rel_error, std::abs(got - want.crossval->rel_error) / want.crossval->rel_error, dg, de, seconds);
     }
   }
 }
