@@ -69,7 +69,7 @@ nlohmann::json report_json(const ilf::BuildReport& r) {
           {"buckets", r.buckets}, {"blocks", r.blocks}, {"octahedral", r.octahedral}, {"samples", r.samples},
           {"fraction_uncovered", r.fraction_uncovered}, {"buckets_reused", r.buckets_reused},
           {"seconds", {{"subsample", r.t_subsample}, {"sort", r.t_sort}, {"project", r.t_project}, {"repair", r.t_repair},
-                       {"accumulate", r.t_accumulate}, {"total", r.t_total}}},
+                       {"accumulate", r.t_accumulate}, {"crossval", r.t_choose + r.t_crossval}, {"total", r.t_total}}},
           {"gemm_gflop", r.gemm_flops * 1e-9}, {"resolution", {r.nx, r.ny, r.nz}}, {"kernel", r.kernel_cells},
           {"ball_radius", r.ball_radius},
           {"gemm_gflops_per_s", r.t_accumulate > 0 ? r.gemm_flops * 1e-9 / r.t_accumulate : 0.0},
