@@ -20,7 +20,7 @@ check run ok "ranks     2:" -- timeout 300 "${MPIRUN[@]}" -np 2 "$BIN" ilf build
 n=$(timeout 300 "${MPIRUN[@]}" -np 2 "$BIN" ilf build "$S" "${ARGS[@]}" --out "$T/ref2.shgrid" | grep -c "^wrote ")
 if [ "$n" = 1 ]; then pass=$((pass+1)); else echo "FAIL one-report: $n reports"; fail=$((fail+1)); fi
 
-# Kill rank 1 while it projects (the buckets reused from above make the sort instant).
+# Kill rank 1 while it cross-validates or projects (the buckets reused from above make the sort instant).
 timeout 300 "${MPIRUN[@]}" -np 2 "$BIN" --quiet ilf build "$S" "${ARGS[@]}" --out "$T/killed.shgrid" >"$T/killed.log" 2>&1 &
 job=$!
 victim=""
