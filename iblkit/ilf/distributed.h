@@ -1,9 +1,10 @@
 // The ILF build on a cluster (issue 18, docs/ilf.md "On a cluster"): `mpirun -np N iblkit ilf build …`
 // runs build_shgrid's phases split between the N processes of an MPI job and gives the serial build's
 // grid (to float rounding). Ranks own contiguous ranges of direction blocks; each reads a disjoint
-// slice of the probe frames, sends every block's samples to its owner (MPI_Alltoallv), projects,
-// repairs and accumulates its own blocks, and the partial SH sums meet on rank 0 (MPI_Reduce), which
-// returns the grid. MPI itself lives in the "mpi" plugin (ilf/mpi/, built with IBLKIT_WITH_MPI); this
+// slice of the probe frames, sends every block's samples to its owner (MPI_Alltoallv), cross-validates
+// (and chooses kernel and grid) on the sampled buckets of its own blocks, those sums meeting on every
+// rank, projects, repairs and accumulates its own blocks, and the partial SH sums meet on rank 0
+// (MPI_Reduce), which returns the grid. MPI itself lives in the "mpi" plugin (ilf/mpi/, built with IBLKIT_WITH_MPI); this
 // header is what the rest of iblkit sees of it.
 #pragma once
 #include <cstdint>
