@@ -69,7 +69,7 @@ nlohmann::json report_json(const ilf::BuildReport& r) {
           {"buckets", r.buckets}, {"blocks", r.blocks}, {"octahedral", r.octahedral}, {"samples", r.samples},
           {"fraction_uncovered", r.fraction_uncovered}, {"buckets_reused", r.buckets_reused},
           {"seconds", {{"subsample", r.t_subsample}, {"sort", r.t_sort}, {"project", r.t_project}, {"repair", r.t_repair},
-                       {"accumulate", r.t_accumulate}, {"total", r.t_total}}},
+                       {"accumulate", r.t_accumulate}, {"crossval", r.t_choose + r.t_crossval}, {"total", r.t_total}}},
           {"gemm_gflop", r.gemm_flops * 1e-9}, {"resolution", {r.nx, r.ny, r.nz}}, {"kernel", r.kernel_cells},
           {"ball_radius", r.ball_radius},
           {"gemm_gflops_per_s", r.t_accumulate > 0 ? r.gemm_flops * 1e-9 / r.t_accumulate : 0.0},
@@ -103,8 +103,9 @@ bool is_auto(const std::string& s) { return s == "auto"; }
 nlohmann::json mpi_json(const ilf::DistributedReport& d) {
   return {{"ranks", d.ranks}, {"chunk", d.chunk}, {"blocks_per_rank", {d.blocks_min, d.blocks_max}},
           {"seconds", {{"subsample", d.t_subsample}, {"read", d.t_read}, {"exchange", d.t_exchange}, {"project", d.t_project},
-                       {"repair", d.t_repair}, {"accumulate", d.t_accumulate}, {"reduce", d.t_reduce}}},
+                       {"repair", d.t_repair}, {"accumulate", d.t_accumulate}, {"reduce", d.t_reduce}, {"crossval", d.t_crossval}}},
           {"bytes_sent", d.bytes_sent}, {"bytes_received", d.bytes_received}, {"bytes_reduced", d.bytes_reduced},
+          {"bytes_crossval", d.bytes_crossval},
           {"peak_rss_bytes", d.peak_rss_bytes}};
 }
 
@@ -205,9 +206,9 @@ void run_build(const BuildOptions& opts, const ilf::SequenceReadDesc& rd, const 
     fmt::print("time      sort {:.1f}s, project+repair {:.1f}s, SH products {:.1f}s ({:.1f} GFLOP/s), total {:.1f}s\n", rep.t_sort,
                rep.t_project, rep.t_accumulate, rep.gemm_flops * 1e-9 / std::max(rep.t_accumulate, 1e-9), rep.t_total);
     if (job)
-      fmt::print("ranks     {}: read {:.1f}s, exchange {:.1f}s ({:.3g} MB sent by the busiest rank), project {:.1f}s "
-                 "(repair {:.1f}s), SH {:.1f}s, reduce {:.1f}s, write {:.1f}s; peak memory {:.0f} MB per rank\n",
-                 drep.ranks, drep.t_read, drep.t_exchange, drep.bytes_sent * 1e-6, drep.t_project, drep.t_repair,
+      fmt::print("ranks     {}: read {:.1f}s, exchange {:.1f}s ({:.3g} MB sent by the busiest rank), cross-validation {:.1f}s, "
+                 "project {:.1f}s (repair {:.1f}s), SH {:.1f}s, reduce {:.1f}s, write {:.1f}s; peak memory {:.0f} MB per rank\n",
+                 drep.ranks, drep.t_read, drep.t_exchange, drep.bytes_sent * 1e-6, drep.t_crossval, drep.t_project, drep.t_repair,
                  drep.t_accumulate, drep.t_reduce, t_write, drep.peak_rss_bytes * 1e-6);
   });
 }
@@ -280,18 +281,6 @@ void setup_build(CLI::App& app) {
     ilf::SequenceReadDesc rd;
     rd.skip_bad = bd.buckets.skip_bad;
     if (o->mpi || ilf::launched_by_mpi()) {
-      // The cross-validated choice and error need the whole bucket store on one rank: not distributed yet.
-      auto given = [&](const char* name) { return app.get_option(name)->count() > 0; };
-      if ((bd.auto_kernel && given("--kernel")) || (bd.auto_grid && given("--grid")) || !o->error_grid.empty() ||
-          (bd.crossval.folds >= 2 && given("--cv-folds")))
-        fail(ErrorKind::Unsupported, "under MPI the build does not cross-validate yet: give --kernel W and --grid N (no --error-grid, "
-             "--cv-folds 0), or build on one machine");
-      if (bd.auto_kernel) {
-        bd.auto_kernel = false;
-        bd.project.kernel_cells = ilf::BuildDesc{}.project.kernel_cells;
-        iblcli::info(fmt::format("under MPI the kernel is not cross-validated: {:g} grid cells (--kernel to choose)", bd.project.kernel_cells));
-      }
-      bd.crossval.folds = 0;
       ilf::run_mpi_job([&](ilf::MpiJob& job) { run_build(*o, rd, bd, &job); });
     } else {
       run_build(*o, rd, bd, nullptr);
