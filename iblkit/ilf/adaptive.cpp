@@ -1,0 +1,224 @@
+#include "iblkit/ilf/adaptive.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+
+#include "iblkit/core/check.h"
+#include "iblkit/core/error.h"
+#include "iblkit/core/parallel.h"
+#include "iblkit/sh/convolve.h"
+
+namespace ibl::ilf {
+
+namespace {
+
+// Level point i along an axis of n fine points at step s: fine index min(i·s, n − 1).
+inline int level_coord(int i, int s, int n) { return int(std::min<int64_t>(int64_t(i) * s, n - 1)); }
+
+}  // namespace
+
+AdaptiveGrid::AdaptiveGrid(const GridDesc& grid, int bands, int brick) : grid_(grid), bands_(bands), brick_(brick) {
+  SHGrid check(GridDesc{2, 2, 2, grid.volume}, bands);  // the volume and bands as SHGrid checks them
+  (void)check;
+  if (brick < kMinBrick || brick > kMaxBrick) fail(ErrorKind::Value, "adaptive SH grid: brick {} outside [{}, {}]", brick, kMinBrick, kMaxBrick);
+  const int n[3] = {grid.nx, grid.ny, grid.nz};
+  for (int a = 0; a < 3; ++a)
+    if (n[a] < 2 || n[a] > (1 << 20)) fail(ErrorKind::Value, "adaptive SH grid: {} points on axis {} outside [2, 2^20]", n[a], "xyz"[a]);
+  for (int step = 1;; step *= 2) {
+    Level L;
+    L.step = step;
+    int64_t cells = 1;
+    for (int a = 0; a < 3; ++a) {
+      L.n[a] = (n[a] - 1 + step - 1) / step + 1;
+      L.nb[a] = (L.n[a] - 1 + brick - 1) / brick;
+      cells *= L.nb[a];
+    }
+    require_allocation("adaptive SH grid: brick map", double(cells), sizeof(int32_t), "choose a coarser grid or larger bricks");
+    L.map.assign(size_t(cells), -1);
+    levels_.push_back(std::move(L));
+    const auto& last = levels_.back();
+    if (last.n[0] == 2 && last.n[1] == 2 && last.n[2] == 2) break;
+  }
+}
+
+float* AdaptiveGrid::add_brick(int l, int bx, int by, int bz) {
+  if (l < 0 || l >= levels()) fail(ErrorKind::Value, "adaptive SH grid: level {} outside [0, {}]", l, levels() - 1);
+  Level& L = levels_[size_t(l)];
+  const int b[3] = {bx, by, bz};
+  for (int a = 0; a < 3; ++a)
+    if (b[a] < 0 || b[a] >= L.nb[a])
+      fail(ErrorKind::Value, "adaptive SH grid: brick ({}, {}, {}) lies outside level {}'s {}x{}x{} bricks", bx, by, bz, l, L.nb[0], L.nb[1], L.nb[2]);
+  int32_t& slot = L.map[size_t((int64_t(bz) * L.nb[1] + by) * L.nb[0] + bx)];
+  if (slot >= 0) fail(ErrorKind::Value, "adaptive SH grid: brick ({}, {}, {}) of level {} given twice", bx, by, bz, l);
+  Brick br{};
+  int64_t pts = 1;
+  for (int a = 0; a < 3; ++a) {
+    br.b[a] = b[a];
+    br.extent[a] = std::min(brick_, L.n[a] - 1 - b[a] * brick_) + 1;
+    pts *= br.extent[a];
+  }
+  br.offset = data_.size();
+  require_allocation("adaptive SH grid: values", double(data_.size() + size_t(pts) * coeff_count() * 3), sizeof(float),
+                     "choose a larger tolerance or a coarser fine grid");
+  slot = int32_t(L.bricks.size());
+  L.bricks.push_back(br);
+  data_.resize(data_.size() + size_t(pts) * coeff_count() * 3, 0.0f);
+  return data_.data() + br.offset;
+}
+
+int AdaptiveGrid::lookup(const double f_in[3], double* out) const {
+  const int KC = coeff_count() * 3;
+  std::fill(out, out + KC, 0.0);
+  if (levels_.empty()) return -1;
+  const int n[3] = {grid_.nx, grid_.ny, grid_.nz};
+  double f[3];
+  for (int a = 0; a < 3; ++a) f[a] = std::isnan(f_in[a]) ? 0.0 : std::clamp(f_in[a], 0.0, double(n[a] - 1));
+  for (int l = 0; l < levels(); ++l) {
+    const Level& L = levels_[size_t(l)];
+    int cell[3], bi[3];
+    for (int a = 0; a < 3; ++a) {
+      // The cell (and so the brick) of a point within 1e-7 cells of a fine point is that fine point's:
+      // the one make_adaptive checked it in (a world coordinate may miss its index by an ulp).
+      double r = std::round(f[a]), fc = std::abs(f[a] - r) < 1e-7 ? r : f[a];
+      cell[a] = std::min(int(fc / L.step), L.n[a] - 2);  // f/1 = f at level 0: SHGrid's cell
+      bi[a] = cell[a] / brick_;
+    }
+    int32_t idx = L.map[size_t((int64_t(bi[2]) * L.nb[1] + bi[1]) * L.nb[0] + bi[0])];
+    if (idx < 0) continue;
+    const Brick& br = L.bricks[size_t(idx)];
+    double t[3];
+    int loc[3];
+    for (int a = 0; a < 3; ++a) {
+      int x0 = level_coord(cell[a], L.step, n[a]), x1 = level_coord(cell[a] + 1, L.step, n[a]);
+      t[a] = (f[a] - x0) / double(x1 - x0);  // (f − i0)/1 at level 0: SHGrid's weight, bit for bit
+      loc[a] = cell[a] - br.b[a] * brick_;
+    }
+    const float* base = data_.data() + br.offset;
+    for (int c = 0; c < 8; ++c) {
+      double w = ((c & 1) ? t[0] : 1 - t[0]) * ((c & 2) ? t[1] : 1 - t[1]) * ((c & 4) ? t[2] : 1 - t[2]);
+      if (w == 0) continue;
+      const float* src = base + size_t((int64_t(loc[2] + (c >> 2)) * br.extent[1] + loc[1] + ((c >> 1) & 1)) * br.extent[0] +
+                                       loc[0] + (c & 1)) * KC;
+      for (int j = 0; j < KC; ++j) out[j] += src[j] * w;
+    }
+    return l;
+  }
+  return -1;  // unreachable once the top brick is there (make_adaptive, read_adaptive)
+}
+
+Vec3 AdaptiveGrid::fine_index(Vec3 p) const {
+  if (!is_finite(p)) fail(ErrorKind::Value, "adaptive SH grid lookup: the point ({}, {}, {}) is not finite", p.x, p.y, p.z);
+  Vec3 s = grid_.volume.size();
+  return {(p.x - grid_.volume.min.x) / s.x * (grid_.nx - 1), (p.y - grid_.volume.min.y) / s.y * (grid_.ny - 1),
+          (p.z - grid_.volume.min.z) / s.z * (grid_.nz - 1)};
+}
+
+sh::Coeffs AdaptiveGrid::coeffs_at(Vec3 p) const {
+  Vec3 fi = fine_index(p);
+  const double f[3] = {fi.x, fi.y, fi.z};
+  std::vector<double> v(size_t(coeff_count()) * 3);
+  lookup(f, v.data());
+  sh::Coeffs out;
+  out.bands = bands_;
+  out.c.resize(size_t(coeff_count()));
+  for (int k = 0; k < coeff_count(); ++k) out.c[size_t(k)] = {v[3 * size_t(k)], v[3 * size_t(k) + 1], v[3 * size_t(k) + 2]};
+  return out;
+}
+
+int AdaptiveGrid::level_at(Vec3 p) const {
+  Vec3 fi = fine_index(p);
+  const double f[3] = {fi.x, fi.y, fi.z};
+  std::vector<double> v(size_t(coeff_count()) * 3);
+  return lookup(f, v.data());
+}
+
+Vec3 AdaptiveGrid::irradiance(Vec3 p, Vec3 n) const { return sh::irradiance_at(coeffs_at(p), normalize(n)); }
+Vec3 AdaptiveGrid::radiance(Vec3 p, Vec3 w) const { return sh_radiance(coeffs_at(p), w); }
+Vec3 AdaptiveGrid::glossy(Vec3 p, Vec3 r, double exponent) const {
+  if (!(exponent >= 0)) fail(ErrorKind::Value, "glossy: Phong exponent {} must be ≥ 0", exponent);
+  return sh_glossy(coeffs_at(p), r, exponent);
+}
+
+SHGrid AdaptiveGrid::to_dense(int nx, int ny, int nz) const {
+  SHGrid out(GridDesc{nx, ny, nz, grid_.volume}, bands_);
+  const int KC = coeff_count() * 3;
+  const int N[3] = {nx, ny, nz}, n[3] = {grid_.nx, grid_.ny, grid_.nz};
+  parallel_for(0, int64_t(nz) * ny, [&](int64_t zy) {
+    std::vector<double> v(static_cast<size_t>(KC));
+    int k = int(zy / ny), j = int(zy % ny);
+    for (int i = 0; i < nx; ++i) {
+      const int ijk[3] = {i, j, k};
+      double f[3];
+      for (int a = 0; a < 3; ++a) f[a] = double(ijk[a]) * (n[a] - 1) / (N[a] - 1);  // = i exactly at the fine resolution
+      lookup(f, v.data());
+      float* dst = out.at(i, j, k);
+      for (int q = 0; q < KC; ++q) dst[q] = float(v[size_t(q)]);
+    }
+  });
+  return out;
+}
+
+AdaptiveGrid make_adaptive(const SHGrid& fine, const AdaptDesc& desc) {
+  if (!fine.content().empty()) fail(ErrorKind::Value, "adaptive SH grid: the grid holds \"{}\", not radiance SH", fine.content());
+  if (fine.data().empty()) fail(ErrorKind::Value, "adaptive SH grid: the fine grid is empty");
+  require_number("adaptive SH grid: tolerance", desc.tolerance, 0, 1e6);
+  const GridDesc& gd = fine.grid();
+  AdaptiveGrid tree(gd, fine.bands(), desc.brick);
+  const int KC = fine.coeff_count() * 3;
+  const int n[3] = {gd.nx, gd.ny, gd.nz};
+  double sum = 0;
+  for (float v : fine.data()) sum += double(v) * v;
+  const double rms = std::sqrt(sum / double(gd.count()));
+  const double bound = desc.tolerance * rms;
+  tree.set_tolerance(desc.tolerance, rms);
+  auto fill = [&](int l, const int b[3]) {
+    const auto& L = tree.level(l);
+    float* dst = tree.add_brick(l, b[0], b[1], b[2]);
+    const auto& br = tree.level(l).bricks.back();
+    for (int z = 0; z < br.extent[2]; ++z)
+      for (int y = 0; y < br.extent[1]; ++y)
+        for (int x = 0; x < br.extent[0]; ++x) {
+          const float* src = fine.at(level_coord(b[0] * desc.brick + x, L.step, n[0]), level_coord(b[1] * desc.brick + y, L.step, n[1]),
+                                     level_coord(b[2] * desc.brick + z, L.step, n[2]));
+          std::copy(src, src + KC, dst + size_t((int64_t(z) * br.extent[1] + y) * br.extent[0] + x) * KC);
+        }
+  };
+  const int top = tree.levels() - 1;
+  const int origin[3] = {0, 0, 0};
+  fill(top, origin);
+  // Top down: a brick of level l is kept where the tree of the levels above misses a fine point that
+  // the lookup would answer from it. Its points are then answered at level l or finer, and a point no
+  // finer brick covers was within the bound when its level-(m−1) brick was left out.
+  for (int l = top - 1; l >= 0; --l) {
+    const auto& L = tree.level(l);
+    std::vector<uint8_t> need(L.map.size(), 0);
+    parallel_for(0, int64_t(gd.nz) * gd.ny, [&](int64_t zy) {
+      std::vector<double> v(static_cast<size_t>(KC));
+      const int k = int(zy / gd.ny), j = int(zy % gd.ny);
+      for (int i = 0; i < gd.nx; ++i) {
+        const int ijk[3] = {i, j, k};
+        int bi[3];
+        for (int a = 0; a < 3; ++a) bi[a] = std::min(ijk[a] / L.step, L.n[a] - 2) / desc.brick;
+        const size_t slot = size_t((int64_t(bi[2]) * L.nb[1] + bi[1]) * L.nb[0] + bi[0]);
+        if (std::atomic_ref<uint8_t>(need[slot]).load(std::memory_order_relaxed)) continue;
+        const double f[3] = {double(i), double(j), double(k)};
+        tree.lookup(f, v.data());
+        const float* src = fine.at(i, j, k);
+        double e = 0;
+        for (int q = 0; q < KC; ++q) e += (v[size_t(q)] - src[q]) * (v[size_t(q)] - src[q]);
+        if (std::sqrt(e) > bound) std::atomic_ref<uint8_t>(need[slot]).store(1, std::memory_order_relaxed);
+      }
+    });
+    for (int bz = 0; bz < L.nb[2]; ++bz)
+      for (int by = 0; by < L.nb[1]; ++by)
+        for (int bx = 0; bx < L.nb[0]; ++bx)
+          if (need[size_t((int64_t(bz) * L.nb[1] + by) * L.nb[0] + bx)]) {
+            const int b[3] = {bx, by, bz};
+            fill(l, b);
+          }
+  }
+  return tree;
+}
+
+}  // namespace ibl::ilf
