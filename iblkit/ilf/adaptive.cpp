@@ -31,7 +31,7 @@ AdaptiveGrid::AdaptiveGrid(const GridDesc& grid, int bands, int brick) : grid_(g
     int64_t cells = 1;
     for (int a = 0; a < 3; ++a) {
       L.n[a] = (n[a] - 1 + step - 1) / step + 1;
-      L.nb[a] = (L.n[a] - 1 + brick - 1) / brick;
+      L.nb[a] = (L.n[a] + brick - 1) / brick;
       cells *= L.nb[a];
     }
     require_allocation("adaptive SH grid: brick map", double(cells), sizeof(int32_t), "choose a coarser grid or larger bricks");
@@ -55,7 +55,7 @@ float* AdaptiveGrid::add_brick(int l, int bx, int by, int bz) {
   int64_t pts = 1;
   for (int a = 0; a < 3; ++a) {
     br.b[a] = b[a];
-    br.extent[a] = std::min(brick_, L.n[a] - 1 - b[a] * brick_) + 1;
+    br.extent[a] = std::min(brick_, L.n[a] - b[a] * brick_);
     pts *= br.extent[a];
   }
   br.offset = data_.size();
@@ -67,40 +67,79 @@ float* AdaptiveGrid::add_brick(int l, int bx, int by, int bz) {
   return data_.data() + br.offset;
 }
 
+namespace {
+
+// The cell of level L around fine index coordinates f (clamped), per axis: its lower corner, and the
+// bricks and in-brick coordinates of its two corners.
+struct CellAxes {
+  int cell[3], brick[2][3], local[2][3];
+};
+
+CellAxes cell_of(const AdaptiveGrid::Level& L, int B, const double f[3]) {
+  CellAxes c;
+  for (int a = 0; a < 3; ++a) {
+    // The cell (and so the bricks) of a point within 1e-7 cells of a fine point is that fine point's:
+    // the one make_adaptive checked it in (a world coordinate may miss its index by an ulp).
+    double r = std::round(f[a]), fc = std::abs(f[a] - r) < 1e-7 ? r : f[a];
+    c.cell[a] = std::min(int(fc / L.step), L.n[a] - 2);  // f/1 = f at level 0: SHGrid's cell
+    for (int e = 0; e < 2; ++e) {
+      c.brick[e][a] = (c.cell[a] + e) / B;
+      c.local[e][a] = c.cell[a] + e - c.brick[e][a] * B;
+    }
+  }
+  return c;
+}
+
+size_t slot_of(const AdaptiveGrid::Level& L, const CellAxes& c, int corner) {
+  return size_t((int64_t(c.brick[corner >> 2][2]) * L.nb[1] + c.brick[(corner >> 1) & 1][1]) * L.nb[0] + c.brick[corner & 1][0]);
+}
+
+void clamp_index(const GridDesc& g, const double in[3], double out[3]) {
+  const int n[3] = {g.nx, g.ny, g.nz};
+  for (int a = 0; a < 3; ++a) out[a] = std::isnan(in[a]) ? 0.0 : std::clamp(in[a], 0.0, double(n[a] - 1));
+}
+
+}  // namespace
+
+void AdaptiveGrid::corner_slots(int l, const double f_in[3], size_t corners[8]) const {
+  double f[3];
+  clamp_index(grid_, f_in, f);
+  const Level& L = levels_[size_t(l)];
+  CellAxes c = cell_of(L, brick_, f);
+  for (int k = 0; k < 8; ++k) corners[k] = slot_of(L, c, k);
+}
+
 int AdaptiveGrid::lookup(const double f_in[3], double* out) const {
   const int KC = coeff_count() * 3;
   std::fill(out, out + KC, 0.0);
-  if (levels_.empty()) return -1;
   const int n[3] = {grid_.nx, grid_.ny, grid_.nz};
   double f[3];
-  for (int a = 0; a < 3; ++a) f[a] = std::isnan(f_in[a]) ? 0.0 : std::clamp(f_in[a], 0.0, double(n[a] - 1));
+  clamp_index(grid_, f_in, f);
   for (int l = 0; l < levels(); ++l) {
     const Level& L = levels_[size_t(l)];
-    int cell[3], bi[3];
-    for (int a = 0; a < 3; ++a) {
-      // The cell (and so the brick) of a point within 1e-7 cells of a fine point is that fine point's:
-      // the one make_adaptive checked it in (a world coordinate may miss its index by an ulp).
-      double r = std::round(f[a]), fc = std::abs(f[a] - r) < 1e-7 ? r : f[a];
-      cell[a] = std::min(int(fc / L.step), L.n[a] - 2);  // f/1 = f at level 0: SHGrid's cell
-      bi[a] = cell[a] / brick_;
+    CellAxes c = cell_of(L, brick_, f);
+    const float* src[8];
+    bool complete = true;
+    for (int k = 0; k < 8 && complete; ++k) {
+      int32_t idx = L.map[slot_of(L, c, k)];
+      if (idx < 0) {
+        complete = false;
+        break;
+      }
+      const Brick& br = L.bricks[size_t(idx)];
+      const int x = c.local[k & 1][0], y = c.local[(k >> 1) & 1][1], z = c.local[k >> 2][2];
+      src[k] = data_.data() + br.offset + size_t((int64_t(z) * br.extent[1] + y) * br.extent[0] + x) * KC;
     }
-    int32_t idx = L.map[size_t((int64_t(bi[2]) * L.nb[1] + bi[1]) * L.nb[0] + bi[0])];
-    if (idx < 0) continue;
-    const Brick& br = L.bricks[size_t(idx)];
+    if (!complete) continue;
     double t[3];
-    int loc[3];
     for (int a = 0; a < 3; ++a) {
-      int x0 = level_coord(cell[a], L.step, n[a]), x1 = level_coord(cell[a] + 1, L.step, n[a]);
+      int x0 = level_coord(c.cell[a], L.step, n[a]), x1 = level_coord(c.cell[a] + 1, L.step, n[a]);
       t[a] = (f[a] - x0) / double(x1 - x0);  // (f − i0)/1 at level 0: SHGrid's weight, bit for bit
-      loc[a] = cell[a] - br.b[a] * brick_;
     }
-    const float* base = data_.data() + br.offset;
-    for (int c = 0; c < 8; ++c) {
-      double w = ((c & 1) ? t[0] : 1 - t[0]) * ((c & 2) ? t[1] : 1 - t[1]) * ((c & 4) ? t[2] : 1 - t[2]);
+    for (int k = 0; k < 8; ++k) {
+      double w = ((k & 1) ? t[0] : 1 - t[0]) * ((k & 2) ? t[1] : 1 - t[1]) * ((k & 4) ? t[2] : 1 - t[2]);
       if (w == 0) continue;
-      const float* src = base + size_t((int64_t(loc[2] + (c >> 2)) * br.extent[1] + loc[1] + ((c >> 1) & 1)) * br.extent[0] +
-                                       loc[0] + (c & 1)) * KC;
-      for (int j = 0; j < KC; ++j) out[j] += src[j] * w;
+      for (int j = 0; j < KC; ++j) out[j] += src[k][j] * w;
     }
     return l;
   }
@@ -187,9 +226,10 @@ AdaptiveGrid make_adaptive(const SHGrid& fine, const AdaptDesc& desc) {
   const int top = tree.levels() - 1;
   const int origin[3] = {0, 0, 0};
   fill(top, origin);
-  // Top down: a brick of level l is kept where the tree of the levels above misses a fine point that
-  // the lookup would answer from it. Its points are then answered at level l or finer, and a point no
-  // finer brick covers was within the bound when its level-(m−1) brick was left out.
+  // Top down: where the levels above miss a fine point by more than the bound, the corner bricks of
+  // its level-l cell are stored; it is then answered at level l or finer. A fine point answered at
+  // level m > 0 was within the bound when level m−1 was decided (else its cell there would be
+  // complete), and the levels from m up have not changed since.
   for (int l = top - 1; l >= 0; --l) {
     const auto& L = tree.level(l);
     std::vector<uint8_t> need(L.map.size(), 0);
@@ -197,17 +237,18 @@ AdaptiveGrid make_adaptive(const SHGrid& fine, const AdaptDesc& desc) {
       std::vector<double> v(static_cast<size_t>(KC));
       const int k = int(zy / gd.ny), j = int(zy % gd.ny);
       for (int i = 0; i < gd.nx; ++i) {
-        const int ijk[3] = {i, j, k};
-        int bi[3];
-        for (int a = 0; a < 3; ++a) bi[a] = std::min(ijk[a] / L.step, L.n[a] - 2) / desc.brick;
-        const size_t slot = size_t((int64_t(bi[2]) * L.nb[1] + bi[1]) * L.nb[0] + bi[0]);
-        if (std::atomic_ref<uint8_t>(need[slot]).load(std::memory_order_relaxed)) continue;
         const double f[3] = {double(i), double(j), double(k)};
+        size_t slots[8];
+        tree.corner_slots(l, f, slots);
+        bool all = true;
+        for (size_t s : slots) all = all && std::atomic_ref<uint8_t>(need[s]).load(std::memory_order_relaxed);
+        if (all) continue;
         tree.lookup(f, v.data());
         const float* src = fine.at(i, j, k);
         double e = 0;
         for (int q = 0; q < KC; ++q) e += (v[size_t(q)] - src[q]) * (v[size_t(q)] - src[q]);
-        if (std::sqrt(e) > bound) std::atomic_ref<uint8_t>(need[slot]).store(1, std::memory_order_relaxed);
+        if (std::sqrt(e) > bound)
+          for (size_t s : slots) std::atomic_ref<uint8_t>(need[s]).store(1, std::memory_order_relaxed);
       }
     });
     for (int bz = 0; bz < L.nb[2]; ++bz)
@@ -218,7 +259,34 @@ AdaptiveGrid make_adaptive(const SHGrid& fine, const AdaptDesc& desc) {
             fill(l, b);
           }
   }
-  return tree;
+  // The bricks some lookup reads: the answering level of every fine cell is that of its centre (coarse
+  // cells are unions of fine ones; a point on a face answers as the cell above it, one of them).
+  std::vector<std::vector<uint8_t>> used(size_t(tree.levels()));
+  for (int l = 0; l < tree.levels(); ++l) used[size_t(l)].assign(tree.level(l).map.size(), 0);
+  used[size_t(top)][0] = 1;  // the format needs the top brick
+  parallel_for(0, int64_t(gd.nz - 1) * (gd.ny - 1), [&](int64_t zy) {
+    std::vector<double> v(static_cast<size_t>(KC));
+    const int k = int(zy / (gd.ny - 1)), j = int(zy % (gd.ny - 1));
+    for (int i = 0; i + 1 < gd.nx; ++i) {
+      const double f[3] = {i + 0.5, j + 0.5, k + 0.5};
+      const int l = tree.lookup(f, v.data());
+      size_t slots[8];
+      tree.corner_slots(l, f, slots);
+      for (size_t s : slots) std::atomic_ref<uint8_t>(used[size_t(l)][s]).store(1, std::memory_order_relaxed);
+    }
+  });
+  AdaptiveGrid out(gd, fine.bands(), desc.brick);
+  out.set_tolerance(desc.tolerance, rms);
+  for (int l = top; l >= 0; --l) {
+    const auto& L = tree.level(l);
+    for (const auto& br : L.bricks) {
+      if (!used[size_t(l)][size_t((int64_t(br.b[2]) * L.nb[1] + br.b[1]) * L.nb[0] + br.b[0])]) continue;
+      float* dst = out.add_brick(l, br.b[0], br.b[1], br.b[2]);
+      const size_t n = size_t(br.extent[0]) * br.extent[1] * br.extent[2] * KC;
+      std::copy(tree.data().data() + br.offset, tree.data().data() + br.offset + n, dst);
+    }
+  }
+  return out;
 }
 
 }  // namespace ibl::ilf

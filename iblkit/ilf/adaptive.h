@@ -1,16 +1,17 @@
 // An adaptive SH grid (issue 15 §4; Löw et al. 2009 §5.3, §6): the coefficients of a dense fine grid
 // (SHGrid) kept at full resolution only where a coarser level's trilinear interpolation misses them.
 // Level 0 is the fine grid, level l+1 halves level l's resolution (every 2^l-th fine point per axis,
-// the last fine point always included), up to the top level of 2 points per axis. Each level is
-// stored as bricks of `brick` cells per axis ((brick+1)³ points, faces shared with the neighbours
-// duplicated); the top level is one brick. A lookup answers from the finest level that has a brick
-// covering the point, trilinearly there, so where level 0 is kept it returns exactly what the fine
-// SHGrid returns (bit for bit; within rounding closer than 1e-7 cells to a grid point, where the cell
-// is chosen as that point's). make_adaptive keeps a brick where the tree without it misses some fine point of it by
-// more than tolerance · (RMS over the fine points of the coefficient vector's L2 norm): at every fine
-// point the lookup is within that bound, so the tree's relative L2 difference to the fine grid is at
-// most `tolerance`. File format .shtree (docs/formats.md): like .shgrid, a magic line, a JSON header
-// padded to 64 bytes, then per level (top first) the brick table (int32) and the bricks' float32 values.
+// the last fine point always included), up to the top level of 2 points per axis. Each level's points
+// are stored in bricks of `brick`³ points (fewer at the level's far faces; no point stored twice).
+// A lookup answers from the finest level whose cell around the point has all 8 corners stored,
+// trilinearly there; so where level 0 is kept it returns exactly what the fine SHGrid returns (bit for
+// bit; within rounding closer than 1e-7 cells to a grid point, where the cell is chosen as that
+// point's). make_adaptive, top down, stores the corner bricks of a level's cell wherever the levels
+// above miss a fine point in it by more than tolerance · (RMS over the fine points of the coefficient
+// vector's L2 norm): at every fine point the lookup is then within that bound, so the tree's relative
+// L2 difference to the fine grid is at most `tolerance`; bricks no lookup reaches are left out.
+// File format .shtree (docs/formats.md): like .shgrid, a magic line, a JSON header padded to 64
+// bytes, then per level (top first) the brick table (int32) and the bricks' float32 values.
 // Renderers take a dense grid: to_dense (read_dense) resamples, the GL path (docs/ilf.md).
 #pragma once
 #include <cstdint>
@@ -25,20 +26,20 @@ inline constexpr int kMinBrick = 2, kMaxBrick = 16;
 
 struct AdaptDesc {
   double tolerance = 0.01;  // per fine point: ‖coefficients − fine‖₂ ≤ tolerance · RMS of ‖fine‖₂
-  int brick = 4;            // cells per brick axis, in [kMinBrick, kMaxBrick]
+  int brick = 4;            // points per brick axis, in [kMinBrick, kMaxBrick]
 };
 
 class AdaptiveGrid {
  public:
   struct Brick {
     int b[3];       // brick coordinates in the level's brick grid
-    int extent[3];  // points per axis (brick + 1, fewer at the level's far faces)
+    int extent[3];  // points per axis (brick, fewer at the level's far faces)
     size_t offset;  // of its first value in data(); values at ((z·ey + y)·ex + x)·K·3 + k·3 + c
   };
   struct Level {
     int step = 1;                // fine points between this level's points (the last cell may be shorter)
     int n[3] = {2, 2, 2};        // points per axis: ⌈(fine − 1)/step⌉ + 1
-    int nb[3] = {1, 1, 1};       // bricks per axis: ⌈(n − 1)/brick⌉
+    int nb[3] = {1, 1, 1};       // bricks per axis: ⌈n/brick⌉
     std::vector<int32_t> map;    // brick index per brick-grid cell (x fastest), −1 where pruned
     std::vector<Brick> bricks;
   };
@@ -67,8 +68,10 @@ class AdaptiveGrid {
   float* add_brick(int l, int bx, int by, int bz);
 
   // The K·3 coefficients at fine-grid index coordinates f (clamped to [0, n − 1]), as doubles; returns
-  // the level that answered.
+  // the level that answered. With `corners`, the 8 brick slots (indices into level(l).map, corner c at
+  // x + (c & 1), y + (c >> 1 & 1), z + (c >> 2)) of the cell of level l around f instead: no lookup.
   int lookup(const double f[3], double* out) const;
+  void corner_slots(int l, const double f[3], size_t corners[8]) const;
   // Trilinear lookup at p (clamped to the volume), as SHGrid::coeffs_at.
   sh::Coeffs coeffs_at(Vec3 p) const;
   int level_at(Vec3 p) const;  // the level whose brick answers at p

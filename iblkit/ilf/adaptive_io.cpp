@@ -156,7 +156,7 @@ AdaptiveGrid read_adaptive(const std::string& path) {
   for (int l = levels - 1; l >= 0; --l) {
     const auto& L = g.level(l);
     const int64_t count = counts[size_t(l)];
-    if (double(count) * (12 + 8.0 * KC * 4) > file_bytes - pos)  // each brick: its entry and at least 2³ points
+    if (double(count) * (12 + 4.0 * KC) > file_bytes - pos)  // each brick: its entry and at least one point
       fail(ErrorKind::Format, "{}: truncated: level {}'s {} bricks need more than the {:.0f} bytes left", path, l, count, std::max(0.0, file_bytes - pos));
     std::vector<int32_t> table(size_t(count) * 3);
     in.read(reinterpret_cast<char*>(table.data()), std::streamsize(table.size() * 4));
@@ -171,7 +171,7 @@ AdaptiveGrid read_adaptive(const std::string& path) {
         if (b[a] < 0 || b[a] >= L.nb[a])
           fail(ErrorKind::Format, "{}: level {} brick {}: coordinates ({}, {}, {}) outside its {}x{}x{} bricks", path, l, i, b[0], b[1], b[2],
                L.nb[0], L.nb[1], L.nb[2]);
-        pts *= std::min(brick, L.n[a] - 1 - b[a] * brick) + 1;
+        pts *= std::min(brick, L.n[a] - b[a] * brick);
       }
       char& s = seen[size_t((int64_t(b[2]) * L.nb[1] + b[1]) * L.nb[0] + b[0])];
       if (s) fail(ErrorKind::Format, "{}: level {} brick {}: ({}, {}, {}) listed twice", path, l, i, b[0], b[1], b[2]);

@@ -73,6 +73,9 @@ TEST(Adaptive, RefinedEverywhereItEqualsTheDenseGridBitForBit) {
   for (int z = 0; z < gd.nz; ++z)
     for (int y = 0; y < gd.ny; ++y)
       for (int x = 0; x < gd.nx; ++x) EXPECT_EQ(t.level_at(gd.point(x, y, z)), 0);
+  // Level 0 covers everything: the levels between it and the top brick hold nothing.
+  for (int l = 1; l + 1 < t.levels(); ++l) EXPECT_TRUE(t.level(l).bricks.empty()) << "level " << l;
+  EXPECT_EQ(t.level(t.levels() - 1).bricks.size(), 1u);
   for (int i = 0; i < 300; ++i) {
     Vec3 p{1 + 1.2 * U(rng), 0.5 + 0.6 * U(rng), 0.75 + 0.9 * U(rng)};  // some outside: both clamp
     auto a = t.coeffs_at(p), b = fine.coeffs_at(p);
