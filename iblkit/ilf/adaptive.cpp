@@ -109,15 +109,18 @@ void AdaptiveGrid::corner_slots(int l, const double f_in[3], size_t corners[8]) 
   for (int k = 0; k < 8; ++k) corners[k] = slot_of(L, c, k);
 }
 
-int AdaptiveGrid::lookup(const double f_in[3], double* out) const {
+int AdaptiveGrid::lookup(const double f[3], double* out) const { return lookup_in(f, f, out); }
+
+int AdaptiveGrid::lookup_in(const double cell_in[3], const double f_in[3], double* out) const {
   const int KC = coeff_count() * 3;
   std::fill(out, out + KC, 0.0);
   const int n[3] = {grid_.nx, grid_.ny, grid_.nz};
-  double f[3];
+  double f[3], cf[3];
   clamp_index(grid_, f_in, f);
+  clamp_index(grid_, cell_in, cf);
   for (int l = 0; l < levels(); ++l) {
     const Level& L = levels_[size_t(l)];
-    CellAxes c = cell_of(L, brick_, f);
+    CellAxes c = cell_of(L, brick_, cf);
     const float* src[8];
     bool complete = true;
     for (int k = 0; k < 8 && complete; ++k) {
@@ -226,28 +229,37 @@ AdaptiveGrid make_adaptive(const SHGrid& fine, const AdaptDesc& desc) {
   const int top = tree.levels() - 1;
   const int origin[3] = {0, 0, 0};
   fill(top, origin);
-  // Top down: where the levels above miss a fine point by more than the bound, the corner bricks of
-  // its level-l cell are stored; it is then answered at level l or finer. A fine point answered at
-  // level m > 0 was within the bound when level m−1 was decided (else its cell there would be
-  // complete), and the levels from m up have not changed since.
+  // Top down, per fine cell C: where the interpolant that answers in C (that of the finest complete
+  // level above l) misses the fine values at one of C's 8 corners by more than the bound, the corner
+  // bricks of the level-l cell around C are stored, so that C is answered at level l or finer. A cell
+  // answered at level m > 0 was within the bound at its corners when level m−1 was decided (else its
+  // level-(m−1) cell would be complete), the levels from m up have not changed since, and a trilinear
+  // difference within the bound at the corners is within it in the whole cell (the norm is convex): the
+  // lookup is within the bound of the fine grid's trilinear lookup everywhere.
   for (int l = top - 1; l >= 0; --l) {
     const auto& L = tree.level(l);
     std::vector<uint8_t> need(L.map.size(), 0);
-    parallel_for(0, int64_t(gd.nz) * gd.ny, [&](int64_t zy) {
+    parallel_for(0, int64_t(gd.nz - 1) * (gd.ny - 1), [&](int64_t zy) {
       std::vector<double> v(static_cast<size_t>(KC));
-      const int k = int(zy / gd.ny), j = int(zy % gd.ny);
-      for (int i = 0; i < gd.nx; ++i) {
-        const double f[3] = {double(i), double(j), double(k)};
+      const int k = int(zy / (gd.ny - 1)), j = int(zy % (gd.ny - 1));
+      for (int i = 0; i + 1 < gd.nx; ++i) {
+        const double centre[3] = {i + 0.5, j + 0.5, k + 0.5};
         size_t slots[8];
-        tree.corner_slots(l, f, slots);
+        tree.corner_slots(l, centre, slots);
         bool all = true;
         for (size_t s : slots) all = all && std::atomic_ref<uint8_t>(need[s]).load(std::memory_order_relaxed);
         if (all) continue;
-        tree.lookup(f, v.data());
-        const float* src = fine.at(i, j, k);
-        double e = 0;
-        for (int q = 0; q < KC; ++q) e += (v[size_t(q)] - src[q]) * (v[size_t(q)] - src[q]);
-        if (std::sqrt(e) > bound)
+        bool miss = false;
+        for (int c = 0; c < 8 && !miss; ++c) {
+          const int q[3] = {i + (c & 1), j + ((c >> 1) & 1), k + (c >> 2)};
+          const double f[3] = {double(q[0]), double(q[1]), double(q[2])};
+          tree.lookup_in(centre, f, v.data());
+          const float* src = fine.at(q[0], q[1], q[2]);
+          double e = 0;
+          for (int m = 0; m < KC; ++m) e += (v[size_t(m)] - src[m]) * (v[size_t(m)] - src[m]);
+          miss = std::sqrt(e) > bound;
+        }
+        if (miss)
           for (size_t s : slots) std::atomic_ref<uint8_t>(need[s]).store(1, std::memory_order_relaxed);
       }
     });

@@ -6,10 +6,12 @@
 // A lookup answers from the finest level whose cell around the point has all 8 corners stored,
 // trilinearly there; so where level 0 is kept it returns exactly what the fine SHGrid returns (bit for
 // bit; within rounding closer than 1e-7 cells to a grid point, where the cell is chosen as that
-// point's). make_adaptive, top down, stores the corner bricks of a level's cell wherever the levels
-// above miss a fine point in it by more than tolerance · (RMS over the fine points of the coefficient
-// vector's L2 norm): at every fine point the lookup is then within that bound, so the tree's relative
-// L2 difference to the fine grid is at most `tolerance`; bricks no lookup reaches are left out.
+// point's). make_adaptive, top down, stores the corner bricks of a level's cell wherever the
+// interpolant the levels above answer with in a fine cell misses the fine values at one of its corners
+// by more than tolerance · (RMS over the fine points of the coefficient vector's L2 norm): the lookup is
+// then within that bound of the fine grid's trilinear lookup everywhere in the volume (so the relative
+// L2 difference at the fine points is at most `tolerance`); bricks no lookup reaches are left out.
+// Across a face between cells answered at different levels the lookup may jump (by ≤ 2 · the bound).
 // File format .shtree (docs/formats.md): like .shgrid, a magic line, a JSON header padded to 64
 // bytes, then per level (top first) the brick table (int32) and the bricks' float32 values.
 // Renderers take a dense grid: to_dense (read_dense) resamples, the GL path (docs/ilf.md).
@@ -71,6 +73,9 @@ class AdaptiveGrid {
   // the level that answered. With `corners`, the 8 brick slots (indices into level(l).map, corner c at
   // x + (c & 1), y + (c >> 1 & 1), z + (c >> 2)) of the cell of level l around f instead: no lookup.
   int lookup(const double f[3], double* out) const;
+  // The same with the cells chosen around cell_f and the interpolant evaluated at f (on the cell's
+  // faces or corners: make_adaptive checks each fine cell's interpolant at its corners).
+  int lookup_in(const double cell_f[3], const double f[3], double* out) const;
   void corner_slots(int l, const double f[3], size_t corners[8]) const;
   // Trilinear lookup at p (clamped to the volume), as SHGrid::coeffs_at.
   sh::Coeffs coeffs_at(Vec3 p) const;
