@@ -10,6 +10,7 @@
 #include "cli.h"
 #include "iblkit/core/check.h"
 #include "iblkit/core/error.h"
+#include "iblkit/core/json_file.h"
 #include "iblkit/ilf/adaptive.h"
 #include "iblkit/ilf/analytic.h"
 #include "iblkit/ilf/build.h"
@@ -301,11 +302,33 @@ void setup_build(CLI::App& app) {
 }
 
 // `ilf query` on a dense or an adaptive grid (the same lookups).
-struct QueryOpts { std::string grid, at, normal, dir; double exponent = 4; };
+struct QueryOpts { std::string grid, at, normal, dir, points; double exponent = 4; };
+
+// --points: the coefficients at every point of a JSON array [[x, y, z], …].
+template <typename Grid>
+void query_points(const Grid& g, const std::string& path) {
+  const nlohmann::json pts = read_json_file(path);
+  if (!pts.is_array()) fail(ErrorKind::Format, "{}: expected a JSON array of points [x, y, z]", path);
+  nlohmann::json rows = nlohmann::json::array();
+  for (size_t i = 0; i < pts.size(); ++i) {
+    const auto& q = pts[i];
+    if (!q.is_array() || q.size() != 3 || !q[0].is_number() || !q[1].is_number() || !q[2].is_number())
+      fail(ErrorKind::Format, "{}: point {} is not [x, y, z]", path, i);
+    Vec3 p{q[0].get<double>(), q[1].get<double>(), q[2].get<double>()};
+    require_point(fmt::format("{}: point {}", path, i), p);
+    nlohmann::json coeffs = nlohmann::json::array();
+    for (auto& v : g.coeffs_at(p).c) coeffs.push_back({v.x, v.y, v.z});
+    rows.push_back(coeffs);
+  }
+  iblcli::emit({{"points", pts.size()}, {"coefficients", rows}},
+               [&] { fmt::print("{} points: the coefficients need --json\n", pts.size()); });
+}
 
 template <typename Grid>
 void query(const Grid& g, const QueryOpts& opts) {
   const QueryOpts* o = &opts;
+  if (!o->points.empty()) return query_points(g, o->points);
+  if (o->at.empty()) fail(ErrorKind::Value, "ilf query: give --at x,y,z or --points FILE");
   Vec3 p = iblcli::parse_vec3(o->at, "--at"), n = o->normal.empty() ? Vec3{0, 1, 0} : iblcli::parse_vec3(o->normal, "--normal");
   require_point("--at", p);
   if (!g.grid().volume.contains(p)) iblcli::info("note: the point lies outside the grid volume; values are clamped to its boundary");
@@ -338,7 +361,8 @@ void query(const Grid& g, const QueryOpts& opts) {
 void setup_query(CLI::App& app) {
   auto* o = iblcli::app_owned<QueryOpts>();
   app.add_option("grid", o->grid, ".shgrid or .shtree file")->required();
-  app.add_option("--at", o->at, "point x,y,z")->required();
+  app.add_option("--at", o->at, "point x,y,z");
+  app.add_option("--points", o->points, "instead of --at: a JSON array of points [[x, y, z], …]; --json prints the coefficients at each");
   app.add_option("--normal", o->normal, "irradiance for this normal x,y,z (default +Y)");
   app.add_option("--dir", o->dir, "also radiance towards, and Phong-glossy response around, this direction");
   app.add_option("--exponent", o->exponent, "Phong exponent for --dir")->capture_default_str();
