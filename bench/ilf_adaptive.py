@@ -19,7 +19,7 @@ Usage: bench/ilf_adaptive.py IBLKIT WORKDIR [CASE ...]   (cases: lab (low-scene2
 environment: POINTS (320), TOLS ("0.02 0.05 0.1 0.2 0.3 0.5"), BRICKS ("4 8"),
              BUILDING_SEQ (default /tmp/mpi_e2e/building/sequence.json; captured into WORKDIR when absent)
 """
-import json, math, os, random, subprocess, sys, time
+import json, os, random, subprocess, sys, time
 
 import numpy as np
 
