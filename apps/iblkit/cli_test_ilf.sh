@@ -46,6 +46,9 @@ check adapt-levels-dense fail "not an adaptive grid" -- "$BIN" --quiet ilf slice
 check adapt-cut fail "truncated" -- bash -c "head -c 2000 \"$T/a5.shtree\" > \"$T/cut.shtree\" && \"$BIN\" --quiet ilf query \"$T/cut.shtree\" --at 0,1,0"
 check adapt-error-volume fail "not radiance SH" -- "$BIN" --quiet ilf adapt "$T/e.shgrid" --tolerance 0.1 --out "$T/x.shtree"
 check adapt-brick-range fail "brick" -- "$BIN" --quiet ilf adapt "$T/a.shgrid" --brick 1 --out "$T/x.shtree"
+check query-points ok '"points": ?2' -- bash -c "echo '[[0,1,0],[0.2,1.1,-0.3]]' > \"$T/pts.json\" && \"$BIN\" --quiet --json ilf query \"$T/a5.shtree\" --points \"$T/pts.json\""
+check query-points-bad fail "point 1 is not" -- bash -c "echo '[[0,1,0],[1,2]]' > \"$T/bad.json\" && \"$BIN\" --quiet --json ilf query \"$T/a.shgrid\" --points \"$T/bad.json\""
+check query-needs-point fail "--at" -- "$BIN" --quiet ilf query "$T/a.shgrid"
 check densify-not-tree fail "not an .shtree" -- "$BIN" --quiet ilf densify "$T/a.shgrid" --out "$T/x.shgrid"
 
 echo "cli_ilf: $pass passed, $fail failed"
