@@ -19,8 +19,8 @@ inline int level_coord(int i, int s, int n) { return int(std::min<int64_t>(int64
 }  // namespace
 
 AdaptiveGrid::AdaptiveGrid(const GridDesc& grid, int bands, int brick) : grid_(grid), bands_(bands), brick_(brick) {
-  SHGrid check(GridDesc{2, 2, 2, grid.volume}, bands);  // the volume and bands as SHGrid checks them
-  (void)check;
+  if (bands < 1 || bands > 16) fail(ErrorKind::Value, "adaptive SH grid: bands = {} outside [1, 16]", bands);
+  require_box("adaptive SH grid: volume", grid.volume.min, grid.volume.max, true);
   if (brick < kMinBrick || brick > kMaxBrick) fail(ErrorKind::Value, "adaptive SH grid: brick {} outside [{}, {}]", brick, kMinBrick, kMaxBrick);
   const int n[3] = {grid.nx, grid.ny, grid.nz};
   for (int a = 0; a < 3; ++a)
@@ -146,7 +146,7 @@ int AdaptiveGrid::lookup_in(const double cell_in[3], const double f_in[3], doubl
     }
     return l;
   }
-  return -1;  // unreachable once the top brick is there (make_adaptive, read_adaptive)
+  fail(ErrorKind::Value, "adaptive SH grid: the top level has no brick (every lookup needs it)");
 }
 
 Vec3 AdaptiveGrid::fine_index(Vec3 p) const {

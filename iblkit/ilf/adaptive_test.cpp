@@ -243,6 +243,10 @@ TEST(Adaptive, ArgumentsAreChecked) {
   AdaptiveGrid t = make_adaptive(fine, {});
   expect_error([&] { t.coeffs_at({NAN, 0, 0}); }, "not finite");
   expect_error([&] { t.add_brick(0, 0, 0, 0); t.add_brick(0, 0, 0, 0); }, "given twice");
+  AdaptiveGrid empty(fine.grid(), 2, 4);  // levels but no bricks: a lookup has nothing to answer from
+  expect_error([&] { empty.coeffs_at({0.5, 0.25, 0.5}); }, "top level has no brick");
+  expect_error([&] { AdaptiveGrid(GridDesc{4, 4, 4, {{0, 0, 0}, {1, 0, 1}}}, 2, 4); }, "max must exceed min");
+  expect_error([&] { AdaptiveGrid(fine.grid(), 0, 4); }, "bands = 0");
 }
 
 }  // namespace
