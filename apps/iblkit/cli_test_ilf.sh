@@ -30,5 +30,26 @@ check cv-error-grid-needs-folds fail "cv-folds" -- "$BIN" --quiet ilf build "$T/
 check cv-folds-range fail "cv-folds" -- "$BIN" --quiet ilf build "$T/cap/sequence.json" --grid 4 --cv-folds 1 --out "$T/g.shgrid"
 check kernel-word fail "kernel" -- "$BIN" --quiet ilf build "$T/cap/sequence.json" --grid 4 --kernel wide --out "$T/g.shgrid"
 
+# Issue 15 §4: adaptive grids. adapt at tolerance 0 answers as the dense grid; densify gives it back
+# byte for byte; query, slice, info, export-threejs read .shtree; a cut file and a cv-error volume fail.
+check adapt-build ok "" -- "$BIN" --quiet ilf build "$T/cap/sequence.json" --grid 9 --kernel 3 --cv-folds 0 --out "$T/a.shgrid"
+check adapt-zero ok '"max_point_error": ?0(\.0)?,' -- "$BIN" --quiet --json ilf adapt "$T/a.shgrid" --tolerance 0 --out "$T/a0.shtree"
+check adapt-densify ok "" -- "$BIN" --quiet ilf densify "$T/a0.shtree" --out "$T/a0.shgrid"
+check adapt-same-bytes ok "" -- cmp "$T/a.shgrid" "$T/a0.shgrid"
+check adapt-query ok "" -- bash -c "diff <(\"$BIN\" --quiet --json ilf query \"$T/a.shgrid\" --at 0.1,1.1,-0.2 | grep -A3 irradiance) <(\"$BIN\" --quiet --json ilf query \"$T/a0.shtree\" --at 0.1,1.1,-0.2 | grep -A3 irradiance)"
+check adapt-tolerance ok "largest point error" -- "$BIN" ilf adapt "$T/a.shgrid" --tolerance 0.05 --brick 2 --out "$T/a5.shtree"
+check adapt-info ok '"adaptive": ?true' -- "$BIN" --quiet --json ilf info "$T/a5.shtree"
+check adapt-slice ok "answering level" -- "$BIN" ilf slice "$T/a5.shtree" --plane y=1 --size 16 --levels --out "$T/lv.png"
+check adapt-slice-irr ok "max irradiance" -- "$BIN" ilf slice "$T/a5.shtree" --plane y=1 --size 16 --out "$T/lv2.png"
+check adapt-threejs ok "" -- "$BIN" --quiet ilf export-threejs "$T/a5.shtree" --out "$T/web3"
+check adapt-levels-dense fail "not an adaptive grid" -- "$BIN" --quiet ilf slice "$T/a.shgrid" --plane y=1 --levels --out "$T/x.png"
+check adapt-cut fail "truncated" -- bash -c "head -c 2000 \"$T/a5.shtree\" > \"$T/cut.shtree\" && \"$BIN\" --quiet ilf query \"$T/cut.shtree\" --at 0,1,0"
+check adapt-error-volume fail "not radiance SH" -- "$BIN" --quiet ilf adapt "$T/e.shgrid" --tolerance 0.1 --out "$T/x.shtree"
+check adapt-brick-range fail "brick" -- "$BIN" --quiet ilf adapt "$T/a.shgrid" --brick 1 --out "$T/x.shtree"
+check query-points ok '"points": ?2' -- bash -c "echo '[[0,1,0],[0.2,1.1,-0.3]]' > \"$T/pts.json\" && \"$BIN\" --quiet --json ilf query \"$T/a5.shtree\" --points \"$T/pts.json\""
+check query-points-bad fail "point 1 is not" -- bash -c "echo '[[0,1,0],[1,2]]' > \"$T/bad.json\" && \"$BIN\" --quiet --json ilf query \"$T/a.shgrid\" --points \"$T/bad.json\""
+check query-needs-point fail "--at" -- "$BIN" --quiet ilf query "$T/a.shgrid"
+check densify-not-tree fail "not an .shtree" -- "$BIN" --quiet ilf densify "$T/a.shgrid" --out "$T/x.shgrid"
+
 echo "cli_ilf: $pass passed, $fail failed"
 [ $fail -eq 0 ]

@@ -2,7 +2,8 @@
 # End-to-end faults of the distributed ILF build (issue 18; CTest cli_mpi, seconds): a rank killed
 # mid-build ends the whole job through mpirun (no hang) and leaves no grid and no temporary file; the
 # re-run reuses the buckets the killed run had finished and gives the grid of an undisturbed run;
-# rank 0 prints one report; `--mpi` without mpirun runs as a job of one rank. Skips without mpirun or
+# rank 0 prints one report; `--mpi` without mpirun runs as a job of one rank; the cross-validated
+# error, kernel and --error-grid under mpirun are the serial build's. Skips without mpirun or
 # without the MPI plugin. Open MPI refuses root unless told: the allowance is given to mpirun here only.
 set -u
 source "$(dirname "$0")/cli_check.sh" "$1"
@@ -19,7 +20,7 @@ check run ok "ranks     2:" -- timeout 300 "${MPIRUN[@]}" -np 2 "$BIN" ilf build
 n=$(timeout 300 "${MPIRUN[@]}" -np 2 "$BIN" ilf build "$S" "${ARGS[@]}" --out "$T/ref2.shgrid" | grep -c "^wrote ")
 if [ "$n" = 1 ]; then pass=$((pass+1)); else echo "FAIL one-report: $n reports"; fail=$((fail+1)); fi
 
-# Kill rank 1 while it projects (the buckets reused from above make the sort instant).
+# Kill rank 1 while it cross-validates or projects (the buckets reused from above make the sort instant).
 timeout 300 "${MPIRUN[@]}" -np 2 "$BIN" --quiet ilf build "$S" "${ARGS[@]}" --out "$T/killed.shgrid" >"$T/killed.log" 2>&1 &
 job=$!
 victim=""
@@ -50,6 +51,24 @@ if cmp -s "$T/ref.shgrid" "$T/again.shgrid"; then pass=$((pass+1)); else echo "F
 check singleton ok "ranks     1:" -- env OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 timeout 120 "$BIN" ilf build "$S" --grid 8 --kernel 3 --mpi --out "$T/one.shgrid" --buckets "$T/b1"
 check serial ok "" -- "$BIN" --quiet ilf build "$S" --grid 8 --kernel 3 --out "$T/serial.shgrid" --buckets "$T/b0"
 if cmp -s "$T/one.shgrid" "$T/serial.shgrid"; then pass=$((pass+1)); else echo "FAIL singleton: its grid differs from the serial build's"; fail=$((fail+1)); fi
+
+# The cross-validation under mpirun, as the serial build's: the CLI's default (--kernel auto, 5 folds)
+# with --error-grid on 3 ranks prints the serial cv error and chosen kernel, and writes the serial
+# error volume (its slice's mean and max to 1e-6).
+"$BIN" --quiet ilf synth --out "$T/cv" --probes 120 --size 24 --supersample 1 >/dev/null || { echo "FAIL synth cv"; exit 1; }
+CV=("$T/cv/sequence.json" --grid 8)
+timeout 120 "${MPIRUN[@]}" -np 3 "$BIN" ilf build "${CV[@]}" --out "$T/cv3.shgrid" --error-grid "$T/cv3.err.shgrid" --buckets "$T/cvb3" >"$T/cv3.log" 2>&1 \
+  && grep -q "^wrote $T/cv3.err.shgrid" "$T/cv3.log" && pass=$((pass+1)) || { echo "FAIL cv-mpi: $(cat "$T/cv3.log")"; fail=$((fail+1)); }
+"$BIN" ilf build "${CV[@]}" --out "$T/cv0.shgrid" --error-grid "$T/cv0.err.shgrid" --buckets "$T/cvb0" >"$T/cv0.log" 2>&1 || echo "serial build failed: $(cat "$T/cv0.log")"
+m=$(grep -E "^(cv error|kernel) " "$T/cv3.log"); s=$(grep -E "^(cv error|kernel) " "$T/cv0.log")
+# the kernel line says how long the choice took: compare up to its timing
+if [ -n "$s" ] && [ "$(sed 's/ in [0-9.]*s//' <<<"$m")" = "$(sed 's/ in [0-9.]*s//' <<<"$s")" ]; then pass=$((pass+1)); else echo "FAIL cv-same: mpi \"$m\" serial \"$s\""; fail=$((fail+1)); fi
+echo "cv under mpirun: $m"
+slice() { "$BIN" --quiet --json ilf slice "$1" --plane y=0.5 --size 16 --out "$T/slice.exr" | tr -d ' \n' | grep -oE '"(max|mean)_rel_error":[-0-9.e+]+' | cut -d: -f2; }
+a=($(slice "$T/cv3.err.shgrid")); b=($(slice "$T/cv0.err.shgrid"))
+if [ ${#a[@]} = 2 ] && [ ${#b[@]} = 2 ] && awk -v a0="${a[0]}" -v a1="${a[1]}" -v b0="${b[0]}" -v b1="${b[1]}" \
+     'function d(x, y) { return (x > y ? x - y : y - x) <= 1e-6 * (y > 0 ? y : -y) } BEGIN { exit !(b0 > 0 && d(a0, b0) && d(a1, b1)) }'; then
+  pass=$((pass+1)); else echo "FAIL cv-error-grid: mpi ${a[*]}, serial ${b[*]}"; fail=$((fail+1)); fi
 
 echo "cli_mpi: $pass passed, $fail failed"
 [ $fail -eq 0 ]

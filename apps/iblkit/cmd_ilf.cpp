@@ -1,4 +1,4 @@
-// iblkit ilf build|query|slice|info|synth: incident light fields — probe sequences resampled into SH
+// iblkit ilf build|adapt|densify|query|slice|info|synth: incident light fields — probe sequences resampled into SH
 // grids (Löw et al. 2009, docs/ilf.md).
 #include <unistd.h>
 
@@ -10,6 +10,8 @@
 #include "cli.h"
 #include "iblkit/core/check.h"
 #include "iblkit/core/error.h"
+#include "iblkit/core/json_file.h"
+#include "iblkit/ilf/adaptive.h"
 #include "iblkit/ilf/analytic.h"
 #include "iblkit/ilf/build.h"
 #include "iblkit/ilf/threejs_grid.h"
@@ -69,7 +71,7 @@ nlohmann::json report_json(const ilf::BuildReport& r) {
           {"buckets", r.buckets}, {"blocks", r.blocks}, {"octahedral", r.octahedral}, {"samples", r.samples},
           {"fraction_uncovered", r.fraction_uncovered}, {"buckets_reused", r.buckets_reused},
           {"seconds", {{"subsample", r.t_subsample}, {"sort", r.t_sort}, {"project", r.t_project}, {"repair", r.t_repair},
-                       {"accumulate", r.t_accumulate}, {"total", r.t_total}}},
+                       {"accumulate", r.t_accumulate}, {"crossval", r.t_choose + r.t_crossval}, {"total", r.t_total}}},
           {"gemm_gflop", r.gemm_flops * 1e-9}, {"resolution", {r.nx, r.ny, r.nz}}, {"kernel", r.kernel_cells},
           {"ball_radius", r.ball_radius},
           {"gemm_gflops_per_s", r.t_accumulate > 0 ? r.gemm_flops * 1e-9 / r.t_accumulate : 0.0},
@@ -103,8 +105,9 @@ bool is_auto(const std::string& s) { return s == "auto"; }
 nlohmann::json mpi_json(const ilf::DistributedReport& d) {
   return {{"ranks", d.ranks}, {"chunk", d.chunk}, {"blocks_per_rank", {d.blocks_min, d.blocks_max}},
           {"seconds", {{"subsample", d.t_subsample}, {"read", d.t_read}, {"exchange", d.t_exchange}, {"project", d.t_project},
-                       {"repair", d.t_repair}, {"accumulate", d.t_accumulate}, {"reduce", d.t_reduce}}},
+                       {"repair", d.t_repair}, {"accumulate", d.t_accumulate}, {"reduce", d.t_reduce}, {"crossval", d.t_crossval}}},
           {"bytes_sent", d.bytes_sent}, {"bytes_received", d.bytes_received}, {"bytes_reduced", d.bytes_reduced},
+          {"bytes_crossval", d.bytes_crossval},
           {"peak_rss_bytes", d.peak_rss_bytes}};
 }
 
@@ -205,9 +208,9 @@ void run_build(const BuildOptions& opts, const ilf::SequenceReadDesc& rd, const 
     fmt::print("time      sort {:.1f}s, project+repair {:.1f}s, SH products {:.1f}s ({:.1f} GFLOP/s), total {:.1f}s\n", rep.t_sort,
                rep.t_project, rep.t_accumulate, rep.gemm_flops * 1e-9 / std::max(rep.t_accumulate, 1e-9), rep.t_total);
     if (job)
-      fmt::print("ranks     {}: read {:.1f}s, exchange {:.1f}s ({:.3g} MB sent by the busiest rank), project {:.1f}s "
-                 "(repair {:.1f}s), SH {:.1f}s, reduce {:.1f}s, write {:.1f}s; peak memory {:.0f} MB per rank\n",
-                 drep.ranks, drep.t_read, drep.t_exchange, drep.bytes_sent * 1e-6, drep.t_project, drep.t_repair,
+      fmt::print("ranks     {}: read {:.1f}s, exchange {:.1f}s ({:.3g} MB sent by the busiest rank), cross-validation {:.1f}s, "
+                 "project {:.1f}s (repair {:.1f}s), SH {:.1f}s, reduce {:.1f}s, write {:.1f}s; peak memory {:.0f} MB per rank\n",
+                 drep.ranks, drep.t_read, drep.t_exchange, drep.bytes_sent * 1e-6, drep.t_crossval, drep.t_project, drep.t_repair,
                  drep.t_accumulate, drep.t_reduce, t_write, drep.peak_rss_bytes * 1e-6);
   });
 }
@@ -280,18 +283,6 @@ void setup_build(CLI::App& app) {
     ilf::SequenceReadDesc rd;
     rd.skip_bad = bd.buckets.skip_bad;
     if (o->mpi || ilf::launched_by_mpi()) {
-      // The cross-validated choice and error need the whole bucket store on one rank: not distributed yet.
-      auto given = [&](const char* name) { return app.get_option(name)->count() > 0; };
-      if ((bd.auto_kernel && given("--kernel")) || (bd.auto_grid && given("--grid")) || !o->error_grid.empty() ||
-          (bd.crossval.folds >= 2 && given("--cv-folds")))
-        fail(ErrorKind::Unsupported, "under MPI the build does not cross-validate yet: give --kernel W and --grid N (no --error-grid, "
-             "--cv-folds 0), or build on one machine");
-      if (bd.auto_kernel) {
-        bd.auto_kernel = false;
-        bd.project.kernel_cells = ilf::BuildDesc{}.project.kernel_cells;
-        iblcli::info(fmt::format("under MPI the kernel is not cross-validated: {:g} grid cells (--kernel to choose)", bd.project.kernel_cells));
-      }
-      bd.crossval.folds = 0;
       ilf::run_mpi_job([&](ilf::MpiJob& job) { run_build(*o, rd, bd, &job); });
     } else {
       run_build(*o, rd, bd, nullptr);
@@ -299,46 +290,83 @@ void setup_build(CLI::App& app) {
   });
 }
 
+// `ilf query` on a dense or an adaptive grid (the same lookups).
+struct QueryOpts { std::string grid, at, normal, dir, points; double exponent = 4; };
+
+// --points: the coefficients at every point of a JSON array [[x, y, z], …].
+template <typename Grid>
+void query_points(const Grid& g, const std::string& path) {
+  const nlohmann::json pts = read_json_file(path);
+  if (!pts.is_array()) fail(ErrorKind::Format, "{}: expected a JSON array of points [x, y, z]", path);
+  nlohmann::json rows = nlohmann::json::array();
+  for (size_t i = 0; i < pts.size(); ++i) {
+    const auto& q = pts[i];
+    if (!q.is_array() || q.size() != 3 || !q[0].is_number() || !q[1].is_number() || !q[2].is_number())
+      fail(ErrorKind::Format, "{}: point {} is not [x, y, z]", path, i);
+    Vec3 p{q[0].get<double>(), q[1].get<double>(), q[2].get<double>()};
+    require_point(fmt::format("{}: point {}", path, i), p);
+    nlohmann::json coeffs = nlohmann::json::array();
+    for (auto& v : g.coeffs_at(p).c) coeffs.push_back({v.x, v.y, v.z});
+    rows.push_back(coeffs);
+  }
+  iblcli::emit({{"points", pts.size()}, {"coefficients", rows}},
+               [&] { fmt::print("{} points: the coefficients need --json\n", pts.size()); });
+}
+
+template <typename Grid>
+void query(const Grid& g, const QueryOpts& opts) {
+  const QueryOpts* o = &opts;
+  if (!o->points.empty()) return query_points(g, o->points);
+  if (o->at.empty()) fail(ErrorKind::Value, "ilf query: give --at x,y,z or --points FILE");
+  Vec3 p = iblcli::parse_vec3(o->at, "--at"), n = o->normal.empty() ? Vec3{0, 1, 0} : iblcli::parse_vec3(o->normal, "--normal");
+  require_point("--at", p);
+  if (!g.grid().volume.contains(p)) iblcli::info("note: the point lies outside the grid volume; values are clamped to its boundary");
+  auto c = g.coeffs_at(p);
+  Vec3 e = g.irradiance(p, n);
+  nlohmann::json coeffs = nlohmann::json::array();
+  for (auto& v : c.c) coeffs.push_back({v.x, v.y, v.z});
+  nlohmann::json j = {{"at", {p.x, p.y, p.z}}, {"normal", {n.x, n.y, n.z}}, {"irradiance", {e.x, e.y, e.z}}, {"coefficients", coeffs}};
+  if constexpr (std::is_same_v<Grid, ilf::AdaptiveGrid>) j["level"] = g.level_at(p);
+  Vec3 L, G;
+  if (!o->dir.empty()) {
+    Vec3 d = iblcli::parse_vec3(o->dir, "--dir");
+    L = g.radiance(p, d);
+    G = g.glossy(p, d, o->exponent);
+    j["radiance"] = {L.x, L.y, L.z};
+    j["glossy"] = {G.x, G.y, G.z};
+  }
+  iblcli::emit(j, [&] {
+    fmt::print("irradiance  {:.6g} {:.6g} {:.6g}  (normal {:.3g},{:.3g},{:.3g})\n", e.x, e.y, e.z, n.x, n.y, n.z);
+    if (!o->dir.empty()) {
+      fmt::print("radiance    {:.6g} {:.6g} {:.6g}\n", L.x, L.y, L.z);
+      fmt::print("glossy      {:.6g} {:.6g} {:.6g}  (Phong exponent {})\n", G.x, G.y, G.z, o->exponent);
+    }
+    fmt::print("c00         {:.6g} {:.6g} {:.6g}\n", c.c[0].x, c.c[0].y, c.c[0].z);
+    if constexpr (std::is_same_v<Grid, ilf::AdaptiveGrid>)
+      fmt::print("level       {} (of {}; 0 = the fine grid's resolution)\n", g.level_at(p), g.levels() - 1);
+  });
+}
+
 void setup_query(CLI::App& app) {
-  struct Opts { std::string grid, at, normal, dir; double exponent = 4; };
-  auto* o = iblcli::app_owned<Opts>();
-  app.add_option("grid", o->grid, ".shgrid file")->required();
-  app.add_option("--at", o->at, "point x,y,z")->required();
+  auto* o = iblcli::app_owned<QueryOpts>();
+  app.add_option("grid", o->grid, ".shgrid or .shtree file")->required();
+  app.add_option("--at", o->at, "point x,y,z");
+  app.add_option("--points", o->points, "instead of --at: a JSON array of points [[x, y, z], …]; --json prints the coefficients at each");
   app.add_option("--normal", o->normal, "irradiance for this normal x,y,z (default +Y)");
   app.add_option("--dir", o->dir, "also radiance towards, and Phong-glossy response around, this direction");
   app.add_option("--exponent", o->exponent, "Phong exponent for --dir")->capture_default_str();
-  app.footer("Example:\n  iblkit ilf query room.shgrid --at 0.1,0.5,0 --normal 0,1,0");
+  app.footer("Examples:\n  iblkit ilf query room.shgrid --at 0.1,0.5,0 --normal 0,1,0\n  iblkit ilf query room.shtree --at 0.1,0.5,0 --normal 0,1,0");
   app.callback([o] {
-    auto g = ilf::read_shgrid(o->grid);
-    Vec3 p = iblcli::parse_vec3(o->at, "--at"), n = o->normal.empty() ? Vec3{0, 1, 0} : iblcli::parse_vec3(o->normal, "--normal");
-    require_point("--at", p);
-    if (!g.grid().volume.contains(p)) iblcli::info("note: the point lies outside the grid volume; values are clamped to its boundary");
-    auto c = g.coeffs_at(p);
-    Vec3 e = g.irradiance(p, n);
-    nlohmann::json coeffs = nlohmann::json::array();
-    for (auto& v : c.c) coeffs.push_back({v.x, v.y, v.z});
-    nlohmann::json j = {{"at", {p.x, p.y, p.z}}, {"normal", {n.x, n.y, n.z}}, {"irradiance", {e.x, e.y, e.z}}, {"coefficients", coeffs}};
-    Vec3 L, G;
-    if (!o->dir.empty()) {
-      Vec3 d = iblcli::parse_vec3(o->dir, "--dir");
-      L = g.radiance(p, d);
-      G = g.glossy(p, d, o->exponent);
-      j["radiance"] = {L.x, L.y, L.z};
-      j["glossy"] = {G.x, G.y, G.z};
-    }
-    iblcli::emit(j, [&] {
-      fmt::print("irradiance  {:.6g} {:.6g} {:.6g}  (normal {:.3g},{:.3g},{:.3g})\n", e.x, e.y, e.z, n.x, n.y, n.z);
-      if (!o->dir.empty()) {
-        fmt::print("radiance    {:.6g} {:.6g} {:.6g}\n", L.x, L.y, L.z);
-        fmt::print("glossy      {:.6g} {:.6g} {:.6g}  (Phong exponent {})\n", G.x, G.y, G.z, o->exponent);
-      }
-      fmt::print("c00         {:.6g} {:.6g} {:.6g}\n", c.c[0].x, c.c[0].y, c.c[0].z);
-    });
+    if (ilf::is_adaptive_file(o->grid)) query(ilf::read_adaptive(o->grid), *o);
+    else query(ilf::read_shgrid(o->grid), *o);
   });
 }
 
 // Irradiance on an axis-aligned plane through the volume, normal along the plane's axis.
-Image irradiance_slice(const ilf::SHGrid& g, int axis, double value, int size, double normal_sign) {
+// A template: the grid is an ilf::SHGrid or an ilf::AdaptiveGrid; with `levels`, each pixel is the level
+// of the adaptive grid that answers there instead (1 at level 0, the fine grid, down to 0 at the top).
+template <typename Grid>
+Image irradiance_slice(const Grid& g, int axis, double value, int size, double normal_sign, bool levels = false) {
   const auto& v = g.grid().volume;
   int a1 = axis == 0 ? 2 : 0, a2 = axis == 1 ? 2 : 1;  // image x, y axes
   Vec3 ext = v.size();
@@ -352,6 +380,12 @@ Image irradiance_slice(const ilf::SHGrid& g, int axis, double value, int size, d
       p[axis] = value;
       p[a1] = v.min[a1] + ext[a1] * (x + 0.5) / w;
       p[a2] = v.max[a2] - ext[a2] * (y + 0.5) / h;
+      if constexpr (std::is_same_v<Grid, ilf::AdaptiveGrid>)
+        if (levels) {
+          double l = 1.0 - double(g.level_at(p)) / std::max(1, g.levels() - 1);
+          img.set_rgb(x, y, {l, l, l});
+          continue;
+        }
       Vec3 e = g.irradiance(p, n);
       img.set_rgb(x, y, {std::max(0.0, e.x), std::max(0.0, e.y), std::max(0.0, e.z)});
     }
@@ -359,20 +393,24 @@ Image irradiance_slice(const ilf::SHGrid& g, int axis, double value, int size, d
 }
 
 void setup_slice(CLI::App& app) {
-  struct Opts { std::string grid, plane, out; int size = 256; bool down = false; double exposure = 0, max_error = 0.5; };
+  struct Opts { std::string grid, plane, out; int size = 256; bool down = false, levels = false; double exposure = 0, max_error = 0.5; };
   auto* o = iblcli::app_owned<Opts>();
-  app.add_option("grid", o->grid, ".shgrid file")->required();
+  app.add_option("grid", o->grid, ".shgrid or .shtree file")->required();
   app.add_option("--plane", o->plane, "axis-aligned plane, e.g. y=0.3")->required();
   app.add_option("-o,--out", o->out, "output image (.png tone mapped, .exr linear W/m²)")->required();
   app.add_option("--size", o->size, "image width in pixels")->capture_default_str()->check(CLI::Range(8, 8192));
   app.add_flag("--down", o->down, "normal along the negative axis (default: positive)");
+  app.add_flag("--levels", o->levels, "adaptive grids (.shtree): draw the level that answers at each pixel (white: the fine grid's, black: the top)");
   app.add_option("--max-error", o->max_error, "error volumes (ilf build --error-grid): the relative error shown red")
       ->capture_default_str()->check(positive_number);
   app.footer("An error volume (ilf build --error-grid) is drawn as its relative error in false colour (.png: black 0,\n"
              "blue, green, yellow, red at --max-error) or as its three channels (.exr: relative, absolute, weight).\n"
-             "Example:\n  iblkit ilf slice room.shgrid --plane y=0.3 --out slice.png");
+             "Examples:\n  iblkit ilf slice room.shgrid --plane y=0.3 --out slice.png\n"
+             "  iblkit ilf slice room.shtree --plane y=0.3 --levels --out levels.png");
   app.callback([o] {
-    auto g = ilf::read_shgrid(o->grid, true);
+    const bool adaptive = ilf::is_adaptive_file(o->grid);
+    if (o->levels && !adaptive) fail(ErrorKind::Value, "--levels: {} is not an adaptive grid (.shtree)", o->grid);
+    auto g = adaptive ? ilf::SHGrid() : ilf::read_shgrid(o->grid, true);
     auto eq = o->plane.find('=');
     std::string ax = eq == std::string::npos ? "" : o->plane.substr(0, eq);
     int axis = ax == "x" ? 0 : ax == "y" ? 1 : ax == "z" ? 2 : -1;
@@ -407,7 +445,18 @@ void setup_slice(CLI::App& app) {
       return;
     }
     if (!g.content().empty()) fail(ErrorKind::Value, "{}: content \"{}\" is neither radiance SH nor cv-error", o->grid, g.content());
-    Image img = irradiance_slice(g, axis, val, o->size, o->down ? -1 : 1);
+    Image img = adaptive ? irradiance_slice(ilf::read_adaptive(o->grid), axis, val, o->size, o->down ? -1 : 1, o->levels)
+                         : irradiance_slice(g, axis, val, o->size, o->down ? -1 : 1);
+    if (o->levels) {
+      io::ToneMapDesc td;
+      td.auto_exposure = false;
+      td.curve = io::ToneCurve::Clamp;
+      if (ext == ".png" || ext == ".jpg") io::write_image(o->out, io::tonemap(img, td));
+      else io::write_image(o->out, img);
+      iblcli::emit({{"out", o->out}, {"width", img.width()}, {"height", img.height()}, {"content", "levels"}},
+                   [&] { fmt::print("wrote {} ({}x{}), the answering level (white: level 0)\n", o->out, img.width(), img.height()); });
+      return;
+    }
     if (ext == ".png" || ext == ".jpg") io::write_image(o->out, io::tonemap(img));
     else io::write_image(o->out, img);
     double mx = 0;
@@ -417,11 +466,54 @@ void setup_slice(CLI::App& app) {
   });
 }
 
+// The levels of an adaptive grid, its bytes against the dense fine grid's, and what it was built with.
+nlohmann::json levels_json(const ilf::AdaptiveGrid& t) {
+  nlohmann::json levels = nlohmann::json::array();
+  for (int l = 0; l < t.levels(); ++l) {
+    const auto& L = t.level(l);
+    levels.push_back({{"level", l}, {"step", L.step}, {"points", {L.n[0], L.n[1], L.n[2]}}, {"bricks", L.bricks.size()},
+                      {"brick_slots", L.map.size()}});
+  }
+  return levels;
+}
+
+// Bytes of the .shgrid of the tree's fine grid (header and values).
+double dense_file_bytes(const ilf::AdaptiveGrid& t) { return double(t.grid().count()) * t.coeff_count() * 3 * 4 + 256; }
+
+void print_levels(const ilf::AdaptiveGrid& t) {
+  for (int l = 0; l < t.levels(); ++l) {
+    const auto& L = t.level(l);
+    fmt::print("  level {:<2} step {:<4} {}x{}x{} points, {} of {} bricks\n", l, L.step, L.n[0], L.n[1], L.n[2], L.bricks.size(), L.map.size());
+  }
+}
+
+void adaptive_info(const std::string& path, const ilf::AdaptiveGrid& t) {
+  const auto& gd = t.grid();
+  const double bytes = double(t.file_bytes()), dense = dense_file_bytes(t);
+  nlohmann::json j = {{"file", path}, {"adaptive", true}, {"bands", t.bands()}, {"coefficients", t.coeff_count()},
+                      {"resolution", {gd.nx, gd.ny, gd.nz}}, {"min", {gd.volume.min.x, gd.volume.min.y, gd.volume.min.z}},
+                      {"max", {gd.volume.max.x, gd.volume.max.y, gd.volume.max.z}}, {"brick", t.brick()}, {"tolerance", t.tolerance()},
+                      {"rms", t.rms()}, {"stored_points", t.stored_points()}, {"bytes", bytes}, {"dense_bytes", dense},
+                      {"levels", levels_json(t)}};
+  iblcli::emit(j, [&] {
+    fmt::print("file        {}\n", path);
+    fmt::print("grid        adaptive, fine grid {}x{}x{}, {} bands ({} coefficients), bricks of {}³ cells\n", gd.nx, gd.ny, gd.nz,
+               t.bands(), t.coeff_count(), t.brick());
+    fmt::print("volume      ({:.4g}, {:.4g}, {:.4g}) .. ({:.4g}, {:.4g}, {:.4g})\n", gd.volume.min.x, gd.volume.min.y, gd.volume.min.z,
+               gd.volume.max.x, gd.volume.max.y, gd.volume.max.z);
+    fmt::print("stored      {} points, {:.2f} MB ({:.1f}% of the dense fine grid's {:.2f} MB)\n", t.stored_points(), bytes / 1048576.0,
+               100 * bytes / dense, dense / 1048576.0);
+    fmt::print("tolerance   {:g} × RMS {:.6g} (per fine point, L2 of the coefficients)\n", t.tolerance(), t.rms());
+    print_levels(t);
+  });
+}
+
 void setup_info(CLI::App& app) {
   auto* path = iblcli::app_owned<std::string>();
-  app.add_option("grid", *path, ".shgrid file")->required();
-  app.footer("Example:\n  iblkit ilf info room.shgrid");
+  app.add_option("grid", *path, ".shgrid or .shtree file")->required();
+  app.footer("Examples:\n  iblkit ilf info room.shgrid\n  iblkit ilf info room.shtree");
   app.callback([path] {
+    if (ilf::is_adaptive_file(*path)) return adaptive_info(*path, ilf::read_adaptive(*path));
     auto g = ilf::read_shgrid(*path, true);
     const auto& gd = g.grid();
     double lo = 1e300, hi = -1e300;
@@ -445,6 +537,73 @@ void setup_info(CLI::App& app) {
       fmt::print("c00 range   {:.6g} .. {:.6g}\n", lo, hi);
       if (!g.content().empty()) fmt::print("content     {} (channel 1: relative error, 2: absolute, 3: probe weight)\n", g.content());
     });
+  });
+}
+
+void setup_adapt(CLI::App& app) {
+  struct Opts { std::string grid, out; ilf::AdaptDesc d; };
+  auto* o = iblcli::app_owned<Opts>();
+  app.add_option("grid", o->grid, "dense .shgrid (the fine grid)")->required();
+  app.add_option("-o,--out", o->out, "output .shtree")->required();
+  app.add_option("--tolerance", o->d.tolerance, "largest error kept at any fine point: L2 of its coefficients' difference, relative to the grid's RMS")
+      ->capture_default_str()->check(CLI::Range(0.0, 1e6));
+  app.add_option("--brick", o->d.brick, "cells per brick axis")->capture_default_str()->check(CLI::Range(ilf::kMinBrick, ilf::kMaxBrick));
+  app.footer("Keeps the fine grid's points only where a coarser level (each halves the resolution) misses them by more\n"
+             "than --tolerance; query, slice, info read the result, densify writes a dense grid back (docs/ilf.md).\n"
+             "Example:\n  iblkit ilf adapt room.shgrid --tolerance 0.02 --out room.shtree");
+  app.callback([o] {
+    auto t0 = std::chrono::steady_clock::now();
+    auto fine = ilf::read_shgrid(o->grid);
+    auto t = ilf::make_adaptive(fine, o->d);
+    double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    ilf::write_adaptive(o->out, t);
+    // Measured, not assumed: the tree's difference to the fine grid at every fine point.
+    auto back = t.to_dense();
+    const int KC = fine.coeff_count() * 3;
+    double worst = 0, num = 0, den = 0;
+    for (int64_t i = 0; i < fine.grid().count(); ++i) {
+      double e = 0;
+      for (int q = 0; q < KC; ++q) {
+        double a = back.data()[size_t(i) * KC + q], b = fine.data()[size_t(i) * KC + q];
+        e += (a - b) * (a - b);
+        den += b * b;
+      }
+      num += e;
+      worst = std::max(worst, std::sqrt(e));
+    }
+    const double rel_l2 = den > 0 ? std::sqrt(num / den) : 0.0, bytes = double(t.file_bytes());
+    const double dense = double(std::filesystem::file_size(o->grid));
+    nlohmann::json j = {{"grid", o->grid}, {"out", o->out}, {"tolerance", t.tolerance()}, {"brick", t.brick()}, {"rms", t.rms()},
+                        {"stored_points", t.stored_points()}, {"fine_points", fine.grid().count()}, {"bytes", bytes},
+                        {"dense_bytes", dense}, {"ratio", bytes / dense}, {"max_point_error", t.rms() > 0 ? worst / t.rms() : 0.0},
+                        {"rel_l2_to_fine", rel_l2}, {"seconds", seconds}, {"levels", levels_json(t)}};
+    iblcli::emit(j, [&] {
+      fmt::print("wrote {} ({:.2f} MB, {:.1f}% of {}'s {:.2f} MB) in {:.2f}s\n", o->out, bytes / 1048576.0, 100 * bytes / dense, o->grid,
+                 dense / 1048576.0, seconds);
+      fmt::print("to the fine grid: largest point error {:.4g} × RMS (tolerance {:g}), relative L2 {:.4g}\n", t.rms() > 0 ? worst / t.rms() : 0.0,
+                 t.tolerance(), rel_l2);
+      print_levels(t);
+    });
+  });
+}
+
+void setup_densify(CLI::App& app) {
+  struct Opts { std::string tree, out, grid; };
+  auto* o = iblcli::app_owned<Opts>();
+  app.add_option("tree", o->tree, "adaptive grid (.shtree)")->required();
+  app.add_option("-o,--out", o->out, "output .shgrid")->required();
+  app.add_option("--grid", o->grid, "points N or NX,NY,NZ (default: the fine grid's)");
+  app.footer("The dense grid the renderers, export-threejs and the viewer load (they also read .shtree this way).\n"
+             "Example:\n  iblkit ilf densify room.shtree --out room-dense.shgrid");
+  app.callback([o] {
+    auto t = ilf::read_adaptive(o->tree);
+    auto n = o->grid.empty() ? std::vector<int>{t.grid().nx, t.grid().ny, t.grid().nz} : parse_grid(o->grid);
+    require_allocation(fmt::format("densify: {}x{}x{} points of {} bands", n[0], n[1], n[2], t.bands()), double(n[0]) * n[1] * n[2] * t.coeff_count() * 3,
+                       sizeof(float), "choose a coarser --grid");
+    auto g = t.to_dense(n[0], n[1], n[2]);
+    ilf::write_shgrid(o->out, g);
+    iblcli::emit({{"tree", o->tree}, {"out", o->out}, {"resolution", {n[0], n[1], n[2]}}, {"bytes", g.data().size() * 4}},
+                 [&] { fmt::print("wrote {} ({}x{}x{}, {:.2f} MB)\n", o->out, n[0], n[1], n[2], g.data().size() * 4 / 1048576.0); });
   });
 }
 
@@ -472,14 +631,14 @@ void setup_synth(CLI::App& app) {
 void setup_export_threejs(CLI::App& app) {
   struct Opts { std::string grid, out, name = "grid"; };
   auto* o = iblcli::app_owned<Opts>();
-  app.add_option("grid", o->grid, ".shgrid file")->required();
+  app.add_option("grid", o->grid, ".shgrid or .shtree file (resampled at its fine resolution)")->required();
   app.add_option("-o,--out", o->out, "output folder (NAME.json and NAME_atlas.bin)")->required();
   app.add_option("--name", o->name, "base name of the two files")->capture_default_str();
   app.footer("Example:\n  iblkit ilf export-threejs room.shgrid --out web-grid");
   app.callback([o] {
     if (o->name.empty() || o->name.find_first_of("/\\") != std::string::npos)
       fail(ErrorKind::Value, "--name \"{}\": expected a plain file name", o->name);
-    auto g = ilf::read_shgrid(o->grid);
+    auto g = ilf::read_dense(o->grid);
     std::string json = ilf::write_threejs_grid(g, o->out, o->name);
     const auto& gd = g.grid();
     iblcli::emit({{"grid", o->grid}, {"out", json}, {"resolution", {gd.nx, gd.ny, gd.nz}}, {"bands_kept", std::min(g.bands(), 3)},
@@ -497,9 +656,11 @@ void setup(CLI::App& app) {
              "  iblkit ilf build cap/sequence.json --grid 16 --bands 5 --out room.shgrid\n"
              "  iblkit ilf query room.shgrid --at 0,1,0");
   setup_build(*app.add_subcommand("build", "Resample a probe sequence into an SH grid (.shgrid)"));
+  setup_adapt(*app.add_subcommand("adapt", "Store a grid adaptively (.shtree): fine bricks only where coarser levels miss it"));
+  setup_densify(*app.add_subcommand("densify", "Resample an adaptive grid (.shtree) into a dense .shgrid"));
   setup_query(*app.add_subcommand("query", "SH, irradiance, radiance and glossy response at a point of a grid"));
   setup_slice(*app.add_subcommand("slice", "Irradiance on a plane through the grid, as a picture"));
-  setup_info(*app.add_subcommand("info", "Describe an .shgrid"));
+  setup_info(*app.add_subcommand("info", "Describe an .shgrid or .shtree"));
   setup_synth(*app.add_subcommand("synth", "Write a synthetic probe sequence of a closed-form light field"));
   setup_export_threejs(*app.add_subcommand("export-threejs", "Write the grid as three.js LightProbeGridWebGL loads it (atlas + JSON)"));
 }

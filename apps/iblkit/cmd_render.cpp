@@ -61,7 +61,7 @@ void add_options(CLI::App& app, Opts* o) {
                  "scaled to --object-size and placed at --at, on a floor")
       ->capture_default_str();
   app.add_option("-l,--light", o->lights,
-                 "lighting: a probe image, an SH grid (.shgrid), iblkit.sh/1 or iblkit.lights/1 JSON; several render one "
+                 "lighting: a probe image, an SH grid (.shgrid, or an adaptive .shtree resampled to dense), iblkit.sh/1 or iblkit.lights/1 JSON; several render one "
                  "frame each (OUT_<name>.ext; NAME_<k> where two share a name)")
       ->required();
   app.add_option("--at", o->at, "place the object's centre here, x,y,z (e.g. inside an SH grid's volume)")->capture_default_str();

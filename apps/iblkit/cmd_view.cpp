@@ -387,7 +387,7 @@ void run(const ViewOpts& o, const ibl::io::EnvReadDesc& rd) {
 void setup(CLI::App& app) {
   auto* o = iblcli::app_owned<ViewOpts>();
   app.add_option("scene", o->object.scene, "the object: blob, sphere, or a mesh file (OBJ, PLY, glTF)")->capture_default_str();
-  app.add_option("-l,--light", o->lights, "lightings to switch between (keys 1-9, Tab): probe, .shgrid, iblkit.sh/1, iblkit.lights/1; "
+  app.add_option("-l,--light", o->lights, "lightings to switch between (keys 1-9, Tab): probe, .shgrid (or .shtree), iblkit.sh/1, iblkit.lights/1; "
                  "with --composite: an SH grid or a probe image (with --proxy)");
   app.add_option("--composite", o->photo, "composite mode: this photograph behind, the object moving in it with its shadows");
   app.add_option("--eye", o->eye, "composite: the photograph's camera position x,y,z");

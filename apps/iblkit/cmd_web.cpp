@@ -23,7 +23,7 @@ void setup(CLI::App& app) {
   app.add_option("-p,--probe", o->d.probes, "HDR probe (any mapping): its SH and a lat-long background; repeatable");
   app.add_option("--specular", o->d.specular, "specular KTX2 (iblkit specular) of the --probe of the same rank; repeatable");
   app.add_option("-l,--lights", o->d.lights, "light set: iblkit.lights/1 JSON or glTF (lights --gltf); repeatable");
-  app.add_option("-g,--grid", o->d.grids, "SH grid (.shgrid); repeatable");
+  app.add_option("-g,--grid", o->d.grids, "SH grid (.shgrid, or .shtree resampled to dense); repeatable");
   app.add_option("--probe-height", o->d.probe_height, "height of the background lat-long copy")->capture_default_str()->check(CLI::Range(8, 8192));
   app.add_option("--screenshot", o->screenshot, "also take a headless-Chromium screenshot of the page into this PNG");
   app.add_option("--view", o->query, "viewer URL parameters for the screenshot (docs/web.md), e.g. mode=lights&shadows=4")->capture_default_str();

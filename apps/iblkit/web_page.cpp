@@ -13,6 +13,7 @@
 #include "iblkit/core/atomic_file.h"
 #include "iblkit/core/error.h"
 #include "iblkit/core/json_file.h"
+#include "iblkit/ilf/adaptive.h"
 #include "iblkit/ilf/shgrid.h"
 #include "iblkit/ilf/threejs_grid.h"
 #include "iblkit/io/envmap_io.h"
@@ -93,7 +94,7 @@ nlohmann::json write_web_page(const WebPageDesc& d) {
   }
   for (size_t i = 0; i < d.grids.size(); ++i) {
     std::string name = fmt::format("grid{}", i);
-    ilf::write_threejs_grid(ilf::read_shgrid(d.grids[i]), data.string(), name);
+    ilf::write_threejs_grid(ilf::read_dense(d.grids[i]), data.string(), name);  // .shtree: resampled to dense
     m["grids"].push_back({{"name", stem(d.grids[i])}, {"source", d.grids[i]}, {"grid", "data/" + name + ".json"}});
   }
   write_json_file((out / "iblkit-web.json").string(), m, 2);

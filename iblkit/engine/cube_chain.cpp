@@ -21,23 +21,42 @@ std::vector<double> cube_face_solid_angles(int size) {
   return out;
 }
 
+namespace {
+// Bilinear RGB of face f of a level strip (n × n faces, 3 channels) at face coordinates (s, t) ∈
+// [−1, 1]², texel centres at (i + ½)/n, clamped at the face's edges: ImageView::bilinear with
+// Wrap::Clamp on the face, written out for the importance sampler's inner loop.
+Vec3 face_bilinear(const Image& strip, int f, double s, double t) {
+  const int n = strip.height();
+  const double fx = (s + 1) * 0.5 * n - 0.5, fy = (t + 1) * 0.5 * n - 0.5;
+  const double x0f = std::floor(fx), y0f = std::floor(fy);
+  const float tx = static_cast<float>(fx - x0f), ty = static_cast<float>(fy - y0f);
+  const int x0 = static_cast<int>(x0f), y0 = static_cast<int>(y0f);
+  const int xa = std::clamp(x0, 0, n - 1) + f * n, xb = std::clamp(x0 + 1, 0, n - 1) + f * n;
+  const int ya = std::clamp(y0, 0, n - 1), yb = std::clamp(y0 + 1, 0, n - 1);
+  const float w00 = (1 - tx) * (1 - ty), w10 = tx * (1 - ty), w01 = (1 - tx) * ty, w11 = tx * ty;
+  const float *p00 = strip.pixel(xa, ya), *p10 = strip.pixel(xb, ya), *p01 = strip.pixel(xa, yb), *p11 = strip.pixel(xb, yb);
+  float c[3];
+  for (int k = 0; k < 3; ++k) c[k] = w00 * p00[k] + w10 * p10[k] + w01 * p01[k] + w11 * p11[k];
+  return {c[0], c[1], c[2]};
+}
+}  // namespace
+
 Vec3 CubeChain::sample(Vec3 d, int level) const {
   const Image& im = levels[static_cast<size_t>(std::clamp(level, 0, count() - 1))];
-  const int n = im.height();
   double s = 0, t = 0;
   const int f = sphere::cube_face_of(d, &s, &t);
-  float px[3];
-  im.view().sub(f * n, 0, n, n).bilinear((s + 1) * 0.5 * n, (t + 1) * 0.5 * n, Wrap::Clamp, px);
-  return {px[0], px[1], px[2]};
+  return face_bilinear(im, f, s, t);
 }
 
 Vec3 CubeChain::sample(Vec3 d, double lod) const {
   lod = std::clamp(lod, 0.0, double(count() - 1));
   const int l0 = static_cast<int>(lod);
   const double a = lod - l0;
-  Vec3 c0 = sample(d, l0);
+  double s = 0, t = 0;
+  const int f = sphere::cube_face_of(d, &s, &t);  // the same face and (s, t) on every level
+  Vec3 c0 = face_bilinear(levels[static_cast<size_t>(l0)], f, s, t);
   if (a <= 0 || l0 + 1 >= count()) return c0;
-  return c0 * (1 - a) + sample(d, l0 + 1) * a;
+  return c0 * (1 - a) + face_bilinear(levels[static_cast<size_t>(l0 + 1)], f, s, t) * a;
 }
 
 namespace {

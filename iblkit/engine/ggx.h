@@ -7,7 +7,8 @@
 //
 // with α = roughness² (the perceptual roughness of Filament and glTF). (1) is what Karis's
 // estimator Σ L(l_k)(n·l_k) / Σ (n·l_k) over GGX-sampled l_k converges to; Filament's cmgen
-// computes the same (libs/ibl CubemapIBL::roughnessFilter).
+// means the same (libs/ibl CubemapIBL::roughnessFilter) but reads its mips half a texel off their
+// centres (Cubemap::filterAt): docs/engines.md, `Cmgen.SpecularMatchesIblLd`.
 //
 // Level m of N holds perceptual roughness ρ_m:
 //   linear:   ρ_m = m/(N−1)                       (the iblkit/glTF/three.js-viewer convention)

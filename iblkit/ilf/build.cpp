@@ -138,6 +138,29 @@ BlockWork resample_block(const BucketStore& store, int k, const GridDesc& grid, 
   return w;
 }
 
+void cross_validate_build(const BucketStore& store, const std::vector<Vec3>& origins, const BuildDesc& desc, GridDesc& grid,
+                          ProjectDesc& pd, BuildReport& rep, const CvShare& share) {
+  if (desc.auto_kernel || desc.auto_grid) {  // cross-validated choice (ilf/crossval.h)
+    ResampleSearch rs{.kernel = desc.auto_kernel, .grid = desc.auto_grid, .volume = grid.volume, .nx = grid.nx, .ny = grid.ny,
+                      .nz = grid.nz, .kernel_cells = pd.kernel_cells, .bands = desc.bands, .memory_bytes = desc.buckets.memory_bytes,
+                      .max_buckets = desc.auto_max_buckets};
+    rep.choice = choose_resampling(store, origins, pd, rs, desc.crossval, desc.ball_parallax, share);
+    rep.t_choose = rep.choice->seconds;
+    pd.kernel_cells = rep.choice->kernel;
+    grid.nx = rep.choice->nx; grid.ny = rep.choice->ny; grid.nz = rep.choice->nz;
+  }
+  rep.nx = grid.nx; rep.ny = grid.ny; rep.nz = grid.nz;
+  rep.kernel_cells = pd.kernel_cells;
+  if (rep.choice && desc.crossval.folds >= 2) rep.crossval = rep.choice->best;  // the chosen trial's
+  else if (desc.crossval.folds >= 2) {
+    auto tc = Clock::now();
+    rep.crossval = cross_validate(store, origins, grid, pd, desc.bands, desc.crossval, desc.auto_max_buckets, desc.ball_parallax,
+                                  &rep.crossval_buckets, share);
+    rep.t_crossval = since(tc);
+  }
+  if (rep.choice) rep.crossval_buckets = rep.choice->buckets_used;
+}
+
 void store_coefficients(const double* C, SHGrid& out) {
   // C(c·G + g, k) → data[(g·K + k)·3 + c].
   int K = out.coeff_count();
@@ -185,29 +208,9 @@ SHGrid build_shgrid(const Sequence& seq_in, const BuildDesc& desc, const Progres
   rep.probes_used = P - br.skipped;
   std::vector<Vec3> origins(static_cast<size_t>(P));
   for (int p = 0; p < P; ++p) origins[p] = seq.probes[p].position;
-  if (desc.auto_kernel || desc.auto_grid) {  // cross-validated choice (ilf/crossval.h)
-    ResampleSearch rs{.kernel = desc.auto_kernel, .grid = desc.auto_grid, .volume = grid.volume, .nx = grid.nx, .ny = grid.ny,
-                      .nz = grid.nz, .kernel_cells = pd.kernel_cells, .bands = desc.bands, .memory_bytes = bd.memory_bytes,
-                      .max_buckets = desc.auto_max_buckets};
-    rep.choice = choose_resampling(store, origins, pd, rs, desc.crossval, desc.ball_parallax);
-    rep.t_choose = rep.choice->seconds;
-    pd.kernel_cells = rep.choice->kernel;
-    if (rep.choice->nx != grid.nx || rep.choice->ny != grid.ny || rep.choice->nz != grid.nz) {
-      grid.nx = rep.choice->nx; grid.ny = rep.choice->ny; grid.nz = rep.choice->nz;
-      out = SHGrid(grid, desc.bands);
-    }
-  }
-  rep.nx = grid.nx; rep.ny = grid.ny; rep.nz = grid.nz;
-  rep.kernel_cells = pd.kernel_cells;
+  cross_validate_build(store, origins, desc, grid, pd, rep);
+  if (grid.nx != out.grid().nx || grid.ny != out.grid().ny || grid.nz != out.grid().nz) out = SHGrid(grid, desc.bands);
   rep.ball_radius = desc.ball_parallax && !t.start.empty() ? seq.ball.radius : 0.0;
-  if (rep.choice && desc.crossval.folds >= 2) rep.crossval = rep.choice->best;  // the chosen trial's
-  else if (desc.crossval.folds >= 2) {
-    auto tc = Clock::now();
-    rep.crossval = cross_validate(store, origins, grid, pd, desc.bands, desc.crossval, desc.auto_max_buckets, desc.ball_parallax,
-                                  &rep.crossval_buckets);
-    rep.t_crossval = since(tc);
-  }
-  if (rep.choice) rep.crossval_buckets = rep.choice->buckets_used;
   // Resample, block by block.
   int K = desc.bands * desc.bands;
   int64_t G = grid.count(), rows = 3 * G;

@@ -100,6 +100,13 @@ struct BlockWork {
 BlockWork resample_block(const BucketStore& store, int k, const GridDesc& grid, const ProjectDesc& desc, const std::vector<Vec3>& origins,
                          int bands, bool ball_parallax, std::vector<uint16_t>& buf, std::vector<float>& R, BlockScratch& scratch,
                          double* C);
+// The cross-validated choice of kernel and resolution (desc.auto_kernel, desc.auto_grid) and the
+// cross-validated error (desc.crossval), as the serial and the distributed build both make them, on
+// the sorted store: sets rep.choice, crossval, crossval_buckets, t_choose, t_crossval, nx/ny/nz and
+// kernel_cells, and moves grid and pd to the choice. Distributed: every rank calls it with its share
+// of the blocks (crossval.h, CvShare) and gets the job's choice and error.
+void cross_validate_build(const BucketStore& store, const std::vector<Vec3>& origins, const BuildDesc& desc, GridDesc& grid,
+                          ProjectDesc& pd, BuildReport& rep, const CvShare& share = {});
 // C (3·G × K, column-major, as accumulate_block leaves it) into the grid's coefficient layout.
 void store_coefficients(const double* C, SHGrid& out);
 

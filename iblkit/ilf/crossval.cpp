@@ -55,8 +55,7 @@ CrossValidator::CrossValidator(const GridDesc& grid, const std::vector<Vec3>& or
     }
   }
   for (int p : eval_) pos_.push_back(origins[p]);
-  Cpred_.assign(size_t(3) * E_ * K_, 0.0f);
-  Cown_.assign(size_t(3) * E_ * K_, 0.0f);
+  C_.assign(size_t(2) * 3 * E_ * K_, 0.0);
 }
 
 void CrossValidator::begin_block(int D) {
@@ -90,8 +89,8 @@ void CrossValidator::end_block(const float* B, int D) {
         Rp[size_t(j) * 3 * E_ + size_t(c) * E_ + e] = pred_[size_t(j) * 3 * P + c * P + eval_[e]];
         Ro[size_t(j) * 3 * E_ + size_t(c) * E_ + e] = own_[size_t(j) * 3 * P + c * P + eval_[e]];
       }
-  accumulate_block(Rp.data(), int64_t(3) * E_, D, B, K_, Cpred_.data());
-  accumulate_block(Ro.data(), int64_t(3) * E_, D, B, K_, Cown_.data());
+  accumulate_block(Rp.data(), int64_t(3) * E_, D, B, K_, C_.data());
+  accumulate_block(Ro.data(), int64_t(3) * E_, D, B, K_, C_.data() + size_t(3) * E_ * K_);
 }
 
 CrossValResult CrossValidator::result() const {
@@ -102,6 +101,8 @@ CrossValResult CrossValidator::result() const {
   r.sq_error.assign(size_t(E_), 0.0);
   r.sq_norm.assign(size_t(E_), 0.0);
   int64_t rows = int64_t(3) * E_;
+  const double* Cpred = C_.data();
+  const double* Cown = C_.data() + size_t(rows) * K_;
   double num = 0, den = 0;
   std::vector<double> rel;
   for (int e = 0; e < E_; ++e) {
@@ -109,9 +110,9 @@ CrossValResult CrossValidator::result() const {
     for (int k = 0; k < K_; ++k)
       for (int c = 0; c < 3; ++c) {
         size_t i = size_t(k) * rows + size_t(c) * E_ + e;
-        double d = double(Cpred_[i]) - Cown_[i];
+        double d = Cpred[i] - Cown[i];
         a += d * d;
-        b += double(Cown_[i]) * Cown_[i];
+        b += Cown[i] * Cown[i];
       }
     r.sq_error[e] = a;
     r.sq_norm[e] = b;
@@ -252,63 +253,78 @@ GridDesc grid_of(const ResampleSearch& s, int n) {
   return {along(e.x), along(e.y), along(e.z), s.volume};
 }
 
-// Cross-validated errors of the candidates on every stride-th bucket (one read of the block files).
+// Buckets the sampling takes: every stride-th by global index, at most max_buckets (all when fewer).
+int sample_stride(const DirectionTable& t, int max_buckets) {
+  return std::max(1, (t.buckets() + max_buckets - 1) / std::max(max_buckets, 1));
+}
+
+// Cross-validated errors of the candidates on every stride-th bucket (one read of the block files),
+// over this process's share of the blocks; then the partial sums of every process are added, so the
+// candidates' result() is the job's. *used: the buckets the whole job evaluates.
 void evaluate(const BucketStore& store, const std::vector<Vec3>& origins, std::vector<Candidate>& cands, int bands, int stride,
-              bool use_starts, int* used) {
+              bool use_starts, int* used, const CvShare& share) {
   const DirectionTable& t = store.table();
-  std::vector<uint16_t> buf;
-  tbb::enumerable_thread_specific<ProjectScratch> scratch;
-  tbb::enumerable_thread_specific<BucketRadiance> rads;
-  int K = bands * bands;
   *used = 0;
-  for (int k = 0; k < t.blocks(); ++k) {
-    std::vector<int> sel;
-    for (int b = t.block_begin[k]; b < t.block_begin[k + 1]; ++b)
-      if (b % stride == 0) sel.push_back(b);
-    if (sel.empty()) continue;
-    store.load_block(k, buf);
-    int D = int(sel.size());
-    *used += D;
-    for (auto& c : cands) c.cv->begin_block(D);
-    parallel_for(0, D, [&](int64_t j) {
-      BucketRays rays = bucket_rays(store, buf, k, sel[j], origins, use_starts, rads.local());
-      for (auto& c : cands) {
-        CvBucket cb = c.cv->bucket(int(j));
-        project_bucket(c.grid, rays, c.project, nullptr, 0, scratch.local(), &cb);
+  for (int b = 0; b < t.buckets(); b += stride) ++*used;
+  auto local = [&] {
+    std::vector<uint16_t> buf;
+    tbb::enumerable_thread_specific<ProjectScratch> scratch;
+    tbb::enumerable_thread_specific<BucketRadiance> rads;
+    int K = bands * bands;
+    int k0 = std::max(share.block_begin, 0), k1 = std::min(share.block_end, t.blocks());
+    for (int k = k0; k < k1; ++k) {
+      std::vector<int> sel;
+      for (int b = t.block_begin[k]; b < t.block_begin[k + 1]; ++b)
+        if (b % stride == 0) sel.push_back(b);
+      if (sel.empty()) continue;
+      store.load_block(k, buf);
+      int D = int(sel.size());
+      for (auto& c : cands) c.cv->begin_block(D);
+      parallel_for(0, D, [&](int64_t j) {
+        BucketRays rays = bucket_rays(store, buf, k, sel[j], origins, use_starts, rads.local());
+        for (auto& c : cands) {
+          CvBucket cb = c.cv->bucket(int(j));
+          project_bucket(c.grid, rays, c.project, nullptr, 0, scratch.local(), &cb);
+        }
+      });
+      std::vector<float> B(size_t(D) * K);
+      for (int j = 0; j < D; ++j) {
+        auto row = bucket_basis(t, sel[j], sel[j] + 1, bands);
+        for (int kk = 0; kk < K; ++kk) B[size_t(kk) * D + j] = row[kk];
       }
-    });
-    std::vector<float> B(size_t(D) * K);
-    for (int j = 0; j < D; ++j) {
-      auto row = bucket_basis(t, sel[j], sel[j] + 1, bands);
-      for (int kk = 0; kk < K; ++kk) B[size_t(kk) * D + j] = row[kk];
+      for (auto& c : cands) c.cv->end_block(B.data(), D);
     }
-    for (auto& c : cands) c.cv->end_block(B.data(), D);
-  }
+  };
+  if (share.agree) share.agree(local);
+  else local();
+  if (share.sum)
+    for (auto& c : cands) {
+      auto& C = c.cv->partial_sums();
+      share.sum(C.data(), C.size());
+    }
 }
 
 }  // namespace
 
 CrossValResult cross_validate(const BucketStore& store, const std::vector<Vec3>& origins, const GridDesc& grid,
                               const ProjectDesc& project, int bands, const CrossValDesc& cv, int max_buckets, bool use_starts,
-                              int* buckets_used) {
-  const DirectionTable& t = store.table();
-  int stride = std::max(1, (t.buckets() + max_buckets - 1) / std::max(max_buckets, 1));
+                              int* buckets_used, const CvShare& share) {
+  int stride = sample_stride(store.table(), max_buckets);
   std::vector<Candidate> c(1);
   c[0].grid = grid;
   c[0].project = project;
   c[0].cv = std::make_unique<CrossValidator>(grid, origins, store.valid(), bands, cv);
   int used = 0;
-  evaluate(store, origins, c, bands, stride, use_starts, &used);
+  evaluate(store, origins, c, bands, stride, use_starts, &used, share);
   if (buckets_used) *buckets_used = used;
   return c[0].cv->result();
 }
 
 ResampleChoice choose_resampling(const BucketStore& store, const std::vector<Vec3>& origins, const ProjectDesc& project,
-                                 const ResampleSearch& s, const CrossValDesc& cvd, bool use_starts) {
+                                 const ResampleSearch& s, const CrossValDesc& cvd, bool use_starts, const CvShare& share) {
   auto t0 = std::chrono::steady_clock::now();
   ResampleChoice ch;
-  const DirectionTable& t = store.table();
-  int stride = std::max(1, (t.buckets() + s.max_buckets - 1) / std::max(s.max_buckets, 1));
+  int stride = sample_stride(store.table(), s.max_buckets);
   CrossValDesc cv = cvd;
   if (cv.folds < 2) cv.folds = 5;
   auto run = [&](const std::vector<std::pair<int, double>>& pairs) {  // (n, kernel); n 0 = the given resolution
@@ -321,7 +337,7 @@ ResampleChoice choose_resampling(const BucketStore& store, const std::vector<Vec
       c.cv = std::make_unique<CrossValidator>(c.grid, origins, store.valid(), s.bands, cv);
       cands.push_back(std::move(c));
     }
-    evaluate(store, origins, cands, s.bands, stride, use_starts, &ch.buckets_used);
+    evaluate(store, origins, cands, s.bands, stride, use_starts, &ch.buckets_used, share);
     for (size_t i = 0; i < cands.size(); ++i) {
       CrossValResult r = cands[i].cv->result();
       bool better = ch.trials.empty() || r.rel_error < ch.best.rel_error;

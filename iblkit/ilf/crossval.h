@@ -6,6 +6,8 @@
 // The same machinery chooses the kernel width and the grid resolution (`--kernel auto`, `--grid auto`).
 #pragma once
 #include <cstdint>
+#include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -47,6 +49,10 @@ class CrossValidator {
   CvBucket bucket(int j);                  // column j of the block (thread-safe for distinct j)
   void end_block(const float* B, int D);   // B: the block's basis rows (D × K, column-major, as bucket_basis)
   CrossValResult result() const;
+  // The sums so far (Σ over blocks of the predictions' and the probes' own SH products), as
+  // 2·3·E·K doubles. They are additive over blocks: a distributed job sums every process's
+  // (CvShare::sum) before result().
+  std::vector<double>& partial_sums() { return C_; }
 
  private:
   GridDesc grid_;
@@ -58,7 +64,21 @@ class CrossValidator {
   std::vector<int> eval_;                  // evaluated probe ids
   std::vector<Vec3> pos_;
   std::vector<float> pred_, own_;
-  std::vector<double> Cpred_, Cown_;  // accumulate_block sums over blocks in double
+  std::vector<double> C_;  // Cpred then Cown (3·E × K each): accumulate_block sums over blocks in double
+};
+
+// A process's share of a cross-validation split between the processes of a job (ilf/mpi/, docs/ilf.md
+// "On a cluster"): it evaluates the sampled buckets of blocks [block_begin, block_end) only — the
+// buckets are sampled by their global index, so the job evaluates the serial build's buckets — and the
+// partial sums meet through `sum`. One process (the default) has every block and no hooks.
+struct CvShare {
+  int block_begin = 0, block_end = std::numeric_limits<int>::max();
+  // Runs f (local work, no collective calls) and lets every process learn whether it failed on any:
+  // then all of them throw the same error. Empty: f().
+  std::function<void(const std::function<void()>& f)> agree;
+  // Replaces n doubles by their sum over the job's processes, the same bits on every process (so that
+  // every process makes the same choice). Empty: nothing to add.
+  std::function<void(double* data, size_t n)> sum;
 };
 
 // The error volume beside a grid (`ilf build --error-grid`): at each of its points (the build grid's
@@ -104,14 +124,18 @@ struct ResampleSearch {
 // Bytes a build of this resolution holds (grid, SH accumulator, one block of bucket columns).
 double build_grid_bytes(int nx, int ny, int nz, int bands, int block_buckets);
 
+// Distributed: every process calls it with the same arguments and its own share; every process gets the
+// job's choice.
 ResampleChoice choose_resampling(const BucketStore& store, const std::vector<Vec3>& origins, const ProjectDesc& project,
-                                 const ResampleSearch& search, const CrossValDesc& cv, bool use_starts);
+                                 const ResampleSearch& search, const CrossValDesc& cv, bool use_starts,
+                                 const CvShare& share = {});
 
 // The cross-validation of one build (grid, kernel) on every s-th bucket, at most max_buckets of them
-// (all when there are fewer): one read of the block files.
+// (all when there are fewer): one read of the block files. buckets_used: the job's count. Distributed
+// as choose_resampling: every process gets the job's result.
 CrossValResult cross_validate(const BucketStore& store, const std::vector<Vec3>& origins, const GridDesc& grid,
                               const ProjectDesc& project, int bands, const CrossValDesc& cv, int max_buckets, bool use_starts,
-                              int* buckets_used = nullptr);
+                              int* buckets_used = nullptr, const CvShare& share = {});
 
 // The rays of bucket b of block k (loaded into buf); their radiance is converted into `rad`, which
 // the returned rays point into.

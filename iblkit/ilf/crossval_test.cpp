@@ -1,10 +1,12 @@
 // Tests of the cross-validation (ilf/crossval.h): zero on a field every grid represents exactly, the
 // one-pass difference of fold rasters equal to k separate builds, the automatic choice, the error
-// volume.
+// volume, and shares of the blocks (a distributed job's, CvShare) that add up to the whole.
 #include <gtest/gtest.h>
 
+#include <barrier>
 #include <cmath>
 #include <filesystem>
+#include <thread>
 
 #include <fmt/format.h>
 
@@ -163,6 +165,88 @@ TEST(IlfCrossVal, AutoChoiceAndErrorVolume) {
   build_shgrid(seq, b3, {}, &r3);
   ASSERT_TRUE(r3.choice);
   EXPECT_NE(std::find(std::begin(kAutoGrids), std::end(kAutoGrids), r3.nx), std::end(kAutoGrids));
+}
+
+// A job of N processes, here N threads of this one: each evaluates its share of the blocks (contiguous
+// ranges, one of them empty) and `sum` adds the partial sums through shared memory. The job's error,
+// its per-probe figures and its automatic choice equal one process's to float rounding of the sum in
+// double, with the buckets sampled (every 5th: max_buckets 100 of ~440) by their global index.
+TEST(IlfCrossVal, SharesOfTheBlocksAddUpToTheWhole) {
+  auto field = AnalyticField::three_spheres();
+  auto seq = capture(field, "share", 60, 24);
+  BucketDesc bd;
+  bd.dir = temp_dir("share_b");
+  BucketStore store = BucketStore::sort(seq, bd);
+  const int blocks = store.table().blocks();
+  ASSERT_GE(blocks, 4);
+  std::vector<Vec3> origins;
+  for (const auto& p : seq.probes) origins.push_back(p.position);
+  GridDesc grid{6, 6, 6, seq.volume};
+  ProjectDesc pd;
+  CrossValDesc cvd;
+  constexpr int kMaxBuckets = 100;
+  ResampleSearch rs{.kernel = true, .volume = seq.volume, .nx = 6, .ny = 6, .nz = 6, .max_buckets = kMaxBuckets};
+  int used = 0;
+  CrossValResult whole = cross_validate(store, origins, grid, pd, 5, cvd, kMaxBuckets, true, &used);
+  ResampleChoice whole_choice = choose_resampling(store, origins, pd, rs, cvd, true);
+  EXPECT_LT(used, store.table().buckets() / 4);  // sampled, not every bucket
+  // Blocks [0, 1), [1, 1) (none), [1, blocks/2), [blocks/2, blocks).
+  const std::vector<int> cut = {0, 1, 1, blocks / 2, blocks};
+  const int N = int(cut.size()) - 1;
+  std::barrier sync(N);
+  std::vector<double*> parts(size_t(N), nullptr);
+  std::vector<double> total;
+  auto sum_of = [&](int rank) {
+    return [&, rank](double* x, size_t n) {
+      parts[rank] = x;
+      sync.arrive_and_wait();
+      if (rank == 0) {
+        total.assign(n, 0.0);
+        for (double* q : parts)
+          for (size_t i = 0; i < n; ++i) total[i] += q[i];
+      }
+      sync.arrive_and_wait();
+      std::copy(total.begin(), total.end(), x);
+      sync.arrive_and_wait();
+    };
+  };
+  std::vector<CrossValResult> res(static_cast<size_t>(N));
+  std::vector<ResampleChoice> choice(static_cast<size_t>(N));
+  std::vector<int> used_by(static_cast<size_t>(N));
+  {
+    std::vector<std::jthread> ranks;
+    for (int r = 0; r < N; ++r)
+      ranks.emplace_back([&, r] {
+        CvShare share{cut[r], cut[r + 1], {}, sum_of(r)};
+        res[r] = cross_validate(store, origins, grid, pd, 5, cvd, kMaxBuckets, true, &used_by[r], share);
+        choice[r] = choose_resampling(store, origins, pd, rs, cvd, true, share);
+      });
+  }
+  auto rel = [](double a, double b) { return std::abs(a - b) / std::max(std::abs(b), 1e-300); };
+  for (int r = 0; r < N; ++r) {
+    EXPECT_EQ(used_by[r], used);
+    EXPECT_EQ(res[r].evaluated, whole.evaluated);
+    EXPECT_LT(rel(res[r].rel_error, whole.rel_error), 1e-9) << r;
+    EXPECT_LT(rel(res[r].median_probe_error, whole.median_probe_error), 1e-9) << r;
+    ASSERT_EQ(res[r].sq_error.size(), whole.sq_error.size());
+    for (size_t e = 0; e < whole.sq_error.size(); ++e) {
+      EXPECT_LT(rel(res[r].sq_error[e], whole.sq_error[e]), 1e-9) << r << " probe " << e;
+      EXPECT_LT(rel(res[r].sq_norm[e], whole.sq_norm[e]), 1e-9) << r << " probe " << e;
+    }
+    EXPECT_EQ(choice[r].kernel, whole_choice.kernel);
+    EXPECT_EQ(choice[r].buckets_used, whole_choice.buckets_used);
+    ASSERT_EQ(choice[r].trials.size(), whole_choice.trials.size());
+    for (size_t i = 0; i < whole_choice.trials.size(); ++i)
+      EXPECT_LT(rel(choice[r].trials[i].cv_error, whole_choice.trials[i].cv_error), 1e-9) << r << " trial " << i;
+    for (size_t i = 0; i < whole.region_error.size(); ++i)
+      if (std::isfinite(whole.region_error[i])) {
+        EXPECT_LT(rel(res[r].region_error[i], whole.region_error[i]), 1e-9);
+      }
+  }
+  // Every rank holds the same bits (the ranks must make the same choice).
+  for (int r = 1; r < N; ++r) EXPECT_EQ(res[r].rel_error, res[0].rel_error);
+  std::printf("[ilf] cv over %d shares of %d blocks, %d of %d buckets: %.9f (one process %.9f), kernel %g\n", N, blocks, used,
+              store.table().buckets(), res[0].rel_error, whole.rel_error, choice[0].kernel);
 }
 
 }  // namespace

@@ -1,9 +1,10 @@
 // The ILF build on a cluster (issue 18, docs/ilf.md "On a cluster"): `mpirun -np N iblkit ilf build …`
 // runs build_shgrid's phases split between the N processes of an MPI job and gives the serial build's
 // grid (to float rounding). Ranks own contiguous ranges of direction blocks; each reads a disjoint
-// slice of the probe frames, sends every block's samples to its owner (MPI_Alltoallv), projects,
-// repairs and accumulates its own blocks, and the partial SH sums meet on rank 0 (MPI_Reduce), which
-// returns the grid. MPI itself lives in the "mpi" plugin (ilf/mpi/, built with IBLKIT_WITH_MPI); this
+// slice of the probe frames, sends every block's samples to its owner (MPI_Alltoallv), cross-validates
+// (and chooses kernel and grid) on the sampled buckets of its own blocks, those sums meeting on every
+// rank, projects, repairs and accumulates its own blocks, and the partial SH sums meet on rank 0
+// (MPI_Reduce), which returns the grid. MPI itself lives in the "mpi" plugin (ilf/mpi/, built with IBLKIT_WITH_MPI); this
 // header is what the rest of iblkit sees of it.
 #pragma once
 #include <cstdint>
@@ -27,9 +28,11 @@ struct DistributedReport {
   double t_repair = 0;      // the repair's share of t_project
   double t_accumulate = 0;  // SH products of the own blocks
   double t_reduce = 0;      // MPI_Reduce of the partial SH sums onto rank 0
+  double t_crossval = 0;    // the cross-validated choice and error (own blocks' sampled buckets, their sums' reduce)
   int64_t bytes_sent = 0;       // samples this rank sent to other ranks (half floats), largest rank
   int64_t bytes_received = 0;   // samples this rank received from other ranks, largest rank
   int64_t bytes_reduced = 0;    // partial SH sums a rank sends in the reduce (8 bytes per value)
+  int64_t bytes_crossval = 0;   // partial cross-validation sums a rank sends in their reduce (8 bytes per value)
   int64_t peak_rss_bytes = 0;   // the largest rank's peak resident memory (VmHWM)
   int blocks_min = 0, blocks_max = 0;  // direction blocks per rank
   int chunk = 0;                // probes per read-and-exchange round of one rank

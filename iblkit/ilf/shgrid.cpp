@@ -56,12 +56,13 @@ sh::Coeffs SHGrid::coeffs_at(Vec3 p) const {
 
 Vec3 SHGrid::irradiance(Vec3 p, Vec3 n) const { return sh::irradiance_at(coeffs_at(p), normalize(n)); }
 
-Vec3 SHGrid::radiance(Vec3 p, Vec3 w) const {
-  auto c = coeffs_at(p);
-  std::vector<double> y(static_cast<size_t>(coeff_count()));
-  sh::eval_basis(bands_, normalize(w), y.data());
+Vec3 SHGrid::radiance(Vec3 p, Vec3 w) const { return sh_radiance(coeffs_at(p), w); }
+
+Vec3 sh_radiance(const sh::Coeffs& c, Vec3 w) {
+  std::vector<double> y(c.c.size());
+  sh::eval_basis(c.bands, normalize(w), y.data());
   Vec3 r{0, 0, 0};
-  for (int k = 0; k < coeff_count(); ++k) r += c.c[k] * y[k];
+  for (size_t k = 0; k < c.c.size(); ++k) r += c.c[k] * y[k];
   return r;
 }
 
@@ -69,12 +70,16 @@ Vec3 SHGrid::radiance(Vec3 p, Vec3 w) const {
 // Σ_lm Λ_l·c_lm·Y_lm(r) — the zonal harmonic rotated to r (Sloan et al. 2005, eq. 1).
 Vec3 SHGrid::glossy(Vec3 p, Vec3 r, double exponent) const {
   if (!(exponent >= 0)) fail(ErrorKind::Value, "glossy: Phong exponent {} must be ≥ 0", exponent);
-  auto c = coeffs_at(p);
-  auto z = sh::phong_zh(bands_, exponent);
-  std::vector<double> y(static_cast<size_t>(coeff_count()));
-  sh::eval_basis(bands_, normalize(r), y.data());
+  return sh_glossy(coeffs_at(p), r, exponent);
+}
+
+Vec3 sh_glossy(const sh::Coeffs& c, Vec3 r, double exponent) {
+  if (!(exponent >= 0)) fail(ErrorKind::Value, "glossy: Phong exponent {} must be ≥ 0", exponent);
+  auto z = sh::phong_zh(c.bands, exponent);
+  std::vector<double> y(c.c.size());
+  sh::eval_basis(c.bands, normalize(r), y.data());
   Vec3 out{0, 0, 0};
-  for (int l = 0; l < bands_; ++l) {
+  for (int l = 0; l < c.bands; ++l) {
     double s = z[l];
     for (int m = -l; m <= l; ++m) out += c.c[sh::index(l, m)] * (s * y[sh::index(l, m)]);
   }

@@ -49,6 +49,10 @@ class SHGrid {
   std::vector<float> data_;
 };
 
+// The radiance and the Phong-glossy response (SHGrid::radiance, SHGrid::glossy) of coefficients c.
+Vec3 sh_radiance(const sh::Coeffs& c, Vec3 w);
+Vec3 sh_glossy(const sh::Coeffs& c, Vec3 r, double exponent);
+
 // Reads/writes a .shgrid; errors name the file and the field.
 // A file whose header names a "content" (an error volume, ilf/crossval.h) is refused unless any_content.
 SHGrid read_shgrid(const std::string& path, bool any_content = false);

@@ -7,6 +7,7 @@
 
 #include "iblkit/core/error.h"
 #include "iblkit/core/json_file.h"
+#include "iblkit/ilf/adaptive.h"
 #include "iblkit/ilf/shgrid.h"
 #include "iblkit/nearfield/dataset.h"
 #include "iblkit/render/prefilter.h"
@@ -55,9 +56,10 @@ std::string read_light_set(const nlohmann::json& j, const std::string& path, int
 void read_lighting(const std::string& path, const LightingReadDesc& desc, Lighting* L, std::string* kind) {
   std::string what;
   const std::string ext = std::filesystem::path(path).extension().string();
-  if (ext == ".shgrid") {
-    const ilf::SHGrid& g = L->grid.emplace(ilf::read_shgrid(path));
-    what = fmt::format("SH grid {}x{}x{}, {} bands", g.grid().nx, g.grid().ny, g.grid().nz, g.bands());
+  if (ext == ".shgrid" || ext == ".shtree") {  // an adaptive grid resampled at its fine resolution (ilf/adaptive.h)
+    const ilf::SHGrid& g = L->grid.emplace(ilf::read_dense(path));
+    what = fmt::format("SH grid {}x{}x{}, {} bands{}", g.grid().nx, g.grid().ny, g.grid().nz, g.bands(),
+                       ext == ".shtree" ? " (adaptive, resampled to dense)" : "");
   } else if (ext == ".json") {
     const nlohmann::json j = read_json_file(path);
     if (!j.is_object()) fail(ErrorKind::Format, "{}: expected a JSON object (an iblkit.lights/1, iblkit.sh/1 or iblkit.nearfield/1 file), got {}", path, j.type_name());

@@ -25,6 +25,26 @@ class SHGrid:
     @staticmethod
     def load(path: str) -> SHGrid: ...
 
+class AdaptiveGrid:
+    resolution: Tuple[int, int, int]
+    min: Vec3
+    max: Vec3
+    bands: int
+    levels: int
+    brick: int
+    tolerance: float
+    rms: float
+    stored_points: int
+    file_bytes: int
+    def eval(self, points: ArrayLike) -> np.ndarray: ...
+    def level_at(self, points: ArrayLike) -> np.ndarray: ...
+    def to_dense(self, grid: Optional[Union[int, Tuple[int, int, int]]] = None) -> SHGrid: ...
+    def save(self, path: str) -> None: ...
+    @staticmethod
+    def load(path: str) -> AdaptiveGrid: ...
+
+def adapt(grid: SHGrid, tolerance: float = 0.01, brick: int = 4) -> AdaptiveGrid: ...
+
 def build(source: Union[str, ArrayLike, Sequence[ArrayLike]], positions: Optional[ArrayLike] = None,
           grid: Union[int, Tuple[int, int, int]] = 16, bands: int = 5, volume: Optional[Tuple[ArrayLike, ArrayLike]] = None,
           mapping: str = "auto", dead_angle: float = 0.0, rotation: Optional[ArrayLike] = None, repair: str = "mip",

@@ -9,6 +9,7 @@
 
 #include "iblkit/core/check.h"
 #include "iblkit/core/error.h"
+#include "iblkit/ilf/adaptive.h"
 #include "iblkit/ilf/build.h"
 #include "iblkit/ilf/sequence.h"
 #include "iblkit/ilf/shgrid.h"
@@ -189,6 +190,84 @@ grid's storage (no copy); point (i, j, k) sits at min + (max − min)·(i/(nx−
       .def("save", [](const SHGrid& g, const std::string& p) { ibl::ilf::write_shgrid(p, g); }, py::arg("path"),
            "Writes a .shgrid file (atomically).")
       .def_static("load", [](const std::string& p) { return ibl::ilf::read_shgrid(p); }, py::arg("path"), "Reads a .shgrid file.");
+
+  using ibl::ilf::AdaptiveGrid;
+  py::class_<AdaptiveGrid>(m, "AdaptiveGrid",
+                           R"doc(An adaptive SH grid (the library's ilf::AdaptiveGrid, the .shtree file): a dense grid's
+coefficients kept at full resolution only where coarser levels miss them by more than the tolerance
+(docs/ilf.md, "Adaptive storage"). Made by `ilf.adapt(grid, tolerance)`.)doc")
+      .def_property_readonly("resolution", [](const AdaptiveGrid& t) { return py::make_tuple(t.grid().nx, t.grid().ny, t.grid().nz); },
+                             "(nx, ny, nz) points of the fine grid (level 0).")
+      .def_property_readonly("min", [](const AdaptiveGrid& t) { return vec3_tuple(t.grid().volume.min); }, "Volume corner (x, y, z), metres.")
+      .def_property_readonly("max", [](const AdaptiveGrid& t) { return vec3_tuple(t.grid().volume.max); }, "Opposite corner, metres.")
+      .def_property_readonly("bands", &AdaptiveGrid::bands, "SH bands (K = bands²).")
+      .def_property_readonly("levels", &AdaptiveGrid::levels, "Levels, 0 (the fine grid) to the top (2 points per axis).")
+      .def_property_readonly("brick", &AdaptiveGrid::brick, "Points per brick axis.")
+      .def_property_readonly("tolerance", &AdaptiveGrid::tolerance, "The tolerance it was made with (× rms).")
+      .def_property_readonly("rms", &AdaptiveGrid::rms, "RMS over the fine points of the coefficient vector's L2 norm.")
+      .def_property_readonly("stored_points", &AdaptiveGrid::stored_points, "Points stored over all levels.")
+      .def_property_readonly("file_bytes", &AdaptiveGrid::file_bytes, "Bytes of its .shtree file.")
+      .def("__repr__", [](const AdaptiveGrid& t) {
+        return fmt::format("AdaptiveGrid({}x{}x{}, bands={}, {} points stored)", t.grid().nx, t.grid().ny, t.grid().nz, t.bands(),
+                           t.stored_points());
+      })
+      .def(
+          "eval",
+          [](const AdaptiveGrid& t, py::handle points) {
+            auto p = points_arg(points, "AdaptiveGrid.eval: points");
+            const py::ssize_t K = t.coeff_count();
+            py::array_t<double> out({static_cast<py::ssize_t>(p.size()), K, py::ssize_t(3)});
+            double* o = out.mutable_data();
+            {
+              py::gil_scoped_release nogil;
+              for (size_t i = 0; i < p.size(); ++i) {
+                auto c = t.coeffs_at(p[i]);
+                for (py::ssize_t k = 0; k < K; ++k) {
+                  o[(i * K + k) * 3] = c.c[k].x; o[(i * K + k) * 3 + 1] = c.c[k].y; o[(i * K + k) * 3 + 2] = c.c[k].z;
+                }
+              }
+            }
+            return out;
+          },
+          py::arg("points"), "Coefficients (N, K, 3) at N points: the tree's own lookup.")
+      .def(
+          "level_at",
+          [](const AdaptiveGrid& t, py::handle points) {
+            auto p = points_arg(points, "AdaptiveGrid.level_at: points");
+            py::array_t<int> out(static_cast<py::ssize_t>(p.size()));
+            for (size_t i = 0; i < p.size(); ++i) out.mutable_data()[i] = t.level_at(p[i]);
+            return out;
+          },
+          py::arg("points"), "The level that answers at each point (0: the fine grid's resolution).")
+      .def(
+          "to_dense",
+          [](const AdaptiveGrid& t, py::object grid) {
+            int n[3] = {t.grid().nx, t.grid().ny, t.grid().nz};
+            if (!grid.is_none()) {
+              if (py::isinstance<py::int_>(grid)) {
+                n[0] = n[1] = n[2] = grid.cast<int>();
+              } else {
+                auto g = grid.cast<std::vector<int>>();
+                if (g.size() != 3) throw py::value_error("AdaptiveGrid.to_dense: grid must be n or (nx, ny, nz)");
+                n[0] = g[0]; n[1] = g[1]; n[2] = g[2];
+              }
+            }
+            py::gil_scoped_release nogil;
+            return t.to_dense(n[0], n[1], n[2]);
+          },
+          py::arg("grid") = py::none(), "The dense SHGrid of n or (nx, ny, nz) points (default: the fine grid's), each looked up.")
+      .def("save", [](const AdaptiveGrid& t, const std::string& p) { ibl::ilf::write_adaptive(p, t); }, py::arg("path"),
+           "Writes a .shtree file (atomically).")
+      .def_static("load", [](const std::string& p) { return ibl::ilf::read_adaptive(p); }, py::arg("path"), "Reads a .shtree file.");
+
+  m.def(
+      "adapt",
+      [](const SHGrid& g, double tolerance, int brick) {
+        py::gil_scoped_release nogil;
+        return ibl::ilf::make_adaptive(g, {.tolerance = tolerance, .brick = brick});
+      },
+      py::arg("grid"), py::arg("tolerance") = ibl::ilf::AdaptDesc{}.tolerance, py::arg("brick") = ibl::ilf::AdaptDesc{}.brick,
+      "The AdaptiveGrid of a dense SHGrid: within tolerance × rms of its lookup everywhere (`iblkit ilf adapt`).");
 
   m.def(
       "build",

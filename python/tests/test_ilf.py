@@ -74,3 +74,28 @@ def test_shgrid_queries(tmp_path):
         ilf.SHGrid(np.zeros((2, 2, 2, 8, 3), np.float32), (0, 0, 0), (1, 1, 1))
     with pytest.raises(ValueError):
         ilf.SHGrid(c, (0, 0, 0), (0, 1, 1))
+
+
+def test_adaptive_grid(tmp_path):
+    # A field linear in position prunes to the top level and stays exact; noise at tolerance 0 keeps
+    # every point and densifies back to the grid; a file round trip keeps the lookups.
+    z, y, x = np.meshgrid(np.arange(5), np.arange(9), np.arange(17), indexing="ij")
+    c = np.zeros((5, 9, 17, 4, 3), np.float32)
+    c[...] = (0.5 + 0.1 * x + 0.05 * y - 0.02 * z)[..., None, None]
+    t = ilf.adapt(ilf.SHGrid(c, (0, 0, 0), (1, 1, 1)), tolerance=1e-5)
+    assert t.stored_points == 8 and t.levels == 5 and t.brick == 4
+    pts = np.random.default_rng(1).random((20, 3))
+    assert np.allclose(t.eval(pts)[:, :, 0], (0.5 + 1.6 * pts[:, 0] + 0.4 * pts[:, 1] - 0.08 * pts[:, 2])[:, None], atol=1e-5)
+    assert (t.level_at(pts) == 4).all()
+    noise = np.random.default_rng(2).random((5, 9, 17, 4, 3)).astype(np.float32)
+    g = ilf.SHGrid(noise, (0, 0, 0), (1, 1, 1))
+    t0 = ilf.adapt(g, tolerance=0)
+    assert np.array_equal(t0.to_dense().coefficients, g.coefficients)
+    assert np.array_equal(t0.eval(pts), g.eval(pts))
+    t0.save(str(tmp_path / "t.shtree"))
+    back = ilf.AdaptiveGrid.load(str(tmp_path / "t.shtree"))
+    assert back.file_bytes == (tmp_path / "t.shtree").stat().st_size and np.array_equal(back.eval(pts), t0.eval(pts))
+    assert t0.to_dense(3).resolution == (3, 3, 3)
+    with pytest.raises(ValueError):
+        ilf.adapt(g, tolerance=-1)
+

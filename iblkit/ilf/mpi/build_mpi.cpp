@@ -5,6 +5,8 @@
 //   read       each rank its chunks of frames, scattered into the block-file layout (half floats);
 //   exchange   per round MPI_Alltoallv: every block's samples to the rank owning it, written there
 //              into the block files at their serial offsets (index.rankRofN.json marks them done);
+//   crossval   the cross-validated choice and error (crossval.h) on the sampled buckets of the own
+//              blocks, the partial sums added on every rank (MPI_Reduce + MPI_Bcast);
 //   project    each rank its own blocks: projection, repair, SH products summed in double;
 //   reduce     MPI_Reduce of the partial sums onto rank 0, which returns the grid.
 // Every failure is agreed between the ranks at the end of the step it happens in (MPI_Allreduce of
@@ -23,6 +25,7 @@
 #include <filesystem>
 #include <fstream>
 #include <mutex>
+#include <optional>
 
 #include <nlohmann/json.hpp>
 
@@ -138,6 +141,27 @@ std::vector<std::string> all_gather_lines(const std::vector<std::string>& mine, 
     pos = e + 1;
   }
   return out;
+}
+
+// The partial sums meet in pieces of 64 MiB (the counts of one call stay within MPI's int).
+constexpr int64_t kReducePiece = int64_t(1) << 23;
+
+// x[0, n) := its sum over the ranks, on rank 0 (the others' x is left as it was).
+void sum_on_root(double* x, int64_t n) {
+  int rank = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  for (int64_t off = 0; off < n; off += kReducePiece) {
+    int m = int(std::min(kReducePiece, n - off));
+    if (rank == 0) MPI_Reduce(MPI_IN_PLACE, x + off, m, MPI_DOUBLE, MPI_SUM, 0, MPI_COMM_WORLD);
+    else MPI_Reduce(x + off, nullptr, m, MPI_DOUBLE, MPI_SUM, 0, MPI_COMM_WORLD);
+  }
+}
+
+// x[0, n) := its sum over the ranks, on every rank and the same bits on each: rank 0's sum, broadcast
+// (MPI_Allreduce need not give every rank the same rounding, and the ranks must make the same choice).
+void sum_on_every_rank(double* x, int64_t n) {
+  sum_on_root(x, n);
+  for (int64_t off = 0; off < n; off += kReducePiece) MPI_Bcast(x + off, int(std::min(kReducePiece, n - off)), MPI_DOUBLE, 0, MPI_COMM_WORLD);
 }
 
 SHGrid Job::build(const Sequence& seq_in, const BuildDesc& desc, const ProgressFn& progress, BuildReport* report,
@@ -348,6 +372,28 @@ SHGrid Job::build(const Sequence& seq_in, const BuildDesc& desc, const ProgressF
   rep.blocks = t.blocks();
   rep.probes_used = P - skipped;
 
+  // The store of this rank's blocks (the others' block files are not touched) and the probes' positions.
+  std::optional<BucketStore> store;
+  agree([&] { store.emplace(BucketStore::open(bd.dir, t, P, d.chunk, valid)); });
+  std::vector<Vec3> origins(static_cast<size_t>(P));
+  for (int p = 0; p < P; ++p) origins[p] = seq.probes[p].position;
+
+  // The cross-validated choice and error, as the serial build makes them: each rank evaluates the
+  // sampled buckets of its own blocks, the partial sums are added over the job (every rank gets them,
+  // so every rank makes the same choice) and every rank continues with the chosen kernel and grid.
+  auto tcv = Clock::now();
+  ProjectDesc pd = desc.project;
+  int64_t cv_values = 0;
+  CvShare share{kb0, kb1, [this](const std::function<void()>& f) { agree(f); }, [&](double* x, size_t n) {
+                  sum_on_every_rank(x, int64_t(n));
+                  cv_values += int64_t(n);
+                }};
+  cross_validate_build(*store, origins, desc, grid, pd, rep, share);
+  if (root && (grid.nx != out.grid().nx || grid.ny != out.grid().ny || grid.nz != out.grid().nz)) out = SHGrid(grid, desc.bands);
+  rep.ball_radius = desc.ball_parallax && !t.start.empty() ? seq.ball.radius : 0.0;
+  dr.t_crossval = since(tcv);
+  dr.bytes_crossval = size_ > 1 ? cv_values * 8 : 0;
+
   // Project, repair and accumulate the own blocks.
   int K = desc.bands * desc.bands;
   int64_t G = grid.count(), rows = 3 * G;
@@ -355,15 +401,12 @@ SHGrid Job::build(const Sequence& seq_in, const BuildDesc& desc, const ProgressF
   double busy_s = 0, repair_s = 0;
   int64_t counts[2] = {0, 0};  // rays, uncovered
   agree([&] {
-    BucketStore store = BucketStore::open(bd.dir, t, P, d.chunk, valid);
-    std::vector<Vec3> origins(static_cast<size_t>(P));
-    for (int p = 0; p < P; ++p) origins[p] = seq.probes[p].position;
     C.assign(size_t(rows) * K, 0.0);
     std::vector<float> R;
     std::vector<uint16_t> buf;
     BlockScratch scratch;
     for (int k = kb0; k < kb1; ++k) {
-      auto w = resample_block(store, k, grid, desc.project, origins, desc.bands, desc.ball_parallax, buf, R, scratch, C.data());
+      auto w = resample_block(*store, k, grid, pd, origins, desc.bands, desc.ball_parallax, buf, R, scratch, C.data());
       counts[0] += w.stats.rays;
       counts[1] += w.stats.uncovered;
       busy_s += w.stats.busy_seconds;
@@ -378,12 +421,7 @@ SHGrid Job::build(const Sequence& seq_in, const BuildDesc& desc, const ProgressF
 
   // Reduce the partial sums onto rank 0, in pieces of 64 MiB.
   auto tr = Clock::now();
-  constexpr int64_t kPiece = int64_t(1) << 23;
-  for (int64_t off = 0; off < rows * K; off += kPiece) {
-    int n = int(std::min(kPiece, rows * K - off));
-    if (root) MPI_Reduce(MPI_IN_PLACE, C.data() + off, n, MPI_DOUBLE, MPI_SUM, 0, MPI_COMM_WORLD);
-    else MPI_Reduce(C.data() + off, nullptr, n, MPI_DOUBLE, MPI_SUM, 0, MPI_COMM_WORLD);
-  }
+  sum_on_root(C.data(), rows * K);
   dr.bytes_reduced = size_ > 1 ? rows * K * 8 : 0;
   if (root) store_coefficients(C.data(), out);
   std::vector<double>().swap(C);
@@ -392,10 +430,10 @@ SHGrid Job::build(const Sequence& seq_in, const BuildDesc& desc, const ProgressF
   // The whole job's figures.
   MPI_Allreduce(MPI_IN_PLACE, counts, 2, MPI_INT64_T, MPI_SUM, MPI_COMM_WORLD);
   MPI_Allreduce(MPI_IN_PLACE, &rep.gemm_flops, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
-  double tmax[8] = {dr.t_read, dr.t_exchange, dr.t_project, dr.t_repair, dr.t_accumulate, dr.t_reduce, dr.t_subsample, 0};
+  double tmax[8] = {dr.t_read, dr.t_exchange, dr.t_project, dr.t_repair, dr.t_accumulate, dr.t_reduce, dr.t_subsample, dr.t_crossval};
   MPI_Allreduce(MPI_IN_PLACE, tmax, 8, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
   dr.t_read = tmax[0]; dr.t_exchange = tmax[1]; dr.t_project = tmax[2]; dr.t_repair = tmax[3];
-  dr.t_accumulate = tmax[4]; dr.t_reduce = tmax[5]; dr.t_subsample = tmax[6];
+  dr.t_accumulate = tmax[4]; dr.t_reduce = tmax[5]; dr.t_subsample = tmax[6]; dr.t_crossval = tmax[7];
   int64_t bmax[4] = {dr.bytes_sent, dr.bytes_received, peak_rss_bytes(), 0};
   MPI_Allreduce(MPI_IN_PLACE, bmax, 4, MPI_INT64_T, MPI_MAX, MPI_COMM_WORLD);
   dr.bytes_sent = bmax[0]; dr.bytes_received = bmax[1]; dr.peak_rss_bytes = bmax[2];

@@ -8,12 +8,16 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 
 #include <fmt/format.h>
+
+#include <nlohmann/json.hpp>
 
 #include "iblkit/ilf/analytic.h"
 #include "iblkit/ilf/build.h"
@@ -81,9 +85,11 @@ class IlfMpi : public ::testing::Test {
     rd.skip_bad = skip_bad;
     return build_shgrid(read_sequence(manifest_, rd), bd);
   }
-  void expect_same(const SHGrid& a, const std::string& path, const std::string& what) {
-    SHGrid b = read_shgrid(path);
-    ASSERT_EQ(a.data().size(), b.data().size()) << what;
+  // Returns the worst relative difference (−1 when the sizes differ).
+  double expect_same(const SHGrid& a, const std::string& path, const std::string& what, bool error_volume = false) {
+    SHGrid b = read_shgrid(path, error_volume);
+    EXPECT_EQ(a.data().size(), b.data().size()) << what;
+    if (a.data().size() != b.data().size()) return -1;
     int bad = 0;
     double worst = 0;
     for (size_t i = 0; i < a.data().size(); ++i) {
@@ -92,6 +98,7 @@ class IlfMpi : public ::testing::Test {
       if (x != 0) worst = std::max(worst, d / std::abs(x));
     }
     EXPECT_EQ(bad, 0) << what << ": " << bad << " of " << a.data().size() << " coefficients differ by more than 1e-6 (worst " << worst << ")";
+    return worst;
   }
   std::string dir_, manifest_;
 };
@@ -107,9 +114,10 @@ TEST_F(IlfMpi, SameGridAsSerialOnOneTwoThreeRanks) {
   oct.bands = 3;
   BuildDesc sub = pixel;
   sub.subsample = SubsampleDesc{0.5, 0.5};
-  std::vector<Case> cases = {{"--grid 6 --directions pixel", pixel},
-                             {"--grid 6 --directions 6 --repair pullpush --bands 3", oct},
-                             {"--grid 6 --directions pixel --subsample 0.5 --subsample-distance 0.5", sub}};
+  // A fixed kernel without cross-validation (the CLI's default cross-validates: next test).
+  std::vector<Case> cases = {{"--grid 6 --directions pixel --kernel 3 --cv-folds 0", pixel},
+                             {"--grid 6 --directions 6 --repair pullpush --bands 3 --kernel 3 --cv-folds 0", oct},
+                             {"--grid 6 --directions pixel --subsample 0.5 --subsample-distance 0.5 --kernel 3 --cv-folds 0", sub}};
   for (const auto& c : cases) {
     SHGrid want = serial(c.bd);
     for (int n : {1, 2, 3}) {
@@ -117,6 +125,82 @@ TEST_F(IlfMpi, SameGridAsSerialOnOneTwoThreeRanks) {
       auto r = mpirun(n, fmt::format("{} {} --out {} --buckets {}/b{}", manifest_, c.args, out, dir_, n));
       ASSERT_EQ(r.status, 0) << c.args << ", " << n << " ranks:\n" << r.out;
       expect_same(want, out, fmt::format("{}, {} ranks", c.args, n));
+    }
+  }
+}
+
+// The cross-validation under MPI (docs/ilf.md "On a cluster"): the CLI's default (--kernel auto, 5
+// folds), --grid auto (with the kernel), a fixed kernel's error, and --error-grid give the serial
+// build's trials, choice, error, error volume and grid on 1, 2 and 3 ranks. 120 probes of 24² (444 pixel buckets, 7 blocks: every
+// bucket is evaluated) and of 64² (3228 buckets of 51 blocks, over BuildDesc::auto_max_buckets: every
+// 2nd by its global index, whichever rank owns it).
+TEST_F(IlfMpi, CrossValidationAndChoiceAsSerial) {
+  struct Case { int size; std::string args; BuildDesc bd; std::vector<int> ranks; };
+  BuildDesc kauto;  // the CLI's defaults at --grid 6
+  kauto.nx = kauto.ny = kauto.nz = 6;
+  kauto.auto_kernel = true;
+  kauto.crossval.folds = 5;
+  BuildDesc fixed = kauto;
+  fixed.auto_kernel = false;
+  fixed.project.kernel_cells = 2;
+  fixed.crossval.folds = 4;
+  BuildDesc both = kauto;  // and the grid: two rounds of candidates, the second chosen by the first
+  both.auto_grid = true;
+  both.buckets.memory_bytes = size_t(64) << 20;  // grids 8-24 (finer ones need more than half of it)
+  std::vector<Case> cases = {{24, "--grid 6", kauto, {1, 2, 3}},
+                             {24, "--grid 6 --kernel 2 --cv-folds 4", fixed, {3}},
+                             {24, "--grid auto --memory 64M", both, {3}},
+                             {64, "--grid 6", kauto, {3}}};
+  std::map<int, std::string> seqs;
+  for (int size : {24, 64}) {
+    SynthDesc sd;
+    sd.out_dir = fmt::format("{}/seq{}", dir_, size);
+    sd.probes = 120;
+    sd.size = size;
+    sd.supersample = 1;
+    seqs[size] = write_synthetic_sequence(AnalyticField::three_spheres(), sd);
+  }
+  for (const auto& c : cases) {
+    BuildDesc bd = c.bd;
+    bd.buckets.dir = fmt::format("{}/serial{}.buckets", dir_, c.size);
+    BuildReport want;
+    SHGrid grid = build_shgrid(read_sequence(seqs[c.size]), bd, {}, &want);
+    ASSERT_TRUE(want.crossval);
+    SHGrid ev = error_volume(*want.crossval, grid.grid());
+    if (c.size == 64) {
+      EXPECT_LT(2 * want.crossval_buckets, want.buckets + 2) << "the buckets were not sampled";
+    }
+    for (int n : c.ranks) {
+      std::string what = fmt::format("{}² frames, {}, {} ranks", c.size, c.args, n);
+      std::string out = fmt::format("{}/cv{}.shgrid", dir_, n), err = fmt::format("{}/cv{}.err.shgrid", dir_, n);
+      auto t0 = std::chrono::steady_clock::now();
+      auto r = mpirun(n, fmt::format("{} {} --json --out {} --error-grid {} --buckets {}/cvb{}_{}", seqs[c.size], c.args, out, err,
+                                     dir_, c.size, n));
+      ASSERT_EQ(r.status, 0) << what << ":\n" << r.out;
+      double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      nlohmann::json j;
+      ASSERT_NO_THROW(j = nlohmann::json::parse(r.out.substr(r.out.find('{')))) << r.out;
+      ASSERT_TRUE(j.contains("crossval")) << what << ": " << r.out;
+      double got = j["crossval"]["rel_error"];
+      EXPECT_LT(std::abs(got - want.crossval->rel_error), kRelTol * want.crossval->rel_error)
+          << what << ": cv error " << got << ", serial " << want.crossval->rel_error;
+      EXPECT_EQ(j["crossval"]["folds"], want.crossval->folds) << what;
+      EXPECT_EQ(j["crossval"]["evaluated"], want.crossval->evaluated) << what;
+      EXPECT_EQ(j["kernel"], want.kernel_cells) << what;
+      EXPECT_EQ(j["resolution"], nlohmann::json({want.nx, want.ny, want.nz})) << what;
+      if (want.choice) {
+        ASSERT_TRUE(j.contains("choice")) << what;
+        EXPECT_EQ(j["choice"]["buckets_used"], want.choice->buckets_used) << what;
+        ASSERT_EQ(j["choice"]["trials"].size(), want.choice->trials.size()) << what;
+        for (size_t i = 0; i < want.choice->trials.size(); ++i) {
+          double e = j["choice"]["trials"][i]["cv_error"], w = want.choice->trials[i].cv_error;
+          EXPECT_LT(std::abs(e - w), kRelTol * w) << what << ", trial " << i;
+        }
+      }
+      double dg = expect_same(grid, out, what), de = expect_same(ev, err, what + " (error volume)", true);
+      std::printf("[ilf] mpi cv: %s (kernel %g, %dx%dx%d): cv error %.9f, relative difference to serial %.1e; grid %.1e, "
+                  "error volume %.1e (worst value); %.1f s\n", what.c_str(), want.kernel_cells, want.nx, want.ny, want.nz,
+                  want.crossval->rel_error, std::abs(got - want.crossval->rel_error) / want.crossval->rel_error, dg, de, seconds);
     }
   }
 }
@@ -144,7 +228,7 @@ TEST_F(IlfMpi, BadFrameFailsOnceOrIsSkippedOnEveryRank) {
   BuildDesc bd;
   bd.nx = bd.ny = bd.nz = 6;
   SHGrid want = serial(bd, true);
-  r = mpirun(3, fmt::format("{} --grid 6 --out {} --skip-bad", manifest_, out));
+  r = mpirun(3, fmt::format("{} --grid 6 --kernel 3 --cv-folds 0 --out {} --skip-bad", manifest_, out));
   ASSERT_EQ(r.status, 0) << r.out;
   expect_same(want, out, "--skip-bad, 3 ranks");
 }
