@@ -8,6 +8,7 @@
 #include "iblkit/core/atomic_file.h"
 #include "iblkit/core/check.h"
 #include "iblkit/core/error.h"
+#include "iblkit/ilf/grid_header.h"
 #include "iblkit/ilf/adaptive.h"
 
 namespace ibl::ilf {
@@ -82,20 +83,9 @@ bool is_adaptive_file(const std::string& path) {
 AdaptiveGrid read_adaptive(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) fail(ErrorKind::Io, "{}: cannot open", path);
-  std::string magic, header;
-  std::getline(in, magic);
-  if (magic != kMagic) fail(ErrorKind::Format, "{}: not an .shtree file (line 1 is not \"{}\")", path, kMagic);
-  std::getline(in, header);
-  json h;
-  try {
-    h = json::parse(header);
-  } catch (const json::exception& e) {
-    fail(ErrorKind::Format, "{}: header (line 2) does not parse ({})", path, e.what());
-  }
-  auto need = [&](const char* f) {
-    if (!h.is_object() || !h.contains(f)) fail(ErrorKind::Format, "{}: header field \"{}\" is missing", path, f);
-    return h[f];
-  };
+  size_t off = 0;
+  json h = read_grid_header(in, path, kMagic, ".shtree", &off);
+  auto need = [&](const char* f) { return grid_header_field(h, path, f); };
   if (need("dtype") != "float32") fail(ErrorKind::Format, "{}: header field \"dtype\" must be \"float32\"", path);
   if (need("layout") != kLayout) fail(ErrorKind::Format, "{}: header field \"layout\" is not \"{}\"", path, kLayout);
   GridDesc gd;
@@ -117,7 +107,6 @@ AdaptiveGrid read_adaptive(const std::string& path) {
   } catch (const json::exception& e) {
     fail(ErrorKind::Format, "{}: header field of the wrong type ({})", path, e.what());
   }
-  const size_t off = magic.size() + 1 + header.size() + 1;
   if (off % 64 != 0) fail(ErrorKind::Format, "{}: data does not start at a multiple of 64 bytes", path);
   for (int a = 0; a < 3; ++a) {
     int n = a == 0 ? gd.nx : a == 1 ? gd.ny : gd.nz;

@@ -9,6 +9,7 @@
 
 #include "iblkit/core/check.h"
 #include "iblkit/core/error.h"
+#include "iblkit/ilf/grid_header.h"
 #include "iblkit/core/atomic_file.h"
 #include "iblkit/sh/basis.h"
 #include "iblkit/sh/convolve.h"
@@ -113,20 +114,9 @@ void write_shgrid(const std::string& path, const SHGrid& g) {
 SHGrid read_shgrid(const std::string& path, bool any_content) {
   std::ifstream in(path, std::ios::binary);
   if (!in) fail(ErrorKind::Io, "{}: cannot open", path);
-  std::string magic, header;
-  std::getline(in, magic);
-  if (magic != "IBLKIT-SHGRID 1") fail(ErrorKind::Format, "{}: not an .shgrid file (line 1 is not \"IBLKIT-SHGRID 1\")", path);
-  std::getline(in, header);
-  json h;
-  try {
-    h = json::parse(header);
-  } catch (const json::exception& e) {
-    fail(ErrorKind::Format, "{}: header (line 2) does not parse ({})", path, e.what());
-  }
-  auto need = [&](const char* f) {
-    if (!h.contains(f)) fail(ErrorKind::Format, "{}: header field \"{}\" is missing", path, f);
-    return h[f];
-  };
+  size_t off = 0;
+  json h = read_grid_header(in, path, "IBLKIT-SHGRID 1", ".shgrid", &off);
+  auto need = [&](const char* f) { return grid_header_field(h, path, f); };
   if (need("dtype") != "float32") fail(ErrorKind::Format, "{}: header field \"dtype\" must be \"float32\"", path);
   if (need("layout") != "z,y,x,coefficient,channel") fail(ErrorKind::Format, "{}: header field \"layout\" is not \"z,y,x,coefficient,channel\"", path);
   GridDesc gd;
@@ -141,7 +131,6 @@ SHGrid read_shgrid(const std::string& path, bool any_content) {
   } catch (const json::exception& e) {
     fail(ErrorKind::Format, "{}: header field of the wrong type ({})", path, e.what());
   }
-  size_t off = magic.size() + 1 + header.size() + 1;
   if (off % 64 != 0) fail(ErrorKind::Format, "{}: data does not start at a multiple of 64 bytes", path);
   if (gd.nx < 2 || gd.ny < 2 || gd.nz < 2)
     fail(ErrorKind::Format, "{}: header field \"resolution\" {}x{}x{} must be at least 2 per axis", path, gd.nx, gd.ny, gd.nz);
