@@ -8,7 +8,8 @@
 # low-scene2 probe set at (0.1, 0.3, 0.1), what composite's examples composite into) and ../shared is
 # the shared data. A failing example fails the test with its command and message. Skipped, with a message:
 # `view` without --frames (an interactive window), examples that need OpenGL where it is absent, and
-# those that read ../shared where it is absent.
+# those that read ../shared where it is absent. Each example may take IBLKIT_EXAMPLE_TIMEOUT seconds
+# (default 120; make test-sanitize gives more).
 set -u
 source "$(dirname "$0")/cli_check.sh" "$1"
 BIN=$(realpath "$BIN")
@@ -60,7 +61,7 @@ run_example() {
   fi
   [[ "$cmd" == iblkit* ]] && cmd="build/$cmd"
   t0=$(date +%s.%N)
-  out=$(eval "timeout 120 $cmd" 2>&1); rc=$?
+  out=$(eval "timeout ${IBLKIT_EXAMPLE_TIMEOUT:-120} $cmd" 2>&1); rc=$?
   printf '%6.2fs  %s\n' "$(echo "$(date +%s.%N) - $t0" | bc)" "$line"
   if [ $rc -ne 0 ]; then echo "FAIL ($where) exit $rc: $line"; echo "$out" | tail -3; fail=$((fail+1)); else pass=$((pass+1)); fi
 }

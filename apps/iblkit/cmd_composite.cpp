@@ -9,7 +9,6 @@
 #include "cli.h"
 #include "render_setup.h"
 #include "iblkit/core/atomic_file.h"
-#include "iblkit/augment/camera_io.h"
 #include "iblkit/augment/composite.h"
 #ifdef IBLKIT_HAVE_GL
 #include "iblkit/augment/gl/compositor.h"
@@ -28,11 +27,12 @@ namespace fs = std::filesystem;
 using ibl::Vec3;
 
 struct Opts {
-  std::string photo, eye, target, up = "0,1,0", camera, probes, proxy, at_probe, probe_depth, object = "blob", at = "0,0.15,0",
-                                   albedo = "0.7,0.7,0.7", out = "composite.exr", layers, backend = "cpu";
+  std::string photo, probe_depth, object = "blob", at = "0,0.15,0", albedo = "0.7,0.7,0.7", out = "composite.exr", layers,
+      backend = "cpu";
+  iblcli::PhotoSceneOptions scene;
   std::vector<std::string> light, truth;
   std::string lobe = "phong", texture;
-  double fov = 40, object_size = 0.3, gloss = 0, exponent = 20;
+  double object_size = 0.3, gloss = 0, exponent = 20;
   int triangles = 20000, median_cut = 0;
   ibl::augment::CompositeDesc desc;
 #ifdef IBLKIT_HAVE_GL
@@ -60,32 +60,12 @@ void run(const Opts& o, const ibl::io::EnvReadDesc& read) {
 #endif
   if (o.light.size() > 1) ibl::fail(ibl::ErrorKind::Value, "--light: give one light file");
   ibl::Image photo = ibl::io::read_image(o.photo);
-  ibl::geometry::Camera cam;
-  if (!o.camera.empty()) {
-    if (!o.eye.empty() || !o.target.empty()) ibl::fail(ibl::ErrorKind::Value, "give either --camera or --eye/--target, not both");
-    cam = ibl::augment::read_camera(o.camera);
-    if ((cam.width != 0 && cam.width != photo.width()) || (cam.height != 0 && cam.height != photo.height()))
-      ibl::fail(ibl::ErrorKind::Value, "{} is {}x{} but the photograph {} is {}x{}", o.camera, cam.width, cam.height, o.photo,
-                photo.width(), photo.height());
-  } else {
-    if (o.eye.empty() || o.target.empty()) ibl::fail(ibl::ErrorKind::Value, "give the photograph's camera: --eye and --target (and --fov), or --camera");
-    cam.eye = iblcli::parse_vec3(o.eye, "--eye");
-    cam.target = iblcli::parse_vec3(o.target, "--target");
-    cam.up = iblcli::parse_vec3(o.up, "--up");
-    cam.fov_y_deg = o.fov;
-  }
-  cam.width = photo.width();
-  cam.height = photo.height();
-  ibl::augment::validate_camera(cam, o.camera.empty() ? "the camera" : o.camera);
+  const ibl::geometry::Camera cam = iblcli::photo_camera(o.scene, photo, o.photo, "");
   const ibl::augment::ObjectDesc od = iblcli::inserted_object(o.object, o.object_size, o.triangles, o.at, o.albedo);
   ibl::geometry::TriMesh object = ibl::augment::make_object(od);
   Vec3 lo, hi;
   object.bounds(&lo, &hi);
-  ibl::augment::LightInput li;
-  li.probes = o.probes;
-  if (!o.light.empty()) li.light = o.light[0];
-  li.proxy = o.proxy;
-  if (!o.at_probe.empty()) li.at_probe = iblcli::parse_vec3(o.at_probe, "--at-probe");
+  ibl::augment::LightInput li = iblcli::photo_light_input(o.scene, o.light);
   li.probe_depth = o.probe_depth;
   li.read = read;
   ibl::augment::LoadedLight L = ibl::augment::load_light(li, lo, hi);
@@ -167,15 +147,8 @@ void run(const Opts& o, const ibl::io::EnvReadDesc& read) {
 void setup(CLI::App& app) {
   auto* o = iblcli::app_owned<Opts>();
   app.add_option("photo", o->photo, "the background photograph (HDR, linear; any format OpenImageIO reads)")->required();
-  app.add_option("--eye", o->eye, "the photograph's camera position x,y,z");
-  app.add_option("--target", o->target, "the point at the frame's centre");
-  app.add_option("--up", o->up, "world direction that appears upwards")->capture_default_str();
-  app.add_option("--fov", o->fov, "vertical field of view, degrees")->capture_default_str();
-  app.add_option("--camera", o->camera, "an iblkit.camera/1 file instead of --eye/--target/--up/--fov");
-  app.add_option("--probes", o->probes, "an iblkit.probes/1 set with its proxy (one probe: Debevec 1998; several: fused at the object)");
+  iblcli::add_photo_scene_options(app, &o->scene, "");
   app.add_option("--light", o->light, "an SH grid (.shgrid) or a probe image (with --at-probe), with --proxy");
-  app.add_option("--proxy", o->proxy, "the local scene's mesh (OBJ, PLY, glTF): receives shadows, occludes the object");
-  app.add_option("--at-probe", o->at_probe, "where the --light probe was captured, x,y,z");
   app.add_option("--probe-depth", o->probe_depth, "the --light probe's depth map (metres; lights in front of the proxy)");
   auto& rd = iblcli::add_probe_read_options(app);
   app.add_option("--object", o->object, "blob, sphere, or a mesh file")->capture_default_str();

@@ -17,7 +17,6 @@
 #include "cli.h"
 #include "render_setup.h"
 #include "iblkit/augment/albedo.h"
-#include "iblkit/augment/camera_io.h"
 #include "iblkit/augment/gl/compositor.h"
 #include "iblkit/augment/load.h"
 #include "iblkit/augment/object.h"
@@ -43,8 +42,8 @@ struct ViewOpts {
   int frames = 0;
   iblcli::ShadowMapOptions shadow_maps;
   // Composite mode (--composite PHOTO): the photograph behind, its camera, the captured light and proxy.
-  std::string photo, eye, target, up = "0,1,0", camera, probes, proxy, at_probe, albedo = "0.7,0.7,0.7";
-  double fov = 40;
+  std::string photo, albedo = "0.7,0.7,0.7";
+  iblcli::PhotoSceneOptions scene;
   int gl_lights = 16;
 };
 
@@ -245,31 +244,12 @@ void show_frame(const ViewOpts& o, Inputs& in, State& st, Viewer& v, GLFWwindow*
 // object goes once round a circle of half its size about --at.
 void run_composite(const ViewOpts& o, const ibl::io::EnvReadDesc& rd) {
   Image photo = io::read_image(o.photo);
-  geometry::Camera cam;
-  if (!o.camera.empty()) {
-    if (!o.eye.empty() || !o.target.empty()) fail(ErrorKind::Value, "give either --camera or --eye/--target, not both");
-    cam = augment::read_camera(o.camera);
-    if ((cam.width != 0 && cam.width != photo.width()) || (cam.height != 0 && cam.height != photo.height()))
-      fail(ErrorKind::Value, "{} is {}x{} but the photograph {} is {}x{}", o.camera, cam.width, cam.height, o.photo, photo.width(), photo.height());
-  } else {
-    if (o.eye.empty() || o.target.empty()) fail(ErrorKind::Value, "--composite: give the photograph's camera (--eye and --target, or --camera)");
-    cam.eye = iblcli::parse_vec3(o.eye, "--eye");
-    cam.target = iblcli::parse_vec3(o.target, "--target");
-    cam.up = iblcli::parse_vec3(o.up, "--up");
-    cam.fov_y_deg = o.fov;
-  }
-  cam.width = photo.width();
-  cam.height = photo.height();
-  augment::validate_camera(cam, o.camera.empty() ? "the camera" : o.camera);
+  const geometry::Camera cam = iblcli::photo_camera(o.scene, photo, o.photo, "--composite: ");
   const augment::ObjectDesc od = iblcli::inserted_object(o.object.scene, o.object.size, o.object.triangles, o.at, o.albedo);
   geometry::TriMesh object = augment::make_object(od);
   Vec3 lo, hi;
   object.bounds(&lo, &hi);
-  augment::LightInput li;
-  li.probes = o.probes;
-  if (!o.lights.empty()) li.light = o.lights[0];
-  li.proxy = o.proxy;
-  if (!o.at_probe.empty()) li.at_probe = iblcli::parse_vec3(o.at_probe, "--at-probe");
+  augment::LightInput li = iblcli::photo_light_input(o.scene, o.lights);
   li.read = rd;
   augment::LoadedLight L = augment::load_light(li, lo, hi);
   for (const auto& w : L.warnings) iblcli::info("warning: " + w);
@@ -390,14 +370,7 @@ void setup(CLI::App& app) {
   app.add_option("-l,--light", o->lights, "lightings to switch between (keys 1-9, Tab): probe, .shgrid (or .shtree), iblkit.sh/1, iblkit.lights/1; "
                  "with --composite: an SH grid or a probe image (with --proxy)");
   app.add_option("--composite", o->photo, "composite mode: this photograph behind, the object moving in it with its shadows");
-  app.add_option("--eye", o->eye, "composite: the photograph's camera position x,y,z");
-  app.add_option("--target", o->target, "composite: the point at the photograph's centre");
-  app.add_option("--up", o->up, "composite: the world direction that appears upwards")->capture_default_str();
-  app.add_option("--fov", o->fov, "composite: vertical field of view, degrees")->capture_default_str();
-  app.add_option("--camera", o->camera, "composite: an iblkit.camera/1 file instead of --eye/--target/--up/--fov");
-  app.add_option("--probes", o->probes, "composite: an iblkit.probes/1 set with its proxy");
-  app.add_option("--proxy", o->proxy, "composite: the local scene's mesh (with --light)");
-  app.add_option("--at-probe", o->at_probe, "composite: where the --light probe was captured, x,y,z");
+  iblcli::add_photo_scene_options(app, &o->scene, "composite: ");
   app.add_option("--albedo", o->albedo, "composite: the object's Lambertian albedo r,g,b")->capture_default_str();
   app.add_option("--gl-lights", o->gl_lights, "composite: most hard lights with shadow maps")->check(CLI::Range(0, 16))->capture_default_str();
   app.add_option("--at", o->at, "the object's starting centre x,y,z (e.g. inside an SH grid's volume)")->capture_default_str();

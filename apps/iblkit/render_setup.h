@@ -7,7 +7,10 @@
 
 #include <CLI/CLI.hpp>
 
+#include "iblkit/augment/load.h"
 #include "iblkit/augment/object.h"
+#include "iblkit/core/image.h"
+#include "iblkit/geometry/camera.h"
 #include "iblkit/geometry/mesh.h"
 #include "iblkit/render/frame.h"
 #include "iblkit/render/shading.h"
@@ -41,6 +44,22 @@ ibl::augment::ObjectDesc inserted_object(const std::string& kind, double size, i
 // replaces the albedo: white times the texture), as `render` and `composite` take them.
 ibl::render::Material object_material(const std::string& albedo, double gloss, double exponent, const std::string& lobe,
                                       const std::string& texture);
+
+// The photograph's camera and the captured light of `composite` and `view --composite` (one set of
+// options, two commands): --eye --target --up --fov or --camera, and --probes, --proxy, --at-probe
+// (--light is each command's own). `prefix` goes before each help text ("composite: " in view).
+struct PhotoSceneOptions {
+  std::string eye, target, up = "0,1,0", camera, probes, proxy, at_probe;
+  double fov = 40;
+};
+void add_photo_scene_options(CLI::App& app, PhotoSceneOptions* o, const std::string& prefix);
+// The camera of `photo` (read from photo_path): --camera's file (its size, where it names one, must be
+// the photograph's) or --eye/--target/--up/--fov; the frame's size is the photograph's; validated.
+// `who` starts the message when neither is given ("" or "--composite: ").
+ibl::geometry::Camera photo_camera(const PhotoSceneOptions& o, const ibl::Image& photo, const std::string& photo_path,
+                                   const std::string& who);
+// What augment::load_light reads: --probes, or the one --light file with --proxy and --at-probe.
+ibl::augment::LightInput photo_light_input(const PhotoSceneOptions& o, const std::vector<std::string>& light);
 
 }  // namespace iblcli
 #endif
