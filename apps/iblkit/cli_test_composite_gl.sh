@@ -25,6 +25,10 @@ check gl ok "against .*object .* shadow .* unchanged" -- "$BIN" composite "$T/ph
 for f in mask difference albedo render_with render_without; do
   if [ -f "$T/layers/$f.exr" ]; then pass=$((pass+1)); else echo "FAIL layers: no $f.exr"; fail=$((fail+1)); fi
 done
+# The material as on the CPU: a glossy, textured object composites on the GL path too.
+"$BIN" --quiet convert "$PROBE" "$T/tex.exr" --mapping latlong --size 16 >/dev/null 2>&1
+check gl-material ok "composite|wrote" -- "$BIN" composite "$T/photo.exr" "${CAM[@]}" --probes "$T/one/probes.json" \
+  "${OBJ[@]}" --backend gl --samples 8 --gloss 0.3 --exponent 30 --lobe blinn --texture "$T/tex.exr" --out "$T/gl_material.exr"
 check bad-backend fail "expected cpu, gl or auto" -- "$BIN" composite "$T/photo.exr" "${CAM[@]}" --probes "$T/one/probes.json" --backend vulkan
 # Beyond the object's reach (its shadow maps' taps, its sphere's share below the cut-off) the composite is the
 # photograph exactly: here about half the frame (the far walls and floor); the object's pixels are not.

@@ -77,15 +77,12 @@ void run(const Opts& o, const ibl::io::EnvReadDesc& read) {
   ibl::augment::CompositeResult r;
 #ifdef IBLKIT_HAVE_GL
   if (backend == "gl") {
-    if (!o.texture.empty() || o.gloss > 0)
-      ibl::fail(ibl::ErrorKind::Unsupported, "--texture/--gloss: the GL compositor shades the object Lambertian with one albedo; "
-                "use --backend cpu");
     ibl::augment::gl::GlCompositeDesc g = o.gl;
     g.albedo_samples = d.light_samples;
     g.seed = d.seed;
     g.shadows = d.shadows;
     g.bounce = d.bounce_samples > 0;
-    r = ibl::augment::gl::composite(photo, cam, L.proxy, L.light, object, od.albedo, g);
+    r = ibl::augment::gl::composite(photo, cam, L.proxy, L.light, object, material, g);
   }
 #endif
   if (backend == "cpu") r = ibl::augment::composite(photo, cam, L.proxy, L.light, object, material, d);

@@ -267,7 +267,7 @@ void run_composite(const ViewOpts& o, const ibl::io::EnvReadDesc& rd) {
   st.step = 0.1 * od.size;
   install_controls(win, &st);
   auto comp = std::make_unique<augment::gl::Compositor>(photo, cam, L.proxy, split, est.albedo);
-  comp->set_object(object, od.albedo);
+  comp->set_object(object, od.albedo);  // Lambertian (composite takes --gloss/--texture)
   auto present = std::make_unique<gl::Presenter>();
   const double meter = io::auto_exposure_scale(photo);
   const std::string renderer_name = reinterpret_cast<const char*>(glGetString(GL_RENDERER));

@@ -13,7 +13,8 @@
 namespace ibl::augment::gl {
 
 CompositeResult composite(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy, const LocalLight& light,
-                          const geometry::TriMesh& object, Vec3 albedo, const GlCompositeDesc& desc, GlFrameTiming* timing) {
+                          const geometry::TriMesh& object, const render::Material& material, const GlCompositeDesc& desc,
+                          GlFrameTiming* timing) {
   auto t0 = std::chrono::steady_clock::now();
   render::gl::Context context;
   AlbedoEstimate est = estimate_albedo(photo, cam, proxy, light, desc.albedo_samples, desc.seed);
@@ -23,7 +24,7 @@ CompositeResult composite(const Image& photo, const geometry::Camera& cam, const
   CompositeResult r;
   {
     Compositor comp(photo, cam, proxy, split, est.albedo, desc);
-    comp.set_object(object, albedo);
+    comp.set_object(object, material);
     comp.draw({}, false, timing);
     Image proxy_comp;
     comp.read_back(&r.composite, &r.mask, &r.difference, &proxy_comp);

@@ -10,6 +10,8 @@
 
 #include "iblkit/core/error.h"
 #include "iblkit/render/gl/program.h"
+#include "iblkit/render/prefilter.h"
+#include "iblkit/sphere/envmap.h"
 
 namespace ibl::augment::gl {
 
@@ -19,29 +21,32 @@ using geometry::Mat4f;
 constexpr int kMaxLights = Compositor::kMaxLights;
 constexpr float kFar = 1e30f;   // a shadow-map texel nothing covers
 
-// Flat-shaded triangles: position and face normal per corner (6 floats), so that both renders and the
-// CPU reference see the same per-triangle normals.
+// Flat-shaded triangles: position, face normal and UV per corner (8 floats; UV 0 for a mesh without UVs),
+// so that both renders and the CPU reference see the same per-triangle normals.
 struct Mesh {
   GLuint vao = 0, vbo = 0;
   GLsizei count = 0;
   void upload(const geometry::TriMesh& m) {
     std::vector<float> v;
-    v.reserve(m.triangle_count() * 18);
+    v.reserve(m.triangle_count() * 24);
+    const bool uvs = m.has_uvs();
     for (size_t i = 0; i < m.triangle_count(); ++i) {
       Vec3 n = m.normal(i);
       for (int k = 0; k < 3; ++k) {
-        Vec3 p = m.positions[m.triangles[i][k]];
-        for (double c : {p.x, p.y, p.z, n.x, n.y, n.z}) v.push_back(static_cast<float>(c));
+        const uint32_t vi = m.triangles[i][k];
+        Vec3 p = m.positions[vi];
+        Vec2 uv = uvs ? m.uvs[vi] : Vec2{0, 0};
+        for (double c : {p.x, p.y, p.z, n.x, n.y, n.z, uv.x, uv.y}) v.push_back(static_cast<float>(c));
       }
     }
     release();
     glCreateBuffers(1, &vbo);
     glNamedBufferStorage(vbo, static_cast<GLsizeiptr>(v.size() * sizeof(float)), v.data(), 0);
     glCreateVertexArrays(1, &vao);
-    glVertexArrayVertexBuffer(vao, 0, vbo, 0, 6 * sizeof(float));
-    for (GLuint a = 0; a < 2; ++a) {
+    glVertexArrayVertexBuffer(vao, 0, vbo, 0, 8 * sizeof(float));
+    for (GLuint a = 0; a < 3; ++a) {
       glEnableVertexArrayAttrib(vao, a);
-      glVertexArrayAttribFormat(vao, a, 3, GL_FLOAT, GL_FALSE, a * 3 * sizeof(float));
+      glVertexArrayAttribFormat(vao, a, a < 2 ? 3 : 2, GL_FLOAT, GL_FALSE, a * 3 * sizeof(float));
       glVertexArrayAttribBinding(vao, a, 0);
     }
     count = static_cast<GLsizei>(m.triangle_count() * 3);
@@ -149,8 +154,9 @@ struct Compositor::Impl {
   int W = 0, H = 0, lights = 0;
   Mesh proxy, object;
   OccluderSphere sphere;
-  Vec3 object_albedo{0.7, 0.7, 0.7};
+  Vec3 object_albedo{0.7, 0.7, 0.7};  // the proxy's bounce: the albedo times the texture's mean
   bool have_object = false;
+  GLuint object_texture = 0, object_glossy = 0;  // the material's albedo texture and prefiltered soft map (or 0)
   GLuint prog_gbuffer = 0, prog_depth = 0, prog_proxy = 0, prog_object = 0, prog_final = 0, empty_vao = 0;
   GLuint photo_tex = 0, albedo_tex = 0, soft_tex = 0, irr_tex = 0, gpos = 0, gnormal = 0, proxy_comp = 0, object_tex = 0, color = 0, diff = 0;
   GLuint object_map = 0, proxy_map = 0, map_depth = 0, depth_rb = 0, ms_color = 0, ms_depth = 0;
@@ -159,7 +165,8 @@ struct Compositor::Impl {
   void release() {
     for (GLuint p : {prog_gbuffer, prog_depth, prog_proxy, prog_object, prog_final})
       if (p) glDeleteProgram(p);
-    GLuint texs[] = {photo_tex, albedo_tex, soft_tex, irr_tex, gpos, gnormal, proxy_comp, object_tex, color, diff, object_map, proxy_map};
+    GLuint texs[] = {photo_tex, albedo_tex, soft_tex, irr_tex, gpos, gnormal, proxy_comp, object_tex, color, diff, object_map, proxy_map,
+                     object_texture, object_glossy};
     glDeleteTextures(static_cast<GLsizei>(std::size(texs)), texs);
     GLuint rbs[] = {map_depth, depth_rb, ms_color, ms_depth};
     glDeleteRenderbuffers(4, rbs);
@@ -346,6 +353,8 @@ Compositor::Compositor(const Image& photo, const geometry::Camera& cam, const ge
     set_int(p, "u_proxy_map", 7);
     set_int(p, "u_soft_irradiance", 5);
   }
+  set_int(m.prog_object, "u_object_texture", 8);
+  set_int(m.prog_object, "u_object_glossy", 9);
   set_int(m.prog_proxy, "u_photo", 0);
   set_int(m.prog_proxy, "u_albedo", 1);
   set_int(m.prog_proxy, "u_gpos", 2);
@@ -367,14 +376,51 @@ Compositor::~Compositor() {
   if (impl_) impl_->release();
 }
 
-void Compositor::set_object(const geometry::TriMesh& object, Vec3 albedo) {
+void Compositor::set_object(const geometry::TriMesh& object, const render::Material& material) {
   if (object.triangle_count() == 0) fail(ErrorKind::Value, "the object has no triangles");
+  const Vec3 a = material.albedo, k = material.specular;
   for (int c = 0; c < 3; ++c)
-    if (!(albedo[c] >= 0 && albedo[c] <= 1)) fail(ErrorKind::Value, "object albedo ({}, {}, {}) must lie in [0, 1]", albedo.x, albedo.y, albedo.z);
+    if (!(a[c] >= 0 && a[c] <= 1 && k[c] >= 0 && k[c] <= 1))
+      fail(ErrorKind::Value, "object albedo ({}, {}, {}) and gloss ({}, {}, {}) must lie in [0, 1]", a.x, a.y, a.z, k.x, k.y, k.z);
+  const bool glossy = max_component(k) > 0;
+  if (glossy && !(material.exponent >= 1 && material.exponent <= 10000))
+    fail(ErrorKind::Value, "glossy exponent {} must lie in 1..10000", material.exponent);
   Impl& m = *impl_;
   m.object.upload(object);
   m.sphere = equivalent_sphere(object);
-  m.object_albedo = albedo;
+  Vec3 mean_texture{1, 1, 1};
+  if (m.object_texture) glDeleteTextures(1, &m.object_texture);
+  if (m.object_glossy) glDeleteTextures(1, &m.object_glossy);
+  m.object_texture = m.object_glossy = 0;
+  if (material.texture) {
+    const Image& t = *material.texture;
+    if (t.pixel_count() == 0) fail(ErrorKind::Value, "the object's texture is empty");
+    Vec3 sum;
+    for (int y = 0; y < t.height(); ++y)
+      for (int x = 0; x < t.width(); ++x) sum += t.rgb(x, y);
+    mean_texture = sum / static_cast<double>(t.pixel_count());
+    // Bilinear and repeating, as render::texture_albedo reads it (texel centres at half-integers).
+    m.object_texture = upload_rgb(t);
+    glTextureParameteri(m.object_texture, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTextureParameteri(m.object_texture, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTextureParameteri(m.object_texture, GL_TEXTURE_WRAP_S, GL_REPEAT);
+    glTextureParameteri(m.object_texture, GL_TEXTURE_WRAP_T, GL_REPEAT);
+  }
+  if (glossy) {
+    // G_s of the soft map (the hard lights' lobe is evaluated per light in the shader): bilinear, u repeats, v clamps.
+    render::GlossyMap g = render::prefilter_phong(sphere::EnvMap::from_image(m.light.soft, sphere::MappingKind::LatLong), material.environment_exponent());
+    m.object_glossy = upload_rgb(g.latlong);
+    glTextureParameteri(m.object_glossy, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTextureParameteri(m.object_glossy, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTextureParameteri(m.object_glossy, GL_TEXTURE_WRAP_S, GL_REPEAT);
+  }
+  m.object_albedo = a * mean_texture;
+  const GLuint p = m.prog_object;
+  set_vec3(p, "u_material_albedo", a);
+  set_int(p, "u_textured", material.texture ? 1 : 0);
+  set_vec3(p, "u_specular", glossy ? k : Vec3{});
+  set_float(p, "u_exponent", material.exponent);
+  set_int(p, "u_blinn", material.lobe == render::Lobe::BlinnPhong ? 1 : 0);
   m.have_object = true;
 }
 
@@ -417,7 +463,8 @@ void Compositor::draw(Vec3 offset, bool gl_rows, GlFrameTiming* timing) {
   glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
   glUseProgram(m.prog_object);
   set_vec3(m.prog_object, "u_offset", offset);
-  set_vec3(m.prog_object, "u_object_albedo", m.object_albedo);
+  const GLuint mat_units[] = {m.object_texture, m.object_glossy};
+  glBindTextures(8, 2, mat_units);
   m.object.draw();
   glBlitNamedFramebuffer(m.fb_object_ms, m.fb_object, 0, 0, m.W, m.H, 0, 0, m.W, m.H, GL_COLOR_BUFFER_BIT, GL_NEAREST);
 

@@ -17,7 +17,12 @@
 //
 // Interreflection kept: proxy → object as captured (in the soft map, not darkened by the object's own
 // shadow), object → proxy through the sphere (its face towards y lit by the soft irradiance and the hard
-// lights, unshadowed). Not kept: the object's light on itself, glossy objects.
+// lights, unshadowed; diffuse, with the texture's mean albedo). Not kept: the object's light on itself.
+//
+// The object's material is render::Material's, as on the CPU: the albedo times the texture at the mesh's
+// UVs (bilinear, repeating), and the glossy lobe (Phong or Blinn-Phong, weight `specular`): from the hard
+// lights the lobe itself, from the soft map its Phong prefiltered map (render/prefilter.h, made once in
+// set_object, the exponent environment_exponent()) looked up along the reflected view ray.
 #pragma once
 #include <memory>
 #include <string>
@@ -26,6 +31,7 @@
 #include "iblkit/augment/composite.h"
 #include "iblkit/augment/split_light.h"
 #include "iblkit/augment/sphere_occlusion.h"
+#include "iblkit/render/shading.h"
 
 namespace ibl::augment::gl {
 
@@ -56,8 +62,11 @@ class Compositor {
   Compositor(const Compositor&) = delete;
   Compositor& operator=(const Compositor&) = delete;
 
-  // The object (world space, at its place) and its Lambertian albedo; uploaded once.
-  void set_object(const geometry::TriMesh& object, Vec3 albedo);
+  // The object (world space, at its place) and its material (albedo, texture, glossy lobe); uploaded once.
+  // Throws ibl::Error on an empty mesh or a material out of range.
+  void set_object(const geometry::TriMesh& object, const render::Material& material);
+  // A Lambertian object of albedo `albedo`.
+  void set_object(const geometry::TriMesh& object, Vec3 albedo) { set_object(object, render::Material{albedo, {0, 0, 0}}); }
   // One frame with the object moved by `offset` (world metres). gl_rows: the colour texture in GL's row
   // order (bottom up, for a window's Presenter) instead of the photograph's.
   void draw(Vec3 offset = {}, bool gl_rows = false, GlFrameTiming* timing = nullptr);
@@ -79,7 +88,13 @@ class Compositor {
 // (estimate_albedo), the light split, one frame read back. Throws ibl::Error (kind Unsupported) when no GL
 // context can be had, and as composite() does on bad input.
 CompositeResult composite(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy, const LocalLight& light,
-                          const geometry::TriMesh& object, Vec3 albedo, const GlCompositeDesc& desc = {},
+                          const geometry::TriMesh& object, const render::Material& material, const GlCompositeDesc& desc = {},
                           GlFrameTiming* timing = nullptr);
+// A Lambertian object of albedo `albedo`.
+inline CompositeResult composite(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy, const LocalLight& light,
+                                 const geometry::TriMesh& object, Vec3 albedo, const GlCompositeDesc& desc = {},
+                                 GlFrameTiming* timing = nullptr) {
+  return composite(photo, cam, proxy, light, object, render::Material{albedo, {0, 0, 0}}, desc, timing);
+}
 
 }  // namespace ibl::augment::gl
