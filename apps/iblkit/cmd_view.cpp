@@ -23,6 +23,7 @@
 #include "iblkit/core/error.h"
 #include "iblkit/io/image_io.h"
 #include "iblkit/io/tonemap.h"
+#include "iblkit/render/gl/context.h"
 #include "iblkit/render/gl/present.h"
 #include "iblkit/render/gl/renderer.h"
 #include "iblkit/render/lighting_io.h"
@@ -111,6 +112,7 @@ GLFWwindow* open_window(int w, int h, bool vsync) {
   if (!win) fail(ErrorKind::Unsupported, "no window with an OpenGL 4.5 core context could be opened on this display");
   glfwMakeContextCurrent(win);
   glfwSwapInterval(vsync ? 1 : 0);
+  ibl::render::gl::keep_drivers_loaded_for_leak_checks();  // (AddressSanitizer builds only)
   return win;
 }
 

@@ -22,12 +22,6 @@
 
 namespace ibl::render::gl {
 
-namespace {
-// Under AddressSanitizer only: keeps every shared object loaded so far (after eglInitialize, Mesa's
-// EGL vendor library and its DRI driver) resident for the process's life. eglTerminate unloads the
-// driver, and LeakSanitizer, which looks at exit, then reports the driver's own allocations (224 bytes,
-// four callocs, in every run that made a context) with no module to name, so that fuzz/lsan.supp's
-// "leak:dri" cannot match them. Promoting each object to RTLD_NODELETE changes nothing else.
 void keep_drivers_loaded_for_leak_checks() {
 #ifdef IBLKIT_LEAK_CHECKED
   std::vector<std::string> names;  // collected first: dlopen is not called under dl_iterate_phdr's lock
@@ -40,7 +34,6 @@ void keep_drivers_loaded_for_leak_checks() {
   for (const auto& n : names) ::dlopen(n.c_str(), RTLD_LAZY | RTLD_NOLOAD | RTLD_NODELETE);
 #endif
 }
-}  // namespace
 
 Context::Context() {
   if (!epoxy_has_egl_extension(EGL_NO_DISPLAY, "EGL_MESA_platform_surfaceless") &&

@@ -26,4 +26,12 @@ class Context {
 // True when a context can be created here (for tests that skip without GL).
 bool available(std::string* why = nullptr);
 
+// Under AddressSanitizer only (a no-op otherwise): keeps every shared object loaded so far resident for the
+// process's life. Call it once a GL driver is loaded (Context does, after eglInitialize; a window's context
+// after it is made): eglTerminate and glfwTerminate unload Mesa's driver, and LeakSanitizer, which looks at
+// exit, then reports the driver's own allocations with no module to name (so that fuzz/lsan.supp's
+// "leak:dri" cannot match them) or crashes reading the unloaded driver's thread-local blocks ("Tracer
+// caught signal 11"). Promoting each object to RTLD_NODELETE changes nothing else.
+void keep_drivers_loaded_for_leak_checks();
+
 }  // namespace ibl::render::gl
