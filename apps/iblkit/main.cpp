@@ -11,6 +11,7 @@
 #include <string_view>
 
 #include <CLI/CLI.hpp>
+#include <oneapi/tbb/global_control.h>
 
 #include "cli.h"
 #include "iblkit/core/atomic_file.h"
@@ -86,7 +87,15 @@ int report(const std::string& what) {
 
 }  // namespace
 
+// TBB's worker threads, joined when main returns rather than left to end while the process exits (where,
+// in a sanitizer build, LeakSanitizer's exit-time scan of the threads races with them).
+struct WorkerThreads {
+  oneapi::tbb::task_scheduler_handle handle{oneapi::tbb::attach{}};
+  ~WorkerThreads() { oneapi::tbb::finalize(handle, std::nothrow); }
+};
+
 int main(int argc, char** argv) {
+  WorkerThreads workers;
   ibl::remove_temp_files_on_signals();  // Ctrl-C or a kill mid-write leaves no temporary file behind
   CLI::App app{
       "iblkit: image-based lighting from captured light.\n"
