@@ -3,7 +3,8 @@
 # cli_atomic; a few seconds; docs/formats.md "How every output is written"): a failing `convert`
 # (bad input, invalid target, a write that fails half way) leaves no file at its output path and
 # keeps the file that was there; an `ilf build` killed by SIGTERM mid-run leaves no file at --out,
-# keeps the previous grid and leaves no temporary file.
+# keeps the previous grid and leaves no temporary file; `sh --format gltf --specular-images` that
+# fails half way leaves none of its PNGs.
 set -u
 source "$(dirname "$0")/cli_check.sh" "$1"
 
@@ -77,6 +78,25 @@ same ilf-killed-keeps-previous "$T/ilf/prev.shgrid" "$T/prev_copy.shgrid"
 no_temp ilf-killed-over-previous-no-temp "$T/ilf"
 # A re-run after the kill succeeds (it reuses the buckets only where their sort had finished).
 check ilf-after-kill ok "wrote" -- "$BIN" ilf build "$T/cap/sequence.json" --grid 4 --out "$T/ilf/new.shgrid"
+
+# ---- sh --format gltf --specular-images: 18 RGBD PNGs and the glTF, or (a face unwritable half way)
+# nothing at all: the PNGs written before the failure go again, the earlier glTF stays.
+if [ -f "$PROBE" ]; then
+  mkdir -p "$T/g"
+  check gltf-faces ok "wrote" -- "$BIN" specular "$PROBE" --size 64 --faces "$T/g/spec"
+  check gltf-ibl ok "18 RGBD PNGs" -- "$BIN" sh "$PROBE" --format gltf --specular-images "$T/g/spec/m{level}_{face}.exr" --out "$T/g/ibl.gltf"
+  n=$(ls "$T/g" | grep -c '^ibl_m[0-2]_[pn][xyz]\.png$')
+  if [ "$n" = 18 ]; then pass=$((pass+1)); else echo "FAIL gltf-ibl-pngs: $n of 18"; fail=$((fail+1)); fi
+  cp "$T/g/ibl.gltf" "$T/ibl_copy.gltf"
+  mkdir -p "$T/g2" && mkdir "$T/g2/new_m1_py.png"
+  check gltf-ibl-unwritable fail "new_m1_py.png" -- "$BIN" sh "$PROBE" --format gltf --specular-images "$T/g/spec/m{level}_{face}.exr" --out "$T/g2/new.gltf"
+  left=$(ls "$T/g2" | grep -v '^new_m1_py.png$')
+  if [ -z "$left" ]; then pass=$((pass+1)); else echo "FAIL gltf-ibl-rollback: left $left"; fail=$((fail+1)); fi
+  rm "$T/g/spec/m1_nz.exr"
+  check gltf-ibl-missing-face fail "m1_nz.exr is missing" -- "$BIN" sh "$PROBE" --format gltf --specular-images "$T/g/spec/m{level}_{face}.exr" --out "$T/g/ibl.gltf"
+  same gltf-ibl-keeps-previous "$T/g/ibl.gltf" "$T/ibl_copy.gltf"
+  no_temp gltf-ibl-no-temp "$T/g"
+fi
 
 echo "cli_atomic: $pass passed, $fail failed, $skip skipped"
 [ $fail -eq 0 ]

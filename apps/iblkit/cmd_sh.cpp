@@ -10,6 +10,7 @@
 #include "cli.h"
 #include "iblkit/core/atomic_file.h"
 #include "iblkit/core/error.h"
+#include "iblkit/engine/gltf_ibl.h"
 #include "iblkit/io/envmap_io.h"
 #include "iblkit/io/image_io.h"
 #include "iblkit/io/tonemap.h"
@@ -31,37 +32,6 @@ Image irradiance_image(const sh::Coeffs& radiance, int height) {
 
 nlohmann::json rgb(Vec3 v) { return {v.x, v.y, v.z}; }
 
-// The face images of a pattern with {level} and {face}, level by level while all six exist; URIs
-// relative to the folder of the glTF written to `out`.
-sh::GltfSpecular specular_images(const std::string& pattern, const std::string& out) {
-  if (pattern.find("{level}") == std::string::npos || pattern.find("{face}") == std::string::npos)
-    fail(ErrorKind::Value, "--specular-images {}: the pattern needs {{level}} and {{face}}", pattern);
-  auto name = [&](int level, const char* face) {
-    std::string s = pattern;
-    s.replace(s.find("{level}"), 7, std::to_string(level));
-    s.replace(s.find("{face}"), 6, face);
-    return s;
-  };
-  static const char* kFaces[6] = {"px", "nx", "py", "ny", "pz", "nz"};
-  fs::path base = out.empty() ? fs::current_path() : fs::absolute(out).parent_path();
-  sh::GltfSpecular spec;
-  for (int level = 0; level < 31; ++level) {
-    std::array<std::string, 6> faces;
-    bool all = true;
-    for (int f = 0; f < 6 && all; ++f) {
-      std::string p = name(level, kFaces[f]);
-      all = fs::exists(p);
-      if (!all) break;
-      if (level == 0 && f == 0) spec.size = io::read_image_spec(p).width;
-      faces[f] = fs::relative(fs::absolute(p), base).generic_string();
-    }
-    if (!all) break;
-    spec.levels.push_back(faces);
-  }
-  if (spec.levels.empty()) fail(ErrorKind::Io, "--specular-images {}: no level 0 with all six faces ({} missing)", pattern, name(0, "px"));
-  return spec;
-}
-
 void setup(CLI::App& app) {
   struct Opts {
     std::string probe, window = "none", format = "iblkit", out, irradiance_map, specular_images;
@@ -78,13 +48,17 @@ void setup(CLI::App& app) {
   app.add_option("--irradiance-map", o->irradiance_map, "also render the SH irradiance E(n) as a lat-long image (.exr …)");
   app.add_option("--irradiance-size", o->irradiance_size, "height of the irradiance map (width is twice)")->capture_default_str();
   app.add_option("--specular-images", o->specular_images,
-                 "--format gltf: the prefiltered cube's face images (EXT_lights_image_based RGBD PNGs) as a pattern with {level} "
-                 "and {face} (px nx py ny pz nz), e.g. spec/m{level}_{face}.png; levels 0, 1, … while all six exist");
+                 "--format gltf: the prefiltered cube's HDR faces as a pattern with {level} and {face} (px nx py ny pz nz), e.g. "
+                 "spec/m{level}_{face}.exr from `iblkit specular --faces spec`; levels 0, 1, … while all six exist. Each face is "
+                 "written beside --out as the extension's RGBD PNG (OUT-STEM_m<level>_<face>.png, flipped as it specifies)");
   auto& rd = iblcli::add_probe_read_options(app);
   app.footer(
       "Examples:\n"
       "  iblkit sh /usr/share/blender/datafiles/studiolights/world/forest.exr --bands 5 --out forest_sh.json\n"
-      "  iblkit sh probe.exr --format filament --window deringing --out sh.txt --irradiance-map irr.exr");
+      "  iblkit sh probe.exr --format filament --window deringing --out sh.txt --irradiance-map irr.exr\n"
+      "  iblkit specular /usr/share/blender/datafiles/studiolights/world/forest.exr --size 64 --faces forest_spec\n"
+      "  iblkit sh /usr/share/blender/datafiles/studiolights/world/forest.exr --format gltf --specular-images "
+      "'forest_spec/m{level}_{face}.exr' --out forest_ibl.gltf");
   app.callback([o, &rd] {
     if (o->bands < 1 || o->bands > sh::kMaxBands)
       fail(ErrorKind::Value, "--bands must be in 1..{} (got {})", sh::kMaxBands, o->bands);
@@ -108,11 +82,15 @@ void setup(CLI::App& app) {
     c = sh::apply_window(c, wd, &wr);
 
     std::string text = sh::export_text(c, format, sh::filament_frame(env.mapping.kind()));
+    std::vector<std::string> specular_files;
     if (!o->specular_images.empty()) {
       if (format != sh::ExportFormat::Gltf) fail(ErrorKind::Value, "--specular-images goes with --format gltf");
-      text = sh::gltf_ibl_text(c, specular_images(o->specular_images, o->out));
+      if (o->out.empty()) fail(ErrorKind::Value, "--specular-images needs --out (the PNGs are written beside the glTF)");
+      specular_files = engine::write_gltf_ibl(o->out, c, engine::read_cube_faces(o->specular_images));
+      specular_files.pop_back();  // the document itself
+    } else if (!o->out.empty()) {
+      write_file_atomically(o->out, text);
     }
-    if (!o->out.empty()) write_file_atomically(o->out, text);
     if (!o->irradiance_map.empty()) io::write_image(o->irradiance_map, irradiance_image(c, o->irradiance_size));
 
     nlohmann::json j = {{"probe", o->probe},
@@ -129,6 +107,7 @@ void setup(CLI::App& app) {
     if (wd.kind == sh::Window::Deringing) j["deringing_lambda"] = wr.lambda;
     if (!o->out.empty()) j["out"] = o->out;
     if (!o->irradiance_map.empty()) j["irradiance_map"] = o->irradiance_map;
+    if (!specular_files.empty()) j["specular_images"] = specular_files;
     if (format != sh::ExportFormat::Iblkit && o->out.empty()) j["export"] = text;
     iblcli::emit(j, [&] {
       if (o->out.empty()) {
@@ -142,6 +121,8 @@ void setup(CLI::App& app) {
       fmt::print("E(+Y) = {:.6g} {:.6g} {:.6g}; min E / mean E = {:.4f} before window, {:.4f} after\n", e.x, e.y, e.z,
                  wr.min_irradiance_before, wr.min_irradiance_after);
       if (!o->irradiance_map.empty()) fmt::print("irradiance map: {}\n", o->irradiance_map);
+      if (!specular_files.empty())
+        fmt::print("specular images: {} RGBD PNGs ({} levels) beside {}\n", specular_files.size(), specular_files.size() / 6, o->out);
     });
   });
 }

@@ -54,7 +54,7 @@ bool encode(std::FILE* f, int w, int h, int color_type, png_bytep* rows, bool sr
 
 void write_png(const std::string& path, const Image& img, bool srgb) {
   const int w = img.width(), h = img.height(), nc = img.channels();
-  if (nc != 1 && nc != 3) fail(ErrorKind::Internal, "{}: write_png takes 1 or 3 channels (got {})", path, nc);
+  if (nc < 1 || nc > 4) fail(ErrorKind::Internal, "{}: write_png takes 1 to 4 channels (got {})", path, nc);
   // Converted up front: nothing below may throw while libpng holds the jump buffer.
   std::vector<unsigned char> bytes(img.size());
   for (size_t i = 0; i < img.size(); ++i) {
@@ -67,7 +67,8 @@ void write_png(const std::string& path, const Image& img, bool srgb) {
   std::FILE* f = std::fopen(path.c_str(), "wb");
   if (!f) fail(ErrorKind::Io, "{}: cannot write ({})", path, std::strerror(errno));
   std::string why;
-  bool ok = encode(f, w, h, nc == 1 ? PNG_COLOR_TYPE_GRAY : PNG_COLOR_TYPE_RGB, rows.data(), srgb, &why);
+  static constexpr int kColorType[4] = {PNG_COLOR_TYPE_GRAY, PNG_COLOR_TYPE_GRAY_ALPHA, PNG_COLOR_TYPE_RGB, PNG_COLOR_TYPE_RGB_ALPHA};
+  bool ok = encode(f, w, h, kColorType[nc - 1], rows.data(), srgb, &why);
   ok = (std::fclose(f) == 0) && ok;
   if (!ok) fail(ErrorKind::Io, "{}: write failed ({})", path, why.empty() ? "libpng" : why);
 }

@@ -48,8 +48,8 @@ Decoded read_pfm(const std::string& path);
 Header read_pfm_header(const std::string& path);
 void write_exr(const std::string& path, const Image& img, bool half);  // every channel, ZIP compression
 void write_rgbe(const std::string& path, const Image& img);            // 3 channels
-// 8 bits per channel, grey or RGB; `img` holds values in [0, 1] already encoded (sRGB): each
-// becomes round(255·v).
+// 8 bits per channel, grey or RGB, or either with alpha (which is stored as it is: unassociated, as
+// PNG defines it); `img` holds values in [0, 1] already encoded (sRGB): each becomes round(255·v).
 // srgb: tag the file as sRGB-encoded (pictures); false for data textures.
 void write_png(const std::string& path, const Image& img, bool srgb = true);
 

@@ -148,8 +148,8 @@ void write_encoded(const std::string& file, const std::string& ext, const Image&
   const int nc = src.channels();
   if (ext == ".exr" && nc <= 4) return detail::write_exr(file, src, half);
   if (ext == ".hdr" && nc == 3) return detail::write_rgbe(file, src);
-  if (ext == ".png" && (nc == 1 || nc == 3)) return detail::write_png(file, src, !data);
-  if (data) fail(ErrorKind::Value, "{}: a data image is written as .png with 1 or 3 channels (got {} channels)", file, nc);
+  if (ext == ".png" && (nc == 1 || nc == 3 || (data && nc <= 4))) return detail::write_png(file, src, !data);
+  if (data) fail(ErrorKind::Value, "{}: a data image is written as .png with 1 to 4 channels (got {} channels)", file, nc);
   detail::oiio_codec.get().write(file, src, ldr, half && ext == ".exr");
 }
 }  // namespace

@@ -39,8 +39,9 @@ int check_pixels(Image& img, const std::string& what, bool sanitize);
 
 struct WriteDesc {
   bool half = false;  // .exr: 16-bit half floats instead of 32-bit
-  bool data = false;  // .png: values in [0,1] stored as they are (a data texture such as a BRDF table),
-                      // without the sRGB curve or the sRGB chunk
+  bool data = false;  // .png: values in [0,1] stored as they are (a data texture such as a BRDF table,
+                      // RGBD), without the sRGB curve or the sRGB chunk; 1 to 4 channels, alpha
+                      // unassociated (not multiplied into the colour)
 };
 
 // Writes img; the format follows the extension. .png/.jpg get sRGB-encoded 8 bits, clamped to [0,1]

@@ -68,8 +68,8 @@ Coeffs from_gltf(const Coeffs& gltf);
 std::string export_text(const Coeffs& radiance, ExportFormat f, const Mat3& filament_frame = filament_from_iblkit());
 
 // The prefiltered specular cube EXT_lights_image_based also requires: per mip level the URIs of its six
-// face images (+X −X +Y −Y +Z −Z; the extension's RGBD PNGs, flipped about the vertical axis as it
-// specifies), level 0 of `size` pixels. Empty: the light carries the irradiance alone.
+// face images (+X −X +Y −Y +Z −Z; the extension's RGBD PNGs, which engine::write_gltf_ibl writes
+// with this document), level 0 of `size` pixels. Empty: the light carries the irradiance alone.
 struct GltfSpecular {
   std::vector<std::array<std::string, 6>> levels;
   int size = 0;
