@@ -343,7 +343,7 @@ def tables(allres):
             "| --- | --- | --- | --- |"]
     for s in allres:
         f = s["floor"]
-        cap = ", ".join("%s %.0f (%.0f)" % (k, v["seconds"], v.get("cpu_s", float("nan"))) for k, v in s["capture"].items())
+        cap = ", ".join("%s %.0f (%s)" % (k, v["seconds"], "%.0f" % v["cpu_s"] if "cpu_s" in v else "—") for k, v in s["capture"].items())
         bw = sum(r["build_s"] for r in s["rows"])
         timed = [r for r in s["rows"] if "cpu_s" in r]  # rows cached before CPU time was recorded have none
         bc = "%.0f" % sum(r["cpu_s"] for r in timed) + ("" if len(timed) == len(s["rows"]) else " over %d of %d builds" % (len(timed), len(s["rows"])))
