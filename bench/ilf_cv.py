@@ -7,7 +7,7 @@
             the volume) against `lab truth` there.
   crossval  ideal mirror balls; for each scene × probe count × grid × kernel (fixed ones and auto) the
             cross-validated error `ilf build` reports beside the true error (as above).
-  density   error against probe count and layout (random, parallel tracked lines, clusters).
+(Error against probe count and layout — random, parallel tracked lines, clusters — is bench/ilf_density.py.)
 Everything is cached in WORK (delete WORK/<study>/*.json to re-measure). Writes WORK/<study>.md.
 """
 import json, os, random, struct, subprocess, sys, time

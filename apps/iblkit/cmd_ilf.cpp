@@ -404,7 +404,7 @@ void setup_slice(CLI::App& app) {
   app.add_option("--max-error", o->max_error, "error volumes (ilf build --error-grid): the relative error shown red")
       ->capture_default_str()->check(positive_number);
   app.footer("An error volume (ilf build --error-grid) is drawn as its relative error in false colour (.png: black 0,\n"
-             "blue, green, yellow, red at --max-error) or as its three channels (.exr: relative, absolute, weight).\n"
+             "blue, green, yellow, red at --max-error; grey: under one probe's weight near, no figure) or as its three channels (.exr: relative, absolute, weight).\n"
              "Examples:\n  iblkit ilf slice room.shgrid --plane y=0.3 --out slice.png\n"
              "  iblkit ilf slice room.shtree --plane y=0.3 --levels --out levels.png");
   app.callback([o] {

@@ -44,8 +44,8 @@ std::vector<Vec3> parse_points(const std::string& s, const std::string& what) {
 struct CaptureOpts {
   std::string scene, out, mapping = "latlong", camera = "ideal", grid, path, volume, format = "exr", look = "0,0,1";
   std::vector<std::string> probes;
-  int size = 64, samples = 1, count = 10, random = 0, bounces = -1, area_samples = 0, env_samples = 0;
-  double dead_angle = 0, ball_radius = 0.04, reflectance = 1;
+  int size = 64, samples = 1, count = 10, random = 0, clusters = 0, bounces = -1, area_samples = 0, env_samples = 0;
+  double dead_angle = 0, ball_radius = 0.04, reflectance = 1, cluster_spread = 0.1;
   uint64_t seed = 0;
   bool depth = false, fusion = false, parallax = false, half = false;
 };
@@ -75,7 +75,10 @@ void run_capture(const CaptureOpts& o) {
   if (o.area_samples > 0) d.capture.render.area_samples = o.area_samples;
   if (o.env_samples > 0) d.capture.render.env_samples = o.env_samples;
   if (o.seed > 0) d.capture.render.seed = o.seed;
-  if (o.random > 0) pos = ibl::lab::random_positions(lo, hi, o.random, d.capture.render.seed);
+  if (o.clusters > 0 && o.random < 1) ibl::fail(ibl::ErrorKind::Value, "--clusters N needs --random M (M positions in N clusters)");
+  if (o.random > 0)
+    pos = o.clusters > 0 ? ibl::lab::cluster_positions(lo, hi, o.clusters, o.random, o.cluster_spread, d.capture.render.seed)
+                         : ibl::lab::random_positions(lo, hi, o.random, d.capture.render.seed);
   d.capture.mapping = ibl::sphere::parse_mapping(o.mapping);
   d.capture.size = o.size;
   d.capture.samples = o.samples;
@@ -240,6 +243,9 @@ void setup(CLI::App& app) {
   c->add_option("--path", co->path, "a polyline \"x,y,z;x,y,z;…\" with --count probes along it");
   c->add_option("--count", co->count, "probes along --path")->capture_default_str();
   c->add_option("--random", co->random, "N random positions in the volume (tracked hand-held capture)");
+  c->add_option("--clusters", co->clusters, "with --random N: the N positions in this many Gaussian clusters (a capture at a few spots)")
+      ->check(CLI::Range(0, 1000000));
+  c->add_option("--cluster-spread", co->cluster_spread, "--clusters: standard deviation of each cluster, metres")->capture_default_str();
   c->add_option("--volume", co->volume, "override the scene's volume: \"x0,y0,z0;x1,y1,z1\"");
   c->add_option("-m,--mapping", co->mapping, "latlong, mirrorball, angular, hcross, vcross, cubestrip, octahedral")->capture_default_str();
   c->add_option("-s,--size", co->size, "lat-long height, cube face edge or disc diameter, pixels")->capture_default_str();
@@ -264,6 +270,7 @@ void setup(CLI::App& app) {
             "  iblkit lab capture low-scene1 --grid 3,3,3 --camera ball --size 64 --out seq\n"
             "  iblkit lab capture t-corridor --path \"0,1.5,9;0,1.5,0.5\" --count 5 --size 64 --out corridor\n"
             "  iblkit lab capture low-scene2 --random 20 --mapping mirrorball --size 64 --out handheld\n"
+            "  iblkit lab capture low-scene2 --random 40 --clusters 4 --cluster-spread 0.08 --size 32 --out spots\n"
             "  iblkit lab capture t-corridor --fusion --probe 0,1.5,2 --probe 0,1.5,6 --size 64 --out corridor-fusion");
   c->callback([co] { run_capture(*co); });
 

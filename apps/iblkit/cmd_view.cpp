@@ -21,6 +21,8 @@
 #include "iblkit/augment/load.h"
 #include "iblkit/augment/object.h"
 #include "iblkit/core/error.h"
+#include "iblkit/ilf/crossval.h"
+#include "iblkit/ilf/shgrid.h"
 #include "iblkit/io/image_io.h"
 #include "iblkit/io/tonemap.h"
 #include "iblkit/render/gl/context.h"
@@ -46,6 +48,8 @@ struct ViewOpts {
   std::string photo, albedo = "0.7,0.7,0.7";
   iblcli::PhotoSceneOptions scene;
   int gl_lights = 16;
+  std::string error_grid;  // --error-grid: a cross-validated error volume shown as a false-colour slice
+  double max_error = 0.5;
 };
 
 // Orbit camera around a target: azimuth, elevation (radians) and distance.
@@ -67,6 +71,7 @@ struct State {
   bool dragging = false;
   double last_x = 0, last_y = 0;
   double step = 0.05;   // metres per key press
+  int slice_axis = 1;   // --error-grid: the slice's normal axis (keys X, Y, Z); it passes through the object
 };
 
 // What the viewer shows, all read before a window opens (everything that can fail on input).
@@ -76,6 +81,7 @@ struct Inputs {
   std::vector<std::string> kinds;
   Vec3 at;
   geometry::TriMesh base;  // the object at the origin
+  ilf::SHGrid error;       // --error-grid (content "cv-error"); empty without
 };
 
 Inputs read_inputs(const ViewOpts& o, const io::EnvReadDesc& rd) {
@@ -97,6 +103,12 @@ Inputs read_inputs(const ViewOpts& o, const io::EnvReadDesc& rd) {
   placed.transform(1.0, in.at);
   for (const Lighting& L : in.lightings)
     if (std::string w = iblcli::grid_bounds_warning(L, placed); !w.empty()) iblcli::info("warning: " + w);
+  if (!o.error_grid.empty()) {
+    in.error = ilf::read_shgrid(o.error_grid, true);
+    if (in.error.content() != "cv-error")
+      fail(ErrorKind::Value, "--error-grid {}: holds \"{}\", not a cross-validated error volume (write one with ilf build --error-grid)",
+           o.error_grid, in.error.content().empty() ? "radiance SH" : in.error.content());
+  }
   return in;
 }
 
@@ -135,6 +147,9 @@ void install_controls(GLFWwindow* win, State* st) {
       case GLFW_KEY_EQUAL: case GLFW_KEY_KP_ADD: s.exposure += 0.5; break;
       case GLFW_KEY_MINUS: case GLFW_KEY_KP_SUBTRACT: s.exposure -= 0.5; break;
       case GLFW_KEY_TAB: ++s.lighting; break;
+      case GLFW_KEY_X: s.slice_axis = 0; break;
+      case GLFW_KEY_Y: s.slice_axis = 1; break;
+      case GLFW_KEY_Z: s.slice_axis = 2; break;
       default:
         if (key >= GLFW_KEY_1 && key <= GLFW_KEY_9) s.lighting = key - GLFW_KEY_1;
     }
@@ -175,14 +190,56 @@ Image capture(int fw, int fh) {
 }
 
 // The renderer and the display path of an open window, and what the frames so far measured.
+// The error volume's slice through the object (--error-grid), drawn over the frame's top-left corner.
+struct ErrorSlice {
+  std::unique_ptr<gl::Overlay> overlay = std::make_unique<gl::Overlay>();
+  int axis = -1, width = 0;
+  double value = 0, mean = 0, max = 0;  // the plane; the relative error over its pixels
+};
+
 struct Viewer {
   std::unique_ptr<gl::Renderer> renderer = std::make_unique<gl::Renderer>();  // released before the window's context goes
   std::unique_ptr<gl::Presenter> present = std::make_unique<gl::Presenter>();
+  ErrorSlice slice;
   Image last;  // the screenshot
   double ms_sum = 0, meter = 1, shown_scale = 1;
   int frame = 0, metered_lighting = -1, shown_w = 0, shown_h = 0;
   std::string renderer_name = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
 };
+
+// The slice of the error volume on the plane `axis` = the object's coordinate (clamped to the volume),
+// `width` pixels wide (as `ilf slice --size width` lays it out and colours it, --max-error red), with
+// the object's place marked by a white cross; recomputed only when the plane or the width changes.
+void update_slice(const ViewOpts& o, const Inputs& in, Vec3 object, int axis, int width, ErrorSlice* s) {
+  const auto& vol = in.error.grid().volume;
+  const double value = std::clamp(object[axis], vol.min[axis], vol.max[axis]);
+  if (axis == s->axis && value == s->value && width == s->width) return;
+  Image e = ilf::error_slice(in.error, axis, value, width);
+  Image c = ilf::error_colours(e, o.max_error);
+  double sum = 0, mx = 0;
+  for (int y = 0; y < e.height(); ++y)
+    for (int x = 0; x < e.width(); ++x) {
+      sum += e.at(x, y, 0);
+      mx = std::max<double>(mx, e.at(x, y, 0));
+    }
+  const int a1 = axis == 0 ? 2 : 0, a2 = axis == 1 ? 2 : 1;  // error_slice's image axes
+  const Vec3 ext = vol.size();
+  const int cx = static_cast<int>(std::floor((object[a1] - vol.min[a1]) / ext[a1] * c.width()));
+  const int cy = static_cast<int>(std::floor((vol.max[a2] - object[a2]) / ext[a2] * c.height()));
+  for (int d = -3; d <= 3; ++d) {
+    if (cx + d >= 0 && cx + d < c.width() && cy >= 0 && cy < c.height()) c.set_rgb(cx + d, cy, {1, 1, 1});
+    if (cy + d >= 0 && cy + d < c.height() && cx >= 0 && cx < c.width()) c.set_rgb(cx, cy + d, {1, 1, 1});
+  }
+  for (int y = 0; y < c.height(); ++y)
+    for (int x = 0; x < c.width(); ++x)
+      for (int ch = 0; ch < 3; ++ch) c.at(x, y, ch) = io::linear_to_srgb(c.at(x, y, ch));
+  s->overlay->set(c);
+  s->axis = axis;
+  s->value = value;
+  s->width = width;
+  s->mean = sum / (double(e.width()) * e.height());
+  s->max = mx;
+}
 
 // Renders, tone-maps and shows one fw × fh frame of the state's lighting, object place and camera.
 void show_frame(const ViewOpts& o, Inputs& in, State& st, Viewer& v, GLFWwindow* win, int fw, int fh) {
@@ -229,6 +286,10 @@ void show_frame(const ViewOpts& o, Inputs& in, State& st, Viewer& v, GLFWwindow*
   v.shown_h = fh;
   v.shown_scale = v.meter * std::exp2(st.exposure);
   v.present->draw(v.renderer->color_texture(), fw, fh, v.shown_scale);
+  if (!in.error.data().empty()) {
+    update_slice(o, in, in.at + st.offset, st.slice_axis, std::clamp(fw / 3, 16, 512), &v.slice);
+    v.slice.overlay->draw(8, fh - 8 - v.slice.overlay->height(), v.slice.overlay->width(), v.slice.overlay->height());
+  }
   // The screenshot reads the window's own back buffer: what the display path shows.
   if (!o.screenshot.empty() && o.frames > 0 && v.frame + 1 == o.frames) v.last = capture(fw, fh);
   glfwSwapBuffers(win);
@@ -236,9 +297,11 @@ void show_frame(const ViewOpts& o, Inputs& in, State& st, Viewer& v, GLFWwindow*
   v.ms_sum += ms;
   ++v.frame;
   bool software = v.renderer_name.find("llvmpipe") != std::string::npos;
-  glfwSetWindowTitle(win, fmt::format("iblkit view — {} — {} {:.2f} ms/frame ({}){}", std::filesystem::path(o.lights[li]).filename().string(),
+  glfwSetWindowTitle(win, fmt::format("iblkit view — {} — {} {:.2f} ms/frame ({}){}{}", std::filesystem::path(o.lights[li]).filename().string(),
                                       software ? "wall" : "GPU", software ? ms : t.frame_ms[0], in.kinds[li],
-                                      st.glossy ? ", glossy" : "").c_str());
+                                      st.glossy ? ", glossy" : "",
+                                      in.error.data().empty() ? std::string() : fmt::format(", error slice {} = {:.2f}: mean {:.3f}, max {:.3f} (red: {:g})",
+                                                                                     "xyz"[v.slice.axis], v.slice.value, v.slice.mean, v.slice.max, o.max_error)).c_str());
 }
 
 // Composite mode: the object moved over the photograph (augment/gl/compositor.h), the camera the
@@ -348,20 +411,30 @@ void run(const ViewOpts& o, const ibl::io::EnvReadDesc& rd) {
     // Interactive: the last frame shown, drawn once more (the back buffer is undefined after a swap).
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     v->present->draw(v->renderer->color_texture(), v->shown_w, v->shown_h, v->shown_scale);
+    if (!in.error.data().empty())
+      v->slice.overlay->draw(8, v->shown_h - 8 - v->slice.overlay->height(), v->slice.overlay->width(), v->slice.overlay->height());
     v->last = capture(v->shown_w, v->shown_h);
   }
   const int frames = v->frame;
   const double ms_sum = v->ms_sum;
   const std::string renderer_name = v->renderer_name;
   const Image last = std::move(v->last);
+  const ErrorSlice slice_shown{nullptr, v->slice.axis, v->slice.width, v->slice.value, v->slice.mean, v->slice.max};
   v.reset();  // the renderer and presenter before the window's context
   glfwDestroyWindow(win);
   if (!o.screenshot.empty() && !last.empty()) io::write_image(o.screenshot, last);
-  iblcli::emit({{"frames", frames}, {"ms_per_frame", frames ? ms_sum / frames : 0.0}, {"gl_renderer", renderer_name},
-                {"screenshot", o.screenshot}},
+  nlohmann::json summary = {{"frames", frames}, {"ms_per_frame", frames ? ms_sum / frames : 0.0}, {"gl_renderer", renderer_name},
+                            {"screenshot", o.screenshot}};
+  if (!in.error.data().empty() && slice_shown.axis >= 0)
+    summary["error_slice"] = {{"plane", fmt::format("{}={:.9g}", "xyz"[slice_shown.axis], slice_shown.value)}, {"width", slice_shown.width},
+                              {"mean_rel_error", slice_shown.mean}, {"max_rel_error", slice_shown.max}, {"max_error", o.max_error}};
+  iblcli::emit(summary,
                [&] {
                  fmt::print("{} frames, {:.1f} ms per frame (render + tone map + display) on {}\n", frames, frames ? ms_sum / frames : 0.0,
                             renderer_name);
+                 if (!in.error.data().empty() && slice_shown.axis >= 0)
+                   fmt::print("error slice {}={:.3g} ({} px wide): cross-validated relative error mean {:.3f}, max {:.3f}\n", "xyz"[slice_shown.axis],
+                              slice_shown.value, slice_shown.width, slice_shown.mean, slice_shown.max);
                  if (!o.screenshot.empty()) fmt::print("screenshot {}\n", o.screenshot);
                });
 }
@@ -387,13 +460,19 @@ void setup(CLI::App& app) {
   app.add_option("--shadows", o->lighting.shadows, "lights of a light set that cast shadows")->check(CLI::Range(0, 16))->capture_default_str();
   app.add_option("--frames", o->frames, "run this many frames (one orbit) and exit; 0: interactive")->check(CLI::Range(0, 100000));
   app.add_option("--screenshot", o->screenshot, "write the last frame here on exit (.png)");
+  app.add_option("--error-grid", o->error_grid, "an error volume (ilf build --error-grid): its false-colour slice through the object, top left "
+                 "(keys X / Y / Z: the plane's normal)");
+  app.add_option("--max-error", o->max_error, "--error-grid: the relative error shown red (as ilf slice)")
+      ->check(CLI::Range(1e-9, 1e9))->capture_default_str();
   iblcli::add_shadow_map_options(app, &o->shadow_maps);
   auto& rd = iblcli::add_probe_read_options(app);
   app.footer(
       "Keys: drag = orbit, scroll = zoom, arrows / PageUp / PageDown = move the object, 1-9 / Tab = lighting,\n"
-      "G = glossy on/off, + / - = exposure, E = meter the auto exposure again, Esc = quit. The title shows the frame time.\n"
+      "G = glossy on/off, + / - = exposure, E = meter the auto exposure again, X / Y / Z = the error slice's normal\n"
+      "(--error-grid), Esc = quit. The title shows the frame time.\n"
       "Examples:\n  iblkit view blob --light grid.shgrid --at 0,1,0 --object-size 0.3\n"
       "  iblkit view blob --light probe.exr --light lights.json\n"
+      "  iblkit view blob --light grid.shgrid --error-grid err.shgrid --at 0,1,0 --object-size 0.3\n"
       "  xvfb-run -a iblkit view sphere --light probe.exr --frames 10 --screenshot view.png\n"
       "  iblkit view blob --composite photo.exr --eye 0,1.3,2.2 --target 0,0.3,0 --fov 40 --probes probe/probes.json --at 0.1,0.2,0.1\n"
       "Composite mode: drag or the arrows / PageUp / PageDown move the object, + / - exposure, Esc quits.");

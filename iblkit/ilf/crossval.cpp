@@ -196,8 +196,13 @@ Image error_colours(const Image& e, double max_error) {
   if (!(max_error > 0) || !std::isfinite(max_error)) fail(ErrorKind::Value, "error colours: max_error {} must be > 0", max_error);
   static const Vec3 stops[] = {{0, 0, 0}, {0.1, 0.2, 0.9}, {0.1, 0.8, 0.3}, {0.95, 0.9, 0.1}, {0.9, 0.1, 0.1}};
   Image img(e.width(), e.height(), 3);
+  const double grey = std::pow(0.45, 2.2);
   for (int y = 0; y < e.height(); ++y)
     for (int x = 0; x < e.width(); ++x) {
+      if (e.channels() >= 3 && e.at(x, y, 2) < kErrorMinWeight) {  // no probe near enough: no figure, not "no error"
+        img.set_rgb(x, y, {grey, grey, grey});
+        continue;
+      }
       double t = std::clamp(e.rgb(x, y).x / max_error, 0.0, 1.0) * 4;
       int i = std::min(int(t), 3);
       double f = t - i;

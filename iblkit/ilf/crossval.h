@@ -93,7 +93,10 @@ SHGrid error_volume(const CrossValResult& r, const GridDesc& grid, int max_res =
 // x; image y: down the other axis), as `ilf slice` lays out irradiance.
 Image error_slice(const SHGrid& ev, int axis, double value, int width);
 // Channel 0 (the relative error) in false colour, linear RGB in [0, 1]: 0 black, then blue, green,
-// yellow, and red at max_error and above.
+// yellow, and red at max_error and above; grey where the weight (channel 2, ≈ probes within σ) is
+// below kErrorMinWeight — no probe near enough to give a figure (a gap in the capture, which would
+// otherwise read as 0, black).
+inline constexpr double kErrorMinWeight = 1.0;
 Image error_colours(const Image& slice, double max_error);
 
 // The automatic choice of kernel width and resolution: cross-validated error of each candidate on a

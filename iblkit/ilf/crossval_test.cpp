@@ -158,6 +158,17 @@ TEST(IlfCrossVal, AutoChoiceAndErrorVolume) {
   for (int64_t i = 0; i < ev.grid().count(); ++i) mean += ev.data()[size_t(i) * 3] / double(ev.grid().count());
   EXPECT_GT(mean, 0.3 * rep.crossval->rel_error);
   EXPECT_LT(mean, 3 * rep.crossval->rel_error);
+  // The colours: 0 black, max_error red, and grey (neither) where less than one probe's weight is near.
+  Image e(3, 1, 3);
+  e.set_rgb(0, 0, {0.0, 0, 5});
+  e.set_rgb(1, 0, {0.5, 1, 5});
+  e.set_rgb(2, 0, {0.0, 0, 0.4});
+  Image c = error_colours(e, 0.5);
+  EXPECT_EQ(c.rgb(0, 0).x + c.rgb(0, 0).y + c.rgb(0, 0).z, 0);
+  EXPECT_NEAR(c.rgb(1, 0).x, std::pow(0.9, 2.2), 1e-6);
+  EXPECT_NEAR(c.rgb(1, 0).y, std::pow(0.1, 2.2), 1e-6);
+  EXPECT_NEAR(c.rgb(2, 0).x, std::pow(0.45, 2.2), 1e-6);
+  EXPECT_EQ(c.rgb(2, 0).x, c.rgb(2, 0).z);
   // Grid auto: a resolution among the candidates, within memory.
   BuildDesc b3 = cv_build(8, temp_dir("auto_b"));
   b3.auto_grid = true;
@@ -171,6 +182,32 @@ TEST(IlfCrossVal, AutoChoiceAndErrorVolume) {
 // ranges, one of them empty) and `sum` adds the partial sums through shared memory. The job's error,
 // its per-probe figures and its automatic choice equal one process's to float rounding of the sum in
 // double, with the buckets sampled (every 5th: max_buckets 100 of ~440) by their global index.
+// A capture with a gap: 64 probes (relative error 0.2 each) in the corner x, y, z < 0.25 of a unit
+// cube. The error volume's slice through z = 0.1 gives 0.2 in the corner and no weight in the far one,
+// which error_colours draws grey — not black, which would read as "no error".
+TEST(IlfCrossVal, ErrorVolumeShowsAGapAsNoFigure) {
+  CrossValResult r;
+  for (int i = 0; i < 64; ++i) {
+    r.positions.push_back({0.05 + 0.05 * (i % 4), 0.05 + 0.05 * (i / 4 % 4), 0.05 + 0.05 * (i / 16)});
+    r.sq_error.push_back(0.04);
+    r.sq_norm.push_back(1.0);
+  }
+  GridDesc g{16, 16, 16, {{0, 0, 0}, {1, 1, 1}}};
+  SHGrid ev = error_volume(r, g);
+  Image e = error_slice(ev, 2, 0.1, 16);
+  ASSERT_EQ(e.height(), 16);
+  EXPECT_NEAR(e.at(1, 14, 0), 0.2, 1e-5);  // image x along x, image y down y: (x, y) ≈ (0.09, 0.09)
+  EXPECT_GT(e.at(1, 14, 2), 1.0);
+  EXPECT_EQ(e.at(14, 1, 2), 0.0f);         // (0.91, 0.91): beyond 3σ of every probe
+  EXPECT_EQ(e.at(14, 1, 0), 0.0f);
+  Image c = error_colours(e, 0.5);
+  const float grey = float(std::pow(0.45, 2.2));
+  EXPECT_NEAR(c.at(14, 1, 0), grey, 1e-6);
+  EXPECT_NEAR(c.at(14, 1, 1), grey, 1e-6);
+  EXPECT_GT(c.at(1, 14, 1), 0.2f);         // 0.2 of 0.5: between blue and green (green 0.56 before encoding)
+  EXPECT_LT(c.at(1, 14, 0), 0.05f);
+}
+
 TEST(IlfCrossVal, SharesOfTheBlocksAddUpToTheWhole) {
   auto field = AnalyticField::three_spheres();
   auto seq = capture(field, "share", 60, 24);

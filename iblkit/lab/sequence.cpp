@@ -1,6 +1,8 @@
 #include "iblkit/lab/sequence.h"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <future>
@@ -73,6 +75,42 @@ std::vector<Vec3> random_positions(Vec3 lo, Vec3 hi, int count, uint64_t seed) {
   for (int i = 0; i < count; ++i) {
     double a = rng.uniform(), b = rng.uniform(), c = rng.uniform();
     p.push_back({lo.x + (hi.x - lo.x) * a, lo.y + (hi.y - lo.y) * b, lo.z + (hi.z - lo.z) * c});
+  }
+  return p;
+}
+
+std::vector<Vec3> cluster_positions(Vec3 lo, Vec3 hi, int clusters, int count, double spread, uint64_t seed) {
+  if (count < 1) fail(ErrorKind::Value, "cluster probe count {} must be ≥ 1", count);
+  if (clusters < 1 || clusters > count)
+    fail(ErrorKind::Value, "cluster count {} must lie in [1, {}] (the probe count)", clusters, count);
+  require_box("cluster volume", lo, hi);
+  require_number("cluster spread (metres)", spread, 1e-9, 1e6);
+  require_probe_count("a clustered capture", count, "choose a smaller probe count");
+  std::vector<Vec3> centre;
+  for (int c = 0; c < clusters; ++c) {
+    Rng rng(stream_key(seed, ~1ull, static_cast<uint64_t>(c), 0));
+    Vec3 v;
+    for (int a = 0; a < 3; ++a) {
+      double m = std::min(spread, 0.25 * (hi[a] - lo[a]));
+      v[a] = lo[a] + m + (hi[a] - lo[a] - 2 * m) * rng.uniform();
+    }
+    centre.push_back(v);
+  }
+  std::vector<Vec3> p;
+  p.reserve(static_cast<size_t>(count));
+  for (int i = 0; i < count; ++i) {
+    Rng rng(stream_key(seed, ~2ull, static_cast<uint64_t>(i), 0));
+    const Vec3 c = centre[static_cast<size_t>(i % clusters)];
+    Vec3 v = c;
+    for (int attempt = 0; attempt < 64; ++attempt) {
+      for (int a = 0; a < 3; ++a) {  // Box–Muller: one normal deviate per axis
+        double u1 = 1 - rng.uniform(), u2 = rng.uniform();
+        v[a] = c[a] + spread * std::sqrt(-2 * std::log(u1)) * std::cos(kTwoPi * u2);
+      }
+      if (v.x >= lo.x && v.x <= hi.x && v.y >= lo.y && v.y <= hi.y && v.z >= lo.z && v.z <= hi.z) break;
+    }
+    for (int a = 0; a < 3; ++a) v[a] = std::clamp(v[a], lo[a], hi[a]);
+    p.push_back(v);
   }
   return p;
 }

@@ -16,6 +16,13 @@ std::vector<Vec3> grid_positions(Vec3 lo, Vec3 hi, int nx, int ny, int nz);
 std::vector<Vec3> path_positions(const std::vector<Vec3>& points, int count);
 // `count` uniform random points in [lo, hi] (a tracked hand-held capture), fixed by `seed`.
 std::vector<Vec3> random_positions(Vec3 lo, Vec3 hi, int count, uint64_t seed);
+// `count` random points in `clusters` Gaussian clusters (a capture made at a few spots): cluster c's
+// centre is uniform in [lo, hi] shrunk by min(spread, a quarter of the edge) on each side; point i
+// belongs to cluster i mod `clusters` and lies at its centre plus an isotropic Gaussian offset of
+// standard deviation `spread` metres, redrawn until it falls inside [lo, hi] (clamped after 64
+// draws). Everything is keyed by (seed, cluster) and (seed, i), not by `count`: the first n points
+// of a larger capture are the n-point capture, so the smaller counts of a study are prefixes.
+std::vector<Vec3> cluster_positions(Vec3 lo, Vec3 hi, int clusters, int count, double spread, uint64_t seed);
 
 struct SequenceDesc {
   CaptureDesc capture;           // mapping, size, camera, samples, render settings

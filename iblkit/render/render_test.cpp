@@ -605,6 +605,49 @@ TEST_F(RenderGl, PresentMatchesCpuToneMapping) {
   glDeleteTextures(1, &target);
 }
 
+// The overlay (the viewer's error-volume slice) lands byte for byte where it is drawn, stretched
+// nearest-neighbour, its row 0 at the top, and leaves the rest of the framebuffer alone.
+TEST_F(RenderGl, OverlayCopiesItsPictureByteForByte) {
+  gl::Context ctx;
+  const int W = 32, H = 24;
+  GLuint target, fbo;
+  glCreateTextures(GL_TEXTURE_2D, 1, &target);
+  glTextureStorage2D(target, 1, GL_RGBA8, W, H);
+  glCreateFramebuffers(1, &fbo);
+  glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, target, 0);
+  const float zero[4] = {0, 0, 0, 1};
+  glClearNamedFramebufferfv(fbo, GL_COLOR, 0, zero);
+  Image pic(4, 2, 3);
+  for (int y = 0; y < 2; ++y)
+    for (int x = 0; x < 4; ++x) pic.set_rgb(x, y, {(10 + 40 * x) / 255.0, (200 + 50 * y) / 255.0, (x + 4 * y + 1) / 255.0});
+  gl::Overlay ov;
+  ov.set(pic);
+  EXPECT_EQ(ov.width(), 4);
+  EXPECT_EQ(ov.height(), 2);
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+  ov.draw(3, 5, 8, 4);  // 2× in both directions
+  std::vector<uint8_t> px(W * H * 4);
+  glGetTextureImage(target, 0, GL_RGBA, GL_UNSIGNED_BYTE, static_cast<GLsizei>(px.size()), px.data());
+  int covered = 0;
+  for (int gy = 0; gy < H; ++gy)
+    for (int gx = 0; gx < W; ++gx) {
+      const uint8_t* p = &px[(static_cast<size_t>(gy) * W + gx) * 4];
+      if (gx >= 3 && gx < 11 && gy >= 5 && gy < 9) {
+        const int x = (gx - 3) / 2, y = 1 - (gy - 5) / 2;  // GL row 5 is the picture's bottom row
+        EXPECT_EQ(p[0], 10 + 40 * x) << gx << "," << gy;
+        EXPECT_EQ(p[1], 200 + 50 * y) << gx << "," << gy;
+        EXPECT_EQ(p[2], x + 4 * y + 1) << gx << "," << gy;
+        ++covered;
+      } else {
+        EXPECT_EQ(p[0] + p[1] + p[2], 0) << gx << "," << gy;
+      }
+    }
+  EXPECT_EQ(covered, 32);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  glDeleteFramebuffers(1, &fbo);
+  glDeleteTextures(1, &target);
+}
+
 // Albedo textures at the meshes' UVs and the Blinn-Phong lobe (lights exact; SH and maps through the
 // Phong lobe of s/4), on both renderers.
 TEST_F(RenderGl, TexturedBlinnPhongAgreesWithCpu) {
