@@ -93,13 +93,14 @@ AdaptiveGrid read_adaptive(const std::string& path) {
   double tolerance = 0, rms = 0;
   std::vector<int64_t> counts;
   try {
-    bands = need("bands").get<int>();
-    brick = need("brick").get<int>();
-    levels = need("levels").get<int>();
-    counts = need("bricks").get<std::vector<int64_t>>();
+    bands = static_cast<int>(grid_header_integer(need("bands"), path, "bands", 1, 16));
+    brick = static_cast<int>(grid_header_integer(need("brick"), path, "brick", kMinBrick, kMaxBrick));
+    levels = static_cast<int>(grid_header_integer(need("levels"), path, "levels", 1, 64));
+    counts = grid_header_integers(need("bricks"), path, "bricks", 0, int64_t{1} << 40);
     tolerance = need("tolerance").get<double>();
     rms = need("rms").get<double>();
-    auto r = need("resolution").get<std::vector<int>>();
+    std::vector<int> r;
+    for (int64_t n : grid_header_integers(need("resolution"), path, "resolution", 0, 1 << 30)) r.push_back(static_cast<int>(n));
     auto mn = need("min").get<std::vector<double>>(), mx = need("max").get<std::vector<double>>();
     if (r.size() != 3 || mn.size() != 3 || mx.size() != 3) fail(ErrorKind::Format, "{}: \"resolution\", \"min\", \"max\" need 3 values", path);
     gd.nx = r[0]; gd.ny = r[1]; gd.nz = r[2];

@@ -1,10 +1,13 @@
 // The two text lines that open the ILF's binary grid files (.shgrid, .shtree): a magic line and a
 // one-line JSON header, read with one-line errors naming the file. Shared by their readers.
 #pragma once
+#include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <istream>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -32,6 +35,30 @@ inline nlohmann::json read_grid_header(std::istream& in, const std::string& path
 inline const nlohmann::json& grid_header_field(const nlohmann::json& h, const std::string& path, const char* f) {
   if (!h.is_object() || !h.contains(f)) fail(ErrorKind::Format, "{}: header field \"{}\" is missing", path, f);
   return h[f];
+}
+
+// An integer field's value, checked before it is converted: a JSON integer, or a number with an integral
+// value, within [lo, hi] (a float such as 8.9e61 must never reach a cast to an integer type); else
+// "PATH: header field "f" = V is not an integer in [lo, hi]". Found by fuzz_shtree (fuzz/crashes/shtree/).
+inline int64_t grid_header_integer(const nlohmann::json& v, const std::string& path, const char* f, int64_t lo, int64_t hi) {
+  if (v.is_number_integer() && !v.is_number_unsigned()) {
+    const int64_t i = v.get<int64_t>();
+    if (i >= lo && i <= hi) return i;
+  } else if (v.is_number_unsigned()) {
+    const uint64_t u = v.get<uint64_t>();
+    if (hi >= 0 && u <= static_cast<uint64_t>(hi) && static_cast<int64_t>(u) >= lo) return static_cast<int64_t>(u);
+  } else if (v.is_number_float()) {
+    const double d = v.get<double>();
+    if (std::isfinite(d) && d == std::floor(d) && d >= static_cast<double>(lo) && d <= static_cast<double>(hi)) return static_cast<int64_t>(d);
+  }
+  fail(ErrorKind::Format, "{}: header field \"{}\" = {} is not an integer in [{}, {}]", path, f, v.dump(), lo, hi);
+}
+inline std::vector<int64_t> grid_header_integers(const nlohmann::json& v, const std::string& path, const char* f, int64_t lo, int64_t hi) {
+  if (!v.is_array()) fail(ErrorKind::Format, "{}: header field \"{}\" must be an array of integers", path, f);
+  std::vector<int64_t> out;
+  out.reserve(v.size());
+  for (const auto& e : v) out.push_back(grid_header_integer(e, path, f, lo, hi));
+  return out;
 }
 
 }  // namespace ibl::ilf

@@ -122,8 +122,9 @@ SHGrid read_shgrid(const std::string& path, bool any_content) {
   GridDesc gd;
   int bands = 0;
   try {
-    bands = need("bands").get<int>();
-    auto r = need("resolution").get<std::vector<int>>();
+    bands = static_cast<int>(grid_header_integer(need("bands"), path, "bands", 1, 16));
+    std::vector<int> r;
+    for (int64_t n : grid_header_integers(need("resolution"), path, "resolution", 0, 1 << 30)) r.push_back(static_cast<int>(n));
     auto mn = need("min").get<std::vector<double>>(), mx = need("max").get<std::vector<double>>();
     if (r.size() != 3 || mn.size() != 3 || mx.size() != 3) fail(ErrorKind::Format, "{}: \"resolution\", \"min\", \"max\" need 3 values", path);
     gd.nx = r[0]; gd.ny = r[1]; gd.nz = r[2];
