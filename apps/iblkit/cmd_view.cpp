@@ -17,6 +17,7 @@
 #include "cli.h"
 #include "render_setup.h"
 #include "iblkit/augment/albedo.h"
+#include "iblkit/augment/composite.h"
 #include "iblkit/augment/gl/compositor.h"
 #include "iblkit/augment/load.h"
 #include "iblkit/augment/object.h"
@@ -332,7 +333,13 @@ void run_composite(const ViewOpts& o, const ibl::io::EnvReadDesc& rd) {
   st.step = 0.1 * od.size;
   install_controls(win, &st);
   auto comp = std::make_unique<augment::gl::Compositor>(photo, cam, L.proxy, split, est.albedo);
-  comp->set_object(object, od.albedo);  // Lambertian (composite takes --gloss/--texture)
+  // The object's own occlusion of its soft light, which moves with it (composite, for one placement, also
+  // traces the proxy's occlusion and the floor darkened by the object's shadow).
+  augment::SoftVisibilityDesc vd;
+  vd.proxy = false;
+  vd.threshold = sd.lights > 0 ? sd.threshold : 0;
+  const std::vector<Vec3> vis = augment::soft_visibility(L.light, L.proxy, object, vd);
+  comp->set_object(object, od.albedo, &vis);  // Lambertian (composite takes --gloss/--texture)
   auto present = std::make_unique<gl::Presenter>();
   const double meter = io::auto_exposure_scale(photo);
   const std::string renderer_name = reinterpret_cast<const char*>(glGetString(GL_RENDERER));

@@ -8,6 +8,7 @@
 
 #include <fmt/format.h>
 
+#include "iblkit/augment/split_light.h"
 #include "iblkit/core/error.h"
 #include "iblkit/core/parallel.h"
 #include "iblkit/geometry/raytracer.h"
@@ -206,6 +207,22 @@ void shadow_patches(const Scene& s, LightField& field, int count, int cone_count
   for (size_t k = 0; k < near.size(); ++k) field.set_shadow(near[k], factor[k]);
 }
 
+// The tracers and the object's bounding sphere.
+void build(Scene& s) {
+  s.proxy_rt.add(s.proxy);
+  s.proxy_rt.commit();
+  s.object_rt.add(s.object);
+  s.object_rt.commit();
+  s.both_rt.add(s.proxy);
+  s.both_rt.add(s.object);
+  s.both_rt.commit();
+  Vec3 lo, hi;
+  s.object.bounds(&lo, &hi);
+  s.bound.c = (lo + hi) * 0.5;
+  for (const Vec3& p : s.object.positions) s.bound.r = std::max(s.bound.r, length(p - s.bound.c));
+  s.bound.r *= 1 + 1e-6;
+}
+
 void check_geometry(const Scene& s, const geometry::Camera& cam) {
   // The camera inside a closed proxy (or a solid part of it): most of its rays meet back faces.
   int back = 0, hits = 0;
@@ -259,18 +276,7 @@ CompositeResult composite(const Image& photo, const geometry::Camera& cam, const
   if (material.texture && (material.texture->empty() || material.texture->channels() < 3))
     fail(ErrorKind::Value, "the object's texture must be an RGB image");
   Scene s{proxy, object, {}, {}, {}, {}, nullptr};
-  s.proxy_rt.add(proxy);
-  s.proxy_rt.commit();
-  s.object_rt.add(object);
-  s.object_rt.commit();
-  s.both_rt.add(proxy);
-  s.both_rt.add(object);
-  s.both_rt.commit();
-  Vec3 lo, hi;
-  object.bounds(&lo, &hi);
-  s.bound.c = (lo + hi) * 0.5;
-  for (const Vec3& p : object.positions) s.bound.r = std::max(s.bound.r, length(p - s.bound.c));
-  s.bound.r *= 1 + 1e-6;
+  build(s);
   if (desc.check_geometry) check_geometry(s, cam);
   LightField field(light, proxy, s.proxy_rt);
   s.light = &field;
@@ -382,6 +388,46 @@ CompositeResult composite(const Image& photo, const geometry::Camera& cam, const
                                      r.stats.unlit));
   if (r.stats.object_pixels == 0) r.warnings.push_back("no pixel of the photograph sees the object: check at, the eye and the target");
   return r;
+}
+
+std::vector<Vec3> soft_visibility(const LocalLight& light, const geometry::TriMesh& proxy, const geometry::TriMesh& object,
+                                  const SoftVisibilityDesc& desc) {
+  if (desc.samples < 1 || desc.samples > 65536) fail(ErrorKind::Value, "soft visibility samples {} must lie in 1..65536", desc.samples);
+  if (desc.shadow_samples < 1 || desc.shadow_cone < 0) fail(ErrorKind::Value, "shadow samples must be ≥ 1 (cone samples ≥ 0)");
+  if (!(desc.threshold >= 0) || !std::isfinite(desc.threshold)) fail(ErrorKind::Value, "soft threshold {} must be ≥ 0", desc.threshold);
+  if (proxy.triangle_count() == 0) fail(ErrorKind::Value, "the proxy has no triangles");
+  if (object.triangle_count() == 0) fail(ErrorKind::Value, "the object has no triangles");
+  Scene s{proxy, object, {}, {}, {}, {}, nullptr};
+  build(s);
+  LightField field(light, proxy, s.proxy_rt);
+  s.light = &field;
+  if (desc.proxy) shadow_patches(s, field, desc.shadow_samples, desc.shadow_cone, desc.seed);
+  const double limit = desc.threshold > 0 ? desc.threshold * field.total_power() / (4 * kPi) : std::numeric_limits<double>::infinity();
+  const geometry::RayTracer& rt = desc.proxy ? s.both_rt : s.object_rt;
+  const int count = desc.samples;
+  std::vector<Vec3> f(object.triangle_count(), Vec3{1, 1, 1});
+  parallel_for(0, static_cast<int64_t>(object.triangle_count()), [&](int64_t ti) {
+    const auto& t = object.triangles[static_cast<size_t>(ti)];
+    const Vec3 n = object.normal(static_cast<size_t>(ti));
+    const Vec3 z = (object.positions[t[0]] + object.positions[t[1]] + object.positions[t[2]]) / 3.0 + n * kRayEpsilon;
+    Rng rng(desc.seed, 0x766973 /* "vis" */, static_cast<uint64_t>(ti));
+    Vec3 num, den;
+    for (int k = 0; k < count; ++k) {
+      double pmf;
+      size_t i = field.sample((k + rng.uniform()) / count, &pmf);
+      if (split_measure(field.radiance(i)) > limit) continue;  // a hard light's texel: the shadow maps' part
+      Vec3 w;
+      double dist;
+      Vec3 c = field.contribution(i, z, n, &w, &dist);
+      if (max_component(c) <= 0) continue;
+      den += c / pmf;
+      if (rt.occluded(z, w, kRayEpsilon, patch_tfar(dist))) continue;
+      num += (desc.proxy ? field.contribution(i, z, n, &w, &dist, true) : c) / pmf;
+    }
+    for (int c = 0; c < 3; ++c)
+      if (den[c] > 0) f[static_cast<size_t>(ti)][c] = std::clamp(num[c] / den[c], 0.0, 1.0);
+  }, 256);
+  return f;
 }
 
 }  // namespace ibl::augment

@@ -88,4 +88,27 @@ inline CompositeResult composite(const Image& photo, const geometry::Camera& cam
   return composite(photo, cam, proxy, light, object, render::Material{albedo, {0, 0, 0}}, desc);
 }
 
+// For the real-time path (augment/gl/), which shades the object with the soft map's unoccluded irradiance (SH,
+// from the map's centre): the share of that light which reaches each object triangle, as this reference
+// computes it. Per triangle (its centre z, its face normal n, the side the normal points to), per channel,
+//
+//   f = Σ_k c_k V(z, q_k) s_k / Σ_k c_k      over patch samples k of the light (light.h) that are soft,
+//
+// c_k the patch's contribution at z, V the visibility past the proxy and the object itself, s_k the patch's
+// shadow factor (the object's shadow on the proxy it sees, from all of the light: the floor under an object
+// does not light its underside). "Soft": the texels split_light leaves in the soft map (mean RGB radiance at
+// most `threshold` × the map's mean; 0: every texel). The same samples in both sums make f a ratio estimate:
+// where nothing is hidden or shadowed it is exactly 1. proxy = false: the object's own occlusion alone (V past
+// the object, s = 1), which stays right while the object moves (iblkit view).
+struct SoftVisibilityDesc {
+  int samples = 64;          // patch samples per triangle
+  double threshold = 8;      // as SplitDesc::threshold
+  bool proxy = true;         // the proxy occludes and carries the object's shadow (as composite())
+  int shadow_samples = 64;   // as CompositeDesc::light_samples, for the shadow on the proxy's patches
+  int shadow_cone = 16;      // as CompositeDesc::bounce_samples
+  uint64_t seed = 1;
+};
+std::vector<Vec3> soft_visibility(const LocalLight& light, const geometry::TriMesh& proxy, const geometry::TriMesh& object,
+                                  const SoftVisibilityDesc& desc = {});
+
 }  // namespace ibl::augment

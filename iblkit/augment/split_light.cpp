@@ -13,7 +13,6 @@ namespace ibl::augment {
 
 namespace {
 constexpr double kDepthInFront = 0.98;  // as light.cpp: a depth this much shorter than the proxy's hit is a lamp
-double mean_rgb(Vec3 L) { return (std::max(0.0, L.x) + std::max(0.0, L.y) + std::max(0.0, L.z)) / 3; }
 }  // namespace
 
 Vec3 HardLight::at(Vec3 centre, Vec3 x, Vec3 n) const {
@@ -33,7 +32,7 @@ SplitLight split_light(const LocalLight& light, const geometry::TriMesh& proxy, 
   const int W = grid.width, H = grid.height;
   double total = 0;
   for (int y = 0; y < H; ++y)
-    for (int x = 0; x < W; ++x) total += mean_rgb(grid.rgb[static_cast<size_t>(y) * W + x]) * grid.row_solid_angle[y];
+    for (int x = 0; x < W; ++x) total += split_measure(grid.rgb[static_cast<size_t>(y) * W + x]) * grid.row_solid_angle[y];
   if (!(total > 0)) fail(ErrorKind::Value, "the {} light has no positive radiance", light.source);
   const double limit = desc.threshold * total / (4 * kPi);
   SplitLight s;
@@ -45,10 +44,10 @@ SplitLight split_light(const LocalLight& light, const geometry::TriMesh& proxy, 
   for (int y = 0; y < H; ++y)
     for (int x = 0; x < W; ++x) {
       size_t i = static_cast<size_t>(y) * W + x;
-      bool is_hard = desc.lights > 0 && desc.threshold > 0 && mean_rgb(grid.rgb[i]) > limit;
+      bool is_hard = desc.lights > 0 && desc.threshold > 0 && split_measure(grid.rgb[i]) > limit;
       if (is_hard) {
         ++hard_texels;
-        hard_power += mean_rgb(grid.rgb[i]) * grid.row_solid_angle[y];
+        hard_power += split_measure(grid.rgb[i]) * grid.row_solid_angle[y];
       } else {
         hard.rgb[i] = {};
         s.soft.set_rgb(x, y, grid.rgb[i]);

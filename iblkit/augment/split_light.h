@@ -6,6 +6,7 @@
 // whose shadow is the soft term (sphere_occlusion.h) and whose irradiance shades the object (SH, 3 bands).
 // The lights and the soft map together hold all of the map's power (test AugmentSplit.*).
 #pragma once
+#include <algorithm>
 #include <vector>
 
 #include "iblkit/augment/light.h"
@@ -23,6 +24,9 @@ struct HardLight {
   // Irradiance on a surface at x with unit normal n (no visibility): inverse square from a local light.
   Vec3 at(Vec3 centre, Vec3 x, Vec3 n) const;
 };
+
+// What the threshold is compared with: a texel's mean RGB radiance, negative channels as 0.
+inline double split_measure(Vec3 L) { return (std::max(0.0, L.x) + std::max(0.0, L.y) + std::max(0.0, L.z)) / 3; }
 
 struct SplitDesc {
   int lights = 16;         // most hard lights (fewer when fewer texels are bright)

@@ -6,9 +6,11 @@
 #include <fmt/format.h>
 
 #include "iblkit/augment/albedo.h"
+#include "iblkit/core/error.h"
 #include "iblkit/render/gl/context.h"
 
-// composite(): the compositor with its CPU inputs (the albedo estimate, the light split), in a file of its
+// composite(): the compositor with its CPU inputs (the albedo estimate, the light split, the object's soft
+// light share), in a file of its
 // own so that the lean GL benchmark (bench/gl_frames_main.cpp, no Embree) builds compositor.cpp alone.
 namespace ibl::augment::gl {
 
@@ -16,6 +18,8 @@ CompositeResult composite(const Image& photo, const geometry::Camera& cam, const
                           const geometry::TriMesh& object, const render::Material& material, const GlCompositeDesc& desc,
                           GlFrameTiming* timing) {
   auto t0 = std::chrono::steady_clock::now();
+  if (desc.visibility_samples < 0 || desc.visibility_samples > 65536)
+    fail(ErrorKind::Value, "visibility samples {} must lie in 0..65536", desc.visibility_samples);
   render::gl::Context context;
   AlbedoEstimate est = estimate_albedo(photo, cam, proxy, light, desc.albedo_samples, desc.seed);
   SplitDesc sd = desc.split;
@@ -24,7 +28,15 @@ CompositeResult composite(const Image& photo, const geometry::Camera& cam, const
   CompositeResult r;
   {
     Compositor comp(photo, cam, proxy, split, est.albedo, desc);
-    comp.set_object(object, material);
+    std::vector<Vec3> vis;
+    if (desc.visibility_samples > 0) {
+      SoftVisibilityDesc vd;
+      vd.samples = desc.visibility_samples;
+      vd.threshold = sd.lights > 0 ? sd.threshold : 0;
+      vd.seed = desc.seed;
+      vis = soft_visibility(light, proxy, object, vd);
+    }
+    comp.set_object(object, material, vis.empty() ? nullptr : &vis);
     comp.draw({}, false, timing);
     Image proxy_comp;
     comp.read_back(&r.composite, &r.mask, &r.difference, &proxy_comp);

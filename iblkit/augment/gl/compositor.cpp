@@ -21,32 +21,35 @@ using geometry::Mat4f;
 constexpr int kMaxLights = Compositor::kMaxLights;
 constexpr float kFar = 1e30f;   // a shadow-map texel nothing covers
 
-// Flat-shaded triangles: position, face normal and UV per corner (8 floats; UV 0 for a mesh without UVs),
-// so that both renders and the CPU reference see the same per-triangle normals.
+// Flat-shaded triangles: position, face normal, UV (0 for a mesh without UVs) and the soft light's share
+// (composite.h's soft_visibility; 1 where none is given) per corner, 11 floats, so that both renders and the
+// CPU reference see the same per-triangle normals.
 struct Mesh {
   GLuint vao = 0, vbo = 0;
   GLsizei count = 0;
-  void upload(const geometry::TriMesh& m) {
+  void upload(const geometry::TriMesh& m, const std::vector<Vec3>* soft = nullptr) {
     std::vector<float> v;
-    v.reserve(m.triangle_count() * 24);
+    v.reserve(m.triangle_count() * 33);
     const bool uvs = m.has_uvs();
     for (size_t i = 0; i < m.triangle_count(); ++i) {
-      Vec3 n = m.normal(i);
+      Vec3 n = m.normal(i), f = soft ? (*soft)[i] : Vec3{1, 1, 1};
       for (int k = 0; k < 3; ++k) {
         const uint32_t vi = m.triangles[i][k];
         Vec3 p = m.positions[vi];
         Vec2 uv = uvs ? m.uvs[vi] : Vec2{0, 0};
-        for (double c : {p.x, p.y, p.z, n.x, n.y, n.z, uv.x, uv.y}) v.push_back(static_cast<float>(c));
+        for (double c : {p.x, p.y, p.z, n.x, n.y, n.z, uv.x, uv.y, f.x, f.y, f.z}) v.push_back(static_cast<float>(c));
       }
     }
     release();
     glCreateBuffers(1, &vbo);
     glNamedBufferStorage(vbo, static_cast<GLsizeiptr>(v.size() * sizeof(float)), v.data(), 0);
     glCreateVertexArrays(1, &vao);
-    glVertexArrayVertexBuffer(vao, 0, vbo, 0, 8 * sizeof(float));
-    for (GLuint a = 0; a < 3; ++a) {
+    glVertexArrayVertexBuffer(vao, 0, vbo, 0, 11 * sizeof(float));
+    const GLint sizes[] = {3, 3, 2, 3};
+    const GLuint offsets[] = {0, 3, 6, 8};
+    for (GLuint a = 0; a < 4; ++a) {
       glEnableVertexArrayAttrib(vao, a);
-      glVertexArrayAttribFormat(vao, a, a < 2 ? 3 : 2, GL_FLOAT, GL_FALSE, a * 3 * sizeof(float));
+      glVertexArrayAttribFormat(vao, a, sizes[a], GL_FLOAT, GL_FALSE, offsets[a] * sizeof(float));
       glVertexArrayAttribBinding(vao, a, 0);
     }
     count = static_cast<GLsizei>(m.triangle_count() * 3);
@@ -376,8 +379,10 @@ Compositor::~Compositor() {
   if (impl_) impl_->release();
 }
 
-void Compositor::set_object(const geometry::TriMesh& object, const render::Material& material) {
+void Compositor::set_object(const geometry::TriMesh& object, const render::Material& material, const std::vector<Vec3>* soft_visibility) {
   if (object.triangle_count() == 0) fail(ErrorKind::Value, "the object has no triangles");
+  if (soft_visibility && soft_visibility->size() != object.triangle_count())
+    fail(ErrorKind::Value, "soft visibility for {} triangles given for an object of {}", soft_visibility->size(), object.triangle_count());
   const Vec3 a = material.albedo, k = material.specular;
   for (int c = 0; c < 3; ++c)
     if (!(a[c] >= 0 && a[c] <= 1 && k[c] >= 0 && k[c] <= 1))
@@ -386,7 +391,7 @@ void Compositor::set_object(const geometry::TriMesh& object, const render::Mater
   if (glossy && !(material.exponent >= 1 && material.exponent <= 10000))
     fail(ErrorKind::Value, "glossy exponent {} must lie in 1..10000", material.exponent);
   Impl& m = *impl_;
-  m.object.upload(object);
+  m.object.upload(object, soft_visibility);
   m.sphere = equivalent_sphere(object);
   Vec3 mean_texture{1, 1, 1};
   if (m.object_texture) glDeleteTextures(1, &m.object_texture);

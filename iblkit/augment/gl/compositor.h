@@ -15,8 +15,9 @@
 // against the proxy's depth (occluded where the proxy is in front), lit by the soft irradiance (SH, 3
 // bands: the proxy's light as the probe saw it) and the hard lights through both maps.
 //
-// Interreflection kept: proxy → object as captured (in the soft map, not darkened by the object's own
-// shadow), object → proxy through the sphere (its face towards y lit by the soft irradiance and the hard
+// Interreflection kept: proxy → object as captured, times the share of it each triangle receives when
+// one is given (set_object's soft_visibility: its own occlusion, the proxy's, and the floor under it darkened
+// by its shadow, ray traced once per placement on the CPU), object → proxy through the sphere (its face towards y lit by the soft irradiance and the hard
 // lights, unshadowed; diffuse, with the texture's mean albedo). Not kept: the object's light on itself.
 //
 // The object's material is render::Material's, as on the CPU: the albedo times the texture at the mesh's
@@ -44,6 +45,8 @@ struct GlCompositeDesc {
   bool shadows = true;         // false: the object pasted without shadow or reflection (a baseline)
   bool bounce = true;          // the object's light on the proxy
   int albedo_samples = 64;     // composite(): light samples per pixel of the albedo estimate
+  int visibility_samples = 64; // composite(): patch samples per object triangle of its soft light's share
+                               // (augment::soft_visibility); 0: the object's soft light unoccluded
   uint64_t seed = 1;
 };
 
@@ -63,10 +66,14 @@ class Compositor {
   Compositor& operator=(const Compositor&) = delete;
 
   // The object (world space, at its place) and its material (albedo, texture, glossy lobe); uploaded once.
-  // Throws ibl::Error on an empty mesh or a material out of range.
-  void set_object(const geometry::TriMesh& object, const render::Material& material);
+  // soft_visibility: per triangle, the share of the soft irradiance that reaches it (augment::soft_visibility,
+  // composite.h: its own occlusion and the proxy's, the floor darkened by its shadow); none: all of it.
+  // Throws ibl::Error on an empty mesh, a material out of range or a visibility of the wrong size.
+  void set_object(const geometry::TriMesh& object, const render::Material& material, const std::vector<Vec3>* soft_visibility = nullptr);
   // A Lambertian object of albedo `albedo`.
-  void set_object(const geometry::TriMesh& object, Vec3 albedo) { set_object(object, render::Material{albedo, {0, 0, 0}}); }
+  void set_object(const geometry::TriMesh& object, Vec3 albedo, const std::vector<Vec3>* soft_visibility = nullptr) {
+    set_object(object, render::Material{albedo, {0, 0, 0}}, soft_visibility);
+  }
   // One frame with the object moved by `offset` (world metres). gl_rows: the colour texture in GL's row
   // order (bottom up, for a window's Presenter) instead of the photograph's.
   void draw(Vec3 offset = {}, bool gl_rows = false, GlFrameTiming* timing = nullptr);

@@ -268,5 +268,66 @@ TEST(AugmentGl, TextureAndSunHighlightAgreeWithTheCpuReference) {
               s.gl.x / s.cpu.x, s.gl.y / s.cpu.y, s.gl.z / s.cpu.z, gx, gy, cx, cy);
 }
 
+TEST(AugmentGl, SoftVisibilityDarkensTheUndersideAsTheCpuReferenceDoes) {
+  SKIP_WITHOUT_GL();
+  // The blob a little above a floor under a sun and a sky that is constant everywhere (so the floor the
+  // object sees carries the sky's radiance too): its underside sees the floor its own shadow darkens, its
+  // bumps hide part of the sky. The GL object against the CPU's, whole and by half (pixel rows below the
+  // blob's centre face the floor), with the soft light's share per triangle and without it.
+  const Vec3 at{0, 0.25, 0};
+  Image photo = constant_photo(0.4);
+  LocalLight light = sky({0.5, 0.5, 0.5}, {3000, 3000, 3000}, at);
+  ObjectDesc od;
+  od.size = 0.4;
+  od.triangles = 4000;
+  od.at = at;
+  geometry::TriMesh object = make_object(od);
+  geometry::Camera cam;
+  cam.eye = {0, 0.45, 1.4};
+  cam.target = at;
+  cam.fov_y_deg = 25;
+  cam.width = kW;
+  cam.height = kH;
+  CompositeDesc cd;
+  cd.object_samples = 4096;
+  auto cpu = augment::composite(photo, cam, floor_mesh(), light, object, {0.7, 0.7, 0.7}, cd);
+  GlCompositeDesc with, without;
+  without.visibility_samples = 0;
+  auto gl = augment::gl::composite(photo, cam, floor_mesh(), light, object, {0.7, 0.7, 0.7}, with);
+  auto gl0 = augment::gl::composite(photo, cam, floor_mesh(), light, object, {0.7, 0.7, 0.7}, without);
+  const double py = kH / 2.0;  // the blob's centre is the camera's target: the frame's centre row
+  struct Half { double gl = 0, gl0 = 0, cpu = 0; int n = 0; } upper, lower;
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x)
+      if (gl.mask.at(x, y, 0) == 1 && gl0.mask.at(x, y, 0) == 1 && cpu.mask.at(x, y, 0) == 1) {
+        Half& h = y + 0.5 > py ? lower : upper;
+        h.gl += gl.composite.rgb(x, y).y;
+        h.gl0 += gl0.composite.rgb(x, y).y;
+        h.cpu += cpu.composite.rgb(x, y).y;
+        ++h.n;
+      }
+  ASSERT_GT(lower.n, 300);
+  ASSERT_GT(upper.n, 300);
+  std::printf("blob over a floor, GL / CPU: lower half %.4f (unoccluded %.4f), upper half %.4f (%.4f), %d + %d pixels\n", lower.gl / lower.cpu,
+              lower.gl0 / lower.cpu, upper.gl / upper.cpu, upper.gl0 / upper.cpu, lower.n, upper.n);
+  EXPECT_NEAR(lower.gl / lower.cpu, 1.0, 0.04);
+  EXPECT_NEAR(upper.gl / upper.cpu, 1.0, 0.04);
+  // Without the share the underside is lit by the floor as if the object cast no shadow on it.
+  EXPECT_GT(lower.gl0 / lower.cpu, lower.gl / lower.cpu + 0.03);
+}
+
+TEST(AugmentGl, SoftVisibilityIsOneWhereNothingIsHidden) {
+  // A sphere (convex: it hides nothing from itself) far above a small floor off to the side, under a
+  // constant sky: every triangle receives all of its soft light, exactly (the ratio estimate of equal sums).
+  geometry::TriMesh proxy = geometry::make_quad({5, -5, 0}, {0, 1, 0}, {0, 0, -1}, 0.5, 0.5);
+  const Vec3 at{0, 0.3, 0};
+  std::vector<Vec3> f = soft_visibility(sky({2, 2, 2}, {}, at), proxy, sphere_at(at, 0.6));
+  ASSERT_FALSE(f.empty());
+  int exact = 0;
+  for (const Vec3& v : f) exact += v.x == 1 && v.y == 1 && v.z == 1;
+  EXPECT_GE(exact, static_cast<int>(f.size() * 0.99));  // rays grazing a neighbouring facet may hit it
+  EXPECT_THROW(soft_visibility(sky({2, 2, 2}, {}, at), proxy, sphere_at(at, 0.6), SoftVisibilityDesc{0}), Error);
+}
+
 }  // namespace
 }  // namespace ibl::augment::gl

@@ -1,12 +1,13 @@
 #version 450 core
 // The object: render::Material as on the CPU (augment/composite.cpp's object_radiance). Diffuse: the
 // albedo (times the texture at the UVs) over π times the soft environment's irradiance (which holds the
-// proxy's light as the probe saw it) and the hard lights through both shadow maps (its own shadow, lamps
+// proxy's light as the probe saw it), times the share of it that reaches the triangle and the hard lights through both shadow maps (its own shadow, lamps
 // the proxy hides). Glossy (u_specular > 0): the lobe of render::glossy_lobe per hard light, per unit
 // irradiance at normal incidence, and the soft map's Phong-prefiltered value along the reflected ray.
 in vec3 v_position;
 in vec3 v_normal;
 in vec2 v_uv;
+in vec3 v_soft;  // the share of the soft irradiance that reaches this triangle (augment::soft_visibility)
 uniform sampler2D u_soft_irradiance;
 uniform sampler2D u_object_texture;  // linear RGB, uv (0,0) at the image's bottom-left, bilinear, repeating
 uniform sampler2D u_object_glossy;   // G_s of the soft map (render/prefilter.h), lat-long
@@ -33,7 +34,7 @@ void main() {
   if (dot(n, v) < 0.0) n = -n;
   const bool glossy = max(u_specular.r, max(u_specular.g, u_specular.b)) > 0.0;
   vec3 r = reflect(-v, n);
-  vec3 e = texture(u_soft_irradiance, latlong(n)).rgb;
+  vec3 e = texture(u_soft_irradiance, latlong(n)).rgb * v_soft;
   vec3 g = glossy ? texture(u_object_glossy, latlong(r)).rgb : vec3(0.0);
   for (int l = 0; l < u_light_count; ++l) {
     vec2 s = shadow(l, v_position, n, 1.5);
