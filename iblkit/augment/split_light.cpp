@@ -6,13 +6,41 @@
 #include "iblkit/core/error.h"
 #include "iblkit/geometry/raytracer.h"
 #include "iblkit/lights/cut.h"
-#include "iblkit/sh/convolve.h"
-#include "iblkit/sh/project.h"
+#include "iblkit/core/parallel.h"
 
 namespace ibl::augment {
 
 namespace {
 constexpr double kDepthInFront = 0.98;  // as light.cpp: a depth this much shorter than the proxy's hit is a lamp
+// E(n) = ∫ L max(0, n·ω) dω on a lat-long of 2·size × size normals, summed over the soft texels (`soft`) of the grid
+// gathered into at most 128 × 64 cells: each cell keeps the exact Σ L dω of its texels (a lamp's power stays whole)
+// at their solid-angle-weighted mean direction. No band limit: 3 SH bands misstate the side facing away from a
+// bright wall or window by several per cent.
+Image cosine_convolution(int W, int H, const lights::LatLongGrid& grid, const std::vector<char>& soft, int size) {
+  const int Wc = std::min(W, 128), Hc = std::min(H, 64);
+  std::vector<Vec3> power(static_cast<size_t>(Wc) * Hc), dir(power.size());
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      const size_t i = static_cast<size_t>(y) * W + x;
+      const size_t c = static_cast<size_t>(y * Hc / H) * Wc + x * Wc / W;
+      const double dw = grid.row_solid_angle[y];
+      dir[c] += grid.direction(x + 0.5, y + 0.5) * dw;
+      if (soft[i]) power[c] += grid.rgb[i] * dw;
+    }
+  for (Vec3& d : dir) d = length(d) > 0 ? normalize(d) : Vec3{0, 1, 0};
+  Image out(2 * size, size, 3);
+  const sphere::Mapping m(sphere::MappingKind::LatLong, 2 * size, size);
+  parallel_for(0, size, [&](int64_t y) {
+    for (int x = 0; x < 2 * size; ++x) {
+      Vec3 n, e;
+      m.to_direction(x + 0.5, static_cast<double>(y) + 0.5, &n);
+      for (size_t c = 0; c < power.size(); ++c) e += power[c] * std::max(0.0, dot(n, dir[c]));
+      out.set_rgb(x, static_cast<int>(y), Vec3{std::max(0.0, e.x), std::max(0.0, e.y), std::max(0.0, e.z)});
+    }
+  });
+  return out;
+}
+
 }  // namespace
 
 Vec3 HardLight::at(Vec3 centre, Vec3 x, Vec3 n) const {
@@ -39,6 +67,7 @@ SplitLight split_light(const LocalLight& light, const geometry::TriMesh& proxy, 
   s.centre = light.centre;
   s.soft = Image(W, H, 3);
   lights::LatLongGrid hard = grid;
+  std::vector<char> soft_texel(grid.rgb.size(), 1);
   int hard_texels = 0;
   double hard_power = 0;
   for (int y = 0; y < H; ++y)
@@ -46,6 +75,7 @@ SplitLight split_light(const LocalLight& light, const geometry::TriMesh& proxy, 
       size_t i = static_cast<size_t>(y) * W + x;
       bool is_hard = desc.lights > 0 && desc.threshold > 0 && split_measure(grid.rgb[i]) > limit;
       if (is_hard) {
+        soft_texel[i] = 0;
         ++hard_texels;
         hard_power += split_measure(grid.rgb[i]) * grid.row_solid_angle[y];
       } else {
@@ -81,10 +111,7 @@ SplitLight split_light(const LocalLight& light, const geometry::TriMesh& proxy, 
       s.hard.push_back(h);
     }
   }
-  sphere::EnvMap soft_map(s.soft, sphere::Mapping(sphere::MappingKind::LatLong, W, H));
-  sh::Coeffs irr = sh::irradiance(sh::project(soft_map, 3));
-  s.soft_irradiance = sh::reconstruct(irr, sphere::Mapping(sphere::MappingKind::LatLong, 2 * desc.irradiance_size, desc.irradiance_size));
-  for (size_t i = 0; i < s.soft_irradiance.size(); ++i) s.soft_irradiance.data()[i] = std::max(0.0f, s.soft_irradiance.data()[i]);
+  s.soft_irradiance = cosine_convolution(grid.width, grid.height, grid, soft_texel, desc.irradiance_size);
   return s;
 }
 

@@ -3,7 +3,7 @@
 // localised lights (median cut of that part, Debevec 2005; each light put where its ray from the map's
 // centre meets the proxy, or the probe's depth map says a lamp hangs, or at infinity where the ray leaves
 // the proxy), which cast shadow maps; the rest of the map (sky, walls, floor) stays a smooth environment,
-// whose shadow is the soft term (sphere_occlusion.h) and whose irradiance shades the object (SH, 3 bands).
+// whose shadow is the soft term (sphere_occlusion.h) and whose irradiance shades the object (its cosine convolution).
 // The lights and the soft map together hold all of the map's power (test AugmentSplit.*).
 #pragma once
 #include <algorithm>
@@ -31,14 +31,15 @@ inline double split_measure(Vec3 L) { return (std::max(0.0, L.x) + std::max(0.0,
 struct SplitDesc {
   int lights = 16;         // most hard lights (fewer when fewer texels are bright)
   double threshold = 8;    // a texel is hard when its mean RGB radiance exceeds this × the map's mean (0: none hard)
-  int irradiance_size = 32;  // lat-long height of the soft irradiance map
+  int irradiance_size = 32;  // lat-long height of the soft irradiance map (and of the soft map it is summed over)
 };
 
 struct SplitLight {
   Vec3 centre;                   // the map's centre, world metres
   std::vector<HardLight> hard;   // the concentrated light
   Image soft;                    // lat-long radiance (RGB, 2H × H): the map less the hard texels
-  Image soft_irradiance;         // lat-long (RGB): E_soft(n) = ∫ L_soft max(0, n·ω) dω, SH 3 bands, ≥ 0
+  Image soft_irradiance;         // lat-long (RGB, 2·irradiance_size × irradiance_size): E_soft(n) = ∫ L_soft max(0, n·ω) dω, summed
+                                 // over the soft map (render::prefilter_phong, exponent 1, times π)
   double hard_share = 0;         // share of the map's ∫ mean(RGB) dω in the hard lights
 };
 

@@ -81,10 +81,20 @@ TEST(AugmentSplit, HardLightsAndSoftMapHoldAllOfTheMapsPowerAndSitWhereTheProxyI
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(hard[c] + rest[c], total[c], 1e-6 * total[c]);
   EXPECT_GT(s.hard_share, 0.5);
   // The soft irradiance on an upward normal: π × the upper hemisphere's radiance (1.0 in blue), the lower
-  // hemisphere's (0.2) on a downward one, within what 3 SH bands of a step between hemispheres keep.
+  // hemisphere's (0.2) on a downward one (the output's first and last rows are 2.8° off the poles: the sky view
+  // factor (1 + cos 2.8°)/2), less, upwards, the sun's two texels, which are hard and missing from the soft sky.
   const Image& irr = s.soft_irradiance;
-  EXPECT_NEAR(irr.rgb(irr.width() / 2, 0).z, kPi * 1.0, 0.1);
-  EXPECT_NEAR(irr.rgb(irr.width() / 2, irr.height() - 1).z, kPi * 0.2, 0.1);
+  const double c = std::cos(kPi / (2 * irr.height()));
+  Vec3 up;
+  ASSERT_TRUE(sphere::Mapping(sphere::MappingKind::LatLong, irr.width(), irr.height()).to_direction(irr.width() / 2 + 0.5, 0.5, &up));
+  double sun_sky = 0;
+  for (int x : {20, 21}) {
+    Vec3 w;
+    ASSERT_TRUE(l.map.mapping.to_direction(x + 0.5, 6.5, &w));
+    sun_sky += 1.0 * l.map.mapping.solid_angle(x, 6) * std::max(0.0, dot(up, w));
+  }
+  EXPECT_NEAR(irr.rgb(irr.width() / 2, 0).z, kPi * (1.0 * (1 + c) / 2 + 0.2 * (1 - c) / 2) - sun_sky, 2e-3);
+  EXPECT_NEAR(irr.rgb(irr.width() / 2, irr.height() - 1).z, kPi * (0.2 * (1 + c) / 2 + 1.0 * (1 - c) / 2), 2e-3);
 
   // Under a ceiling the sun's light comes from a point on it (intensity E·d² W/sr).
   geometry::TriMesh room = floor;
@@ -101,6 +111,34 @@ TEST(AugmentSplit, HardLightsAndSoftMapHoldAllOfTheMapsPowerAndSitWhereTheProxyI
   EXPECT_TRUE(split_light(l, floor, none).hard.empty());
   none.lights = -1;
   EXPECT_THROW(split_light(l, floor, none), Error);
+}
+
+TEST(AugmentSplit, SoftIrradianceIsTheCosineSumOfTheSoftTexels) {
+  // With nothing hard (threshold 0), E(n) on every normal of the irradiance map is Σ L dω max(0, n·ω) over the
+  // map's texels, the sun's two included: against that sum done here texel by texel, within the cells' spread
+  // (a 64 × 32 map is its own cells: exact but for float rounding).
+  LocalLight l = sky_and_sun({0, 0.5, 0});
+  geometry::TriMesh floor = geometry::make_quad({0, 0, 0}, {0, 1, 0}, {0, 0, -1}, 6, 6);
+  SplitDesc all_soft;
+  all_soft.threshold = 0;
+  SplitLight s = split_light(l, floor, all_soft);
+  const Image& irr = s.soft_irradiance;
+  const sphere::Mapping& in = l.map.mapping;
+  const sphere::Mapping out(sphere::MappingKind::LatLong, irr.width(), irr.height());
+  double worst = 0;
+  for (int y = 0; y < irr.height(); y += 3)
+    for (int x = 0; x < irr.width(); x += 5) {
+      Vec3 n, e;
+      ASSERT_TRUE(out.to_direction(x + 0.5, y + 0.5, &n));
+      for (int v = 0; v < 32; ++v)
+        for (int u = 0; u < 64; ++u) {
+          Vec3 w;
+          ASSERT_TRUE(in.to_direction(u + 0.5, v + 0.5, &w));
+          e += l.map.image.rgb(u, v) * (in.solid_angle(u, v) * std::max(0.0, dot(n, w)));
+        }
+      for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(irr.rgb(x, y)[c] - e[c]) / e[c]);
+    }
+  EXPECT_LT(worst, 1e-4);
 }
 
 }  // namespace

@@ -12,8 +12,8 @@
 // E_with − E_without is evaluated as the sum of these terms, the only inputs that differ between the two
 // renders, so ΔE is exactly 0 (the pixel is the photograph, bit for bit) where no shadow-map tap sees the
 // object and the sphere's cosine-weighted share is below the cut-off. The object is drawn with 4× MSAA
-// against the proxy's depth (occluded where the proxy is in front), lit by the soft irradiance (SH, 3
-// bands: the proxy's light as the probe saw it) and the hard lights through both maps.
+// against the proxy's depth (occluded where the proxy is in front), lit by the soft irradiance (the soft map's
+// cosine convolution: the proxy's light as the probe saw it) and the hard lights through both maps.
 //
 // Interreflection kept: proxy → object as captured, times the share of it each triangle receives when
 // one is given (set_object's soft_visibility: its own occlusion, the proxy's, and the floor under it darkened
