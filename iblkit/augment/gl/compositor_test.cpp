@@ -174,6 +174,25 @@ struct ObjectSums {
   Vec3 gl, cpu;
   int pixels = 0;
 };
+// The test frame's camera from eye towards target.
+geometry::Camera frame_camera(Vec3 eye, Vec3 target, double fov_deg) {
+  geometry::Camera cam;
+  cam.eye = eye;
+  cam.target = target;
+  cam.fov_y_deg = fov_deg;
+  cam.width = kW;
+  cam.height = kH;
+  return cam;
+}
+
+// The CPU composite over the floor with 4096 light samples per object pixel (its object nearly noise-free).
+CompositeResult cpu_reference(const Image& photo, const geometry::Camera& cam, const LocalLight& light, const geometry::TriMesh& object,
+                              const render::Material& m) {
+  CompositeDesc cd;
+  cd.object_samples = 4096;
+  return augment::composite(photo, cam, floor_mesh(), light, object, m, cd);
+}
+
 ObjectSums object_sums(const CompositeResult& gl, const CompositeResult& cpu) {
   ObjectSums s;
   for (int y = 0; y < kH; ++y)
@@ -225,15 +244,8 @@ TEST(AugmentGl, TextureAndSunHighlightAgreeWithTheCpuReference) {
   render::Material m{{1, 1, 1}, {0.3, 0.3, 0.3}, 30};
   m.texture = tex;
   geometry::TriMesh object = sphere_at(at, 0.5);
-  geometry::Camera cam;
-  cam.eye = {0, 1.4, 1.2};
-  cam.target = at;
-  cam.fov_y_deg = 40;
-  cam.width = kW;
-  cam.height = kH;
-  CompositeDesc cd;
-  cd.object_samples = 4096;
-  auto cpu = augment::composite(photo, cam, floor_mesh(), light, object, m, cd);
+  const geometry::Camera cam = frame_camera({0, 1.4, 1.2}, at, 40);
+  auto cpu = cpu_reference(photo, cam, light, object, m);
   auto gl = augment::gl::composite(photo, cam, floor_mesh(), light, object, m);
   ObjectSums s = object_sums(gl, cpu);
   ASSERT_GT(s.pixels, 500);
@@ -282,15 +294,8 @@ TEST(AugmentGl, SoftVisibilityDarkensTheUndersideAsTheCpuReferenceDoes) {
   od.triangles = 4000;
   od.at = at;
   geometry::TriMesh object = make_object(od);
-  geometry::Camera cam;
-  cam.eye = {0, 0.45, 1.4};
-  cam.target = at;
-  cam.fov_y_deg = 25;
-  cam.width = kW;
-  cam.height = kH;
-  CompositeDesc cd;
-  cd.object_samples = 4096;
-  auto cpu = augment::composite(photo, cam, floor_mesh(), light, object, {0.7, 0.7, 0.7}, cd);
+  const geometry::Camera cam = frame_camera({0, 0.45, 1.4}, at, 25);
+  auto cpu = cpu_reference(photo, cam, light, object, render::Material{{0.7, 0.7, 0.7}, {0, 0, 0}});
   GlCompositeDesc with, without;
   without.visibility_samples = 0;
   auto gl = augment::gl::composite(photo, cam, floor_mesh(), light, object, {0.7, 0.7, 0.7}, with);
