@@ -36,8 +36,7 @@ Decoded oiio_read(const std::string& path) {
   const OIIO::ImageSpec& spec = in->spec();
   if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0)
     fail(ErrorKind::Format, "{}: image has no pixels ({}x{}x{})", path, spec.width, spec.height, spec.nchannels);
-  if (static_cast<int64_t>(spec.width) * spec.height > (int64_t(1) << 30))
-    fail(ErrorKind::Value, "{}: image {}x{} is too large", path, spec.width, spec.height);
+  check_decoded_size(path, spec.width, spec.height, spec.nchannels);
   int nc = spec.nchannels;
   Decoded d;
   d.image = Image(spec.width, spec.height, nc);

@@ -80,8 +80,7 @@ Header read_pfm_header(const std::string& path) {
 Decoded read_pfm(const std::string& path) {
   std::ifstream in = open_or_fail(path);
   PfmHeader h = parse_header(in, path);
-  if (static_cast<int64_t>(h.width) * h.height > (int64_t(1) << 30))
-    fail(ErrorKind::Value, "{}: image {}x{} is too large", path, h.width, h.height);
+  check_decoded_size(path, h.width, h.height, h.channels);
   // The pixels must be in the file before they are allocated (a 28-byte header may declare 12.9 GB).
   {
     const std::streamoff here = in.tellg();

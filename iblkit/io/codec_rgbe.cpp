@@ -186,7 +186,7 @@ std::optional<Decoded> read_rgbe(const std::string& path) {
   File f = open_or_fail(path);
   int w = 0, h = 0;
   if (!read_header(f.get(), path, w, h)) return std::nullopt;
-  if (static_cast<int64_t>(w) * h > (int64_t(1) << 30)) fail(ErrorKind::Value, "{}: image {}x{} is too large", path, w, h);
+  check_decoded_size(path, w, h, 3);
   // Every scanline takes at least 4 bytes in any RGBE encoding: check the file can hold the rows the
   // header declares before allocating them (a 60-byte header may declare 10.8 GB).
   {

@@ -7,9 +7,14 @@
 // EXR with layers or integer channels, an RGBE file stored in another orientation, …) goes to
 // OpenImageIO too.
 #pragma once
+#include <algorithm>
+#include <cstdint>
+#include <filesystem>
 #include <optional>
 #include <string>
+#include <system_error>
 
+#include "iblkit/core/error.h"
 #include "iblkit/core/image.h"
 #include "iblkit/core/plugin.h"
 
@@ -28,6 +33,23 @@ struct Header {
   int width = 0, height = 0, channels = 0;
   std::string format;
 };
+
+// What every decoder checks before it allocates the pixels a header declares: at most 2^30 pixels, and no more
+// decoded bytes (channels × 4) than the file could hold at kMaxCompression : 1, above a floor of
+// kAnyFileMayDecodeTo (fuzz_image: a 1.9 KB EXR header declared an image that OpenEXR allocated 1 GB for before
+// it found the pixels missing). ZIP's deflate stops near 1032 : 1 and RLE near 64 : 1, on half floats; the decoded
+// floats are twice those. Throws ibl::Error naming the file.
+inline constexpr int64_t kMaxCompression = 4096;
+inline constexpr int64_t kAnyFileMayDecodeTo = int64_t(256) << 20;
+inline void check_decoded_size(const std::string& path, int64_t width, int64_t height, int64_t channels) {
+  if (width * height > (int64_t(1) << 30)) fail(ErrorKind::Value, "{}: image {}x{} is too large", path, width, height);
+  const int64_t bytes = width * height * std::max<int64_t>(channels, 1) * int64_t(sizeof(float));
+  std::error_code ec;
+  const auto file = std::filesystem::file_size(path, ec);
+  if (!ec && bytes > kAnyFileMayDecodeTo && bytes / kMaxCompression > static_cast<int64_t>(file))
+    fail(ErrorKind::Format, "{}: corrupt or truncated: its header declares a {}x{} image of {} channels ({} MB of pixels), which its {} bytes "
+         "cannot hold", path, width, height, channels, bytes >> 20, static_cast<int64_t>(file));
+}
 
 // What a file is, from its first bytes.
 enum class FileKind { OpenExr, Rgbe, Pfm, Other };
