@@ -22,20 +22,34 @@ constexpr int kMaxLights = Compositor::kMaxLights;
 constexpr float kFar = 1e30f;   // a shadow-map texel nothing covers
 
 // Flat-shaded triangles: position, face normal, UV (0 for a mesh without UVs) and the soft light's share
-// (composite.h's soft_visibility; 1 where none is given) per corner, 11 floats, so that both renders and the
+// (composite.h's soft_visibility, smoothed over each vertex; 1 where none is given) per corner, 11 floats, so that both renders and the
 // CPU reference see the same per-triangle normals.
 struct Mesh {
   GLuint vao = 0, vbo = 0;
   GLsizei count = 0;
   void upload(const geometry::TriMesh& m, const std::vector<Vec3>* soft = nullptr) {
+    // The share at each corner is its vertex's mean over the triangles around it: one estimate per triangle (64
+    // rays) is grainy, the mean over the ~6 around a vertex about 2.4× less so, and it varies smoothly.
+    std::vector<Vec3> corner_share;
+    if (soft) {
+      corner_share.assign(m.positions.size(), Vec3{});
+      std::vector<int> count(m.positions.size(), 0);
+      for (size_t i = 0; i < m.triangle_count(); ++i)
+        for (uint32_t vi : m.triangles[i]) {
+          corner_share[vi] += (*soft)[i];
+          ++count[vi];
+        }
+      for (size_t vi = 0; vi < corner_share.size(); ++vi)
+        if (count[vi] > 0) corner_share[vi] = corner_share[vi] / static_cast<double>(count[vi]);
+    }
     std::vector<float> v;
     v.reserve(m.triangle_count() * 33);
     const bool uvs = m.has_uvs();
     for (size_t i = 0; i < m.triangle_count(); ++i) {
-      Vec3 n = m.normal(i), f = soft ? (*soft)[i] : Vec3{1, 1, 1};
+      Vec3 n = m.normal(i);
       for (int k = 0; k < 3; ++k) {
         const uint32_t vi = m.triangles[i][k];
-        Vec3 p = m.positions[vi];
+        Vec3 p = m.positions[vi], f = soft ? corner_share[vi] : Vec3{1, 1, 1};
         Vec2 uv = uvs ? m.uvs[vi] : Vec2{0, 0};
         for (double c : {p.x, p.y, p.z, n.x, n.y, n.z, uv.x, uv.y, f.x, f.y, f.z}) v.push_back(static_cast<float>(c));
       }

@@ -34,7 +34,9 @@ void main() {
   if (dot(n, v) < 0.0) n = -n;
   const bool glossy = max(u_specular.r, max(u_specular.g, u_specular.b)) > 0.0;
   vec3 r = reflect(-v, n);
-  vec3 e = texture(u_soft_irradiance, latlong(n)).rgb * v_soft;
+  // Clamped: a multisampled edge pixel evaluates the attribute at its centre, which may lie outside the
+  // triangle, where the corners' values extrapolate (below 0 next to a dark corner).
+  vec3 e = texture(u_soft_irradiance, latlong(n)).rgb * clamp(v_soft, 0.0, 1.0);
   vec3 g = glossy ? texture(u_object_glossy, latlong(r)).rgb : vec3(0.0);
   for (int l = 0; l < u_light_count; ++l) {
     vec2 s = shadow(l, v_position, n, 1.5);
