@@ -144,12 +144,12 @@ std::optional<Decoded> read_exr(const std::string& path) {
     Decoded d;
     d.format = "openexr";
     d.image = Image(l->width, l->height, nc);
-    // The frame buffer's origin sits at the data window's corner: point it back by that offset.
+    // The frame buffer's origin sits at the data window's corner: OpenEXR's Slice::Make takes the window and does
+    // the offset itself (done here as pointer arithmetic it overflowed for a window far from 0: UBSan, fuzz_image).
     const size_t xs = sizeof(float) * nc, ys = xs * l->width;
-    char* base = reinterpret_cast<char*>(d.image.data()) - static_cast<ptrdiff_t>(l->window.min.x) * xs -
-                 static_cast<ptrdiff_t>(l->window.min.y) * ys;
+    char* base = reinterpret_cast<char*>(d.image.data());
     Imf::FrameBuffer fb;
-    for (int c = 0; c < nc; ++c) fb.insert(l->channels[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), xs, ys));
+    for (int c = 0; c < nc; ++c) fb.insert(l->channels[c], Imf::Slice::Make(Imf::FLOAT, base + c * sizeof(float), l->window, xs, ys));
     file.setFrameBuffer(fb);
     try {
       file.readPixels(l->window.min.y, l->window.max.y);
