@@ -8,7 +8,9 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <initializer_list>
 #include <limits>
+#include <utility>
 
 #include "iblkit/core/error.h"
 #include "iblkit/io/envmap_io.h"
@@ -104,37 +106,34 @@ TEST(ImageIo, TruncatedFileIsAFormatError) {
   expect_error([&] { read_image(junk); }, ErrorKind::Format, {junk});
 }
 
-TEST(ImageIo, AHeaderDeclaringMorePixelsThanItsFileCanHoldIsRefusedBeforeAllocating) {
-  // A 64×64 EXR whose data window is rewritten to 16384×16384 (4 GB of float RGB): refused from the header and
-  // the file's size (io/codecs.h, check_decoded_size), not after OpenEXR allocated the frame buffer.
-  std::string p = (tmpdir() / "declares-16k.exr").string();
-  write_image(p, gradient(64, 64, 3));
+// Writes a small EXR at `name` and overwrites int32 (little-endian) values in it: each pair is the offset after
+// the first occurrence of `key` and the value. Returns the path; fails the test where `key` is missing.
+std::string patched_exr(const std::string& name, int size, const std::string& key, std::initializer_list<std::pair<size_t, int32_t>> values) {
+  std::string p = (tmpdir() / name).string();
+  write_image(p, gradient(size, size, 3));
   std::ifstream in(p, std::ios::binary);
   std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const std::string key("dataWindow\0box2i\0", 17);
-  size_t at = bytes.find(key);
-  ASSERT_NE(at, std::string::npos);
-  at += key.size() + 4;  // the attribute's size, then xMin, yMin, xMax, yMax (int32, little-endian)
-  const int32_t max = 16383;
-  bytes.replace(at + 8, 4, reinterpret_cast<const char*>(&max), 4);
-  bytes.replace(at + 12, 4, reinterpret_cast<const char*>(&max), 4);
+  in.close();
+  const size_t at = bytes.find(key);
+  EXPECT_NE(at, std::string::npos) << key;
+  if (at == std::string::npos) return p;
+  for (auto [offset, v] : values) bytes.replace(at + key.size() + offset, 4, reinterpret_cast<const char*>(&v), 4);
   std::ofstream(p, std::ios::binary | std::ios::trunc).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  return p;
+}
+
+TEST(ImageIo, AHeaderDeclaringMorePixelsThanItsFileCanHoldIsRefusedBeforeAllocating) {
+  // A 64×64 EXR whose data window is rewritten to 16384×16384 (4 GB of float RGB): refused from the header and
+  // the file's size (io/codecs.h, check_decoded_size), not after OpenEXR allocated the frame buffer. After the key:
+  // the attribute's size, then xMin, yMin, xMax, yMax (int32).
+  std::string p = patched_exr("declares-16k.exr", 64, std::string("dataWindow\0box2i\0", 17), {{12, 16383}, {16, 16383}});
   expect_error([&] { read_image(p); }, ErrorKind::Format, {p, "16384x16384", "cannot hold"});
 }
 
 TEST(ImageIo, AnExrAttributeLongerThanItsFileIsRefusedBeforeOpenExrAllocatesIt) {
   // A good EXR whose "compression" attribute (1 byte) is rewritten to declare 1 GB (what fuzz_image found with a
   // string attribute: OpenEXR allocated it before reading): refused by the header walk, the file named.
-  std::string p = (tmpdir() / "attr-1gb.exr").string();
-  write_image(p, gradient(16, 16, 3));
-  std::ifstream in(p, std::ios::binary);
-  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const std::string key("compression\0compression\0", 24);
-  size_t at = bytes.find(key);
-  ASSERT_NE(at, std::string::npos);
-  const int32_t huge = 1 << 30;
-  bytes.replace(at + key.size(), 4, reinterpret_cast<const char*>(&huge), 4);
-  std::ofstream(p, std::ios::binary | std::ios::trunc).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  std::string p = patched_exr("attr-1gb.exr", 16, std::string("compression\0compression\0", 24), {{0, 1 << 30}});
   expect_error([&] { read_image(p); }, ErrorKind::Format, {p, "'compression'", "1073741824 bytes"});
   // The file fuzz_image found, kept in fuzz/crashes/image, is replayed by make test (fuzz_replay_image).
 }
