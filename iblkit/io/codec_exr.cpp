@@ -6,6 +6,7 @@
 // "Y", else R, G, B, A), ZIP compression, float or half (Imath's round-to-nearest conversion).
 #include <algorithm>
 #include <cstdint>
+#include <cstring>
 #include <fstream>
 #include <mutex>
 #include <thread>
@@ -41,11 +42,14 @@ int channel_rank(const std::string& name) {
   return -1;
 }
 
-// OpenEXR allocates each header attribute's declared size before it reads the value (fuzz_image: a 1.9 KB file
-// whose "capDate" string declared 1.04 GB). Walks the header(s) as the file format lays them out — after the
-// magic number and version, attributes of name\0 type\0 int32 size and value, an empty name ending a header, and
-// in a multi-part file an empty header ending the list — and refuses a size beyond the file's end.
-void check_attribute_sizes(const std::string& path) {
+// OpenEXR allocates what a header declares before it reads a pixel: each attribute's declared size (fuzz_image: a
+// 1.9 KB file whose "capDate" string declared 1.04 GB) and, when it opens the file, a line or tile buffer as wide as
+// the data window (a 1.3 KB file whose 8388624 x 8 window cost 400 MB and 22 s before check_decoded_size saw it).
+// Walks the header(s) as the file format lays them out — after the magic number and version, attributes of name\0
+// type\0 int32 size and value, an empty name ending a header, and in a multi-part file an empty header ending the
+// list — and refuses a size beyond the file's end, and a data window or tile that check_decoded_size refuses, before
+// OpenEXR or OpenImageIO opens the file.
+void check_header(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) return;  // OpenEXR's open says why
   in.seekg(0, std::ios::end);
@@ -63,9 +67,10 @@ void check_attribute_sizes(const std::string& path) {
     }
     return false;
   };
-  std::string name, type;
+  std::string name, type, value;
   for (;;) {  // headers
     bool empty = true;
+    int64_t width = 0, height = 0, channels = 0, tile_w = 0, tile_h = 0;
     for (;;) {  // attributes
       if (!read_name(&name)) return;  // OpenEXR reports the broken header itself
       if (name.empty()) break;        // the end of this header
@@ -76,7 +81,41 @@ void check_attribute_sizes(const std::string& path) {
       if (size < 0 || size > left)
         fail(ErrorKind::Format, "{}: corrupt or truncated: the header's attribute '{}' ({}) declares {} bytes, {} are left in the file", path,
              name, type, size, static_cast<int64_t>(left));
-      in.seekg(size, std::ios::cur);
+      const bool window = name == "dataWindow" && type == "box2i" && size == 16;
+      const bool tiles = name == "tiles" && type == "tiledesc" && size == 9;
+      const bool chlist = name == "channels" && type == "chlist";
+      if (!window && !tiles && !chlist) {
+        in.seekg(size, std::ios::cur);
+        continue;
+      }
+      value.resize(static_cast<size_t>(size));
+      if (!in.read(value.data(), size)) return;
+      if (window) {
+        int32_t box[4];
+        std::memcpy(box, value.data(), sizeof box);
+        width = int64_t(box[2]) - box[0] + 1;
+        height = int64_t(box[3]) - box[1] + 1;
+      } else if (tiles) {
+        uint32_t xy[2];
+        std::memcpy(xy, value.data(), sizeof xy);
+        tile_w = xy[0];
+        tile_h = xy[1];
+      } else {  // name\0 then 16 bytes per channel, an empty name at the end
+        channels = 0;
+        for (size_t at = 0; at < value.size() && value[at] != '\0'; ++channels) {
+          const size_t end = value.find('\0', at);
+          if (end == std::string::npos) break;  // OpenEXR reports the broken list
+          at = end + 1 + 16;
+        }
+      }
+    }
+    if (width > 0 && height > 0) check_decoded_size(path, width, height, std::max<int64_t>(channels, 1));
+    // A tile larger than the window is legal, but OpenEXR allocates its buffer whole.
+    if (tile_w > 0 && tile_h > 0 && tile_w * tile_h > std::max<int64_t>(width * height, 1)) {
+      const int64_t bytes = tile_w * tile_h * std::max<int64_t>(channels, 1) * int64_t(sizeof(float));
+      if (tile_w * tile_h > (int64_t(1) << 30) || (bytes > kAnyFileMayDecodeTo && bytes / kMaxCompression > static_cast<int64_t>(file_size)))
+        fail(ErrorKind::Format, "{}: corrupt: its header declares {}x{} tiles for a {}x{} image, which its {} bytes cannot hold", path,
+             tile_w, tile_h, width, height, static_cast<int64_t>(file_size));
     }
     if (!multipart || empty) return;  // one header, or the empty one that ends a multi-part list
   }
@@ -122,7 +161,7 @@ auto header_step(const std::string& path, F&& f) {
 }  // namespace
 
 std::optional<Header> read_exr_header(const std::string& path) {
-  check_attribute_sizes(path);
+  check_header(path);
   return header_step(path, [&]() -> std::optional<Header> {
     Imf::InputFile file(path.c_str());
     auto l = layout_of(file.header());
@@ -133,7 +172,7 @@ std::optional<Header> read_exr_header(const std::string& path) {
 
 std::optional<Decoded> read_exr(const std::string& path) {
   use_all_cores();
-  check_attribute_sizes(path);
+  check_header(path);
   return header_step(path, [&]() -> std::optional<Decoded> {
     Imf::InputFile file(path.c_str());
     auto l = layout_of(file.header());

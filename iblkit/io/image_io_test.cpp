@@ -15,6 +15,12 @@
 #include "iblkit/core/error.h"
 #include "iblkit/io/envmap_io.h"
 #include "iblkit/io/tonemap.h"
+#include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfFrameBuffer.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfTileDescription.h>
+#include <OpenEXR/ImfTiledOutputFile.h>
+#include <vector>
 
 using ibl::test_util::expect_error;
 
@@ -136,6 +142,43 @@ TEST(ImageIo, AnExrAttributeLongerThanItsFileIsRefusedBeforeOpenExrAllocatesIt) 
   std::string p = patched_exr("attr-1gb.exr", 16, std::string("compression\0compression\0", 24), {{0, 1 << 30}});
   expect_error([&] { read_image(p); }, ErrorKind::Format, {p, "'compression'", "1073741824 bytes"});
   // The file fuzz_image found, kept in fuzz/crashes/image, is replayed by make test (fuzz_replay_image).
+}
+
+TEST(ImageIo, AWideExrWindowIsRefusedBeforeOpenExrAllocatesItsLineBuffer) {
+  // What fuzz_image found (fuzz/crashes/image/slow-22s-400MB-exr-1.3KB-file.exr): a small file whose data window
+  // is 8388624 x 8. OpenEXR's InputFile allocated a 400 MB line buffer when it opened the file, before the size
+  // check after it; the header walk refuses it first, for the header alone (read_image_spec) as for the pixels.
+  std::string p = patched_exr("wide.exr", 16, std::string("dataWindow\0box2i\0", 17), {{12, 8388623}, {16, 7}});
+  expect_error([&] { read_image_spec(p); }, ErrorKind::Format, {p, "8388624x8", "cannot hold"});
+  expect_error([&] { read_image(p); }, ErrorKind::Format, {p, "8388624x8", "cannot hold"});
+}
+
+TEST(ImageIo, ExrTilesLargerThanTheFileCanHoldAreRefused) {
+  // A 16 x 16 tiled EXR (OpenEXR's own writer) whose tile size is rewritten to 65536 x 65536: OpenEXR clips a
+  // tile to the window but allocates its buffer whole, so the header walk refuses it.
+  std::string p = (tmpdir() / "tiled.exr").string();
+  {
+    Imf::Header h(16, 16);
+    h.channels().insert("Y", Imf::Channel(Imf::FLOAT));
+    h.setTileDescription(Imf::TileDescription(16, 16, Imf::ONE_LEVEL));
+    std::vector<float> px(256, 0.5f);
+    Imf::FrameBuffer fb;
+    fb.insert("Y", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(px.data()), sizeof(float), 16 * sizeof(float)));
+    Imf::TiledOutputFile out(p.c_str(), h);
+    out.setFrameBuffer(fb);
+    out.writeTiles(0, out.numXTiles() - 1, 0, out.numYTiles() - 1);
+  }
+  EXPECT_NEAR(read_image(p).at(3, 4, 0), 0.5f, 1e-6f);  // read as it was written
+  std::ifstream in(p, std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  in.close();
+  const std::string key("tiles\0tiledesc\0", 15);
+  const size_t at = bytes.find(key);
+  ASSERT_NE(at, std::string::npos);
+  const uint32_t big = 65536;
+  for (size_t off : {4, 8}) bytes.replace(at + key.size() + off, 4, reinterpret_cast<const char*>(&big), 4);
+  std::ofstream(p, std::ios::binary | std::ios::trunc).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  expect_error([&] { read_image(p); }, ErrorKind::Format, {p, "65536x65536 tiles", "cannot hold"});
 }
 
 TEST(ImageIo, BadPixelsAreRejectedWithTheirPositionOrSanitized) {
