@@ -173,8 +173,9 @@ void setup(CLI::App& app) {
   app.add_option("--gl-lights", o->gl.split.lights, "gl: most hard lights with shadow maps")->check(CLI::Range(0, 16))->capture_default_str();
   app.add_option("--gl-threshold", o->gl.split.threshold, "gl: a texel brighter than this x the mean radiance is a hard light's")
       ->check(CLI::Range(0.0, 1e6))->capture_default_str();
-  app.add_option("--gl-visibility", o->gl.visibility_samples, "gl: rays per object triangle for the share of the soft light that reaches it "
-                 "(its own occlusion and the floor its shadow darkens; 0: none)")->check(CLI::Range(0, 65536))->capture_default_str();
+  app.add_option("--gl-visibility", o->gl.visibility_samples, "gl: rays per object triangle for the soft light that reaches it (its own "
+                 "occlusion, the floor its shadow darkens, the parallax from the probe; 0: none; default: 4194304 rays over the "
+                 "triangles, 16 to 1024 each)")->check(CLI::Range(0, 65536));
   app.add_option("--shadow-map-size", o->gl.shadow_map_size, "gl: texels per side of each light's shadow maps")->check(CLI::Range(16, 8192))
       ->capture_default_str();
 #endif

@@ -390,6 +390,8 @@ CompositeResult composite(const Image& photo, const geometry::Camera& cam, const
   return r;
 }
 
+constexpr double kMaxSoftFactor = 16;  // composite.h: soft_visibility's f
+
 std::vector<Vec3> soft_visibility(const LocalLight& light, const geometry::TriMesh& proxy, const geometry::TriMesh& object,
                                   const SoftVisibilityDesc& desc) {
   if (desc.samples < 1 || desc.samples > 65536) fail(ErrorKind::Value, "soft visibility samples {} must lie in 1..65536", desc.samples);
@@ -418,14 +420,15 @@ std::vector<Vec3> soft_visibility(const LocalLight& light, const geometry::TriMe
       if (split_measure(field.radiance(i)) > limit) continue;  // a hard light's texel: the shadow maps' part
       Vec3 w;
       double dist;
+      if (desc.proxy) den += field.contribution(i, light.centre, n, &w, &dist) / pmf;  // E_c(n), what the shader has
       Vec3 c = field.contribution(i, z, n, &w, &dist);
       if (max_component(c) <= 0) continue;
-      den += c / pmf;
+      if (!desc.proxy) den += c / pmf;
       if (rt.occluded(z, w, kRayEpsilon, patch_tfar(dist))) continue;
       num += (desc.proxy ? field.contribution(i, z, n, &w, &dist, true) : c) / pmf;
     }
     for (int c = 0; c < 3; ++c)
-      if (den[c] > 0) f[static_cast<size_t>(ti)][c] = std::clamp(num[c] / den[c], 0.0, 1.0);
+      if (den[c] > 0) f[static_cast<size_t>(ti)][c] = std::clamp(num[c] / den[c], 0.0, kMaxSoftFactor);
   }, 256);
   return f;
 }

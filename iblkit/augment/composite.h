@@ -88,18 +88,22 @@ inline CompositeResult composite(const Image& photo, const geometry::Camera& cam
   return composite(photo, cam, proxy, light, object, render::Material{albedo, {0, 0, 0}}, desc);
 }
 
-// For the real-time path (augment/gl/), which shades the object with the soft map's unoccluded irradiance (SH,
-// from the map's centre): the share of that light which reaches each object triangle, as this reference
+// For the real-time path (augment/gl/), which shades the object with the soft map's irradiance E_c(n) as seen
+// from the map's centre c: the factor that turns it into what each object triangle receives, as this reference
 // computes it. Per triangle (its centre z, its face normal n, the side the normal points to), per channel,
 //
-//   f = Σ_k c_k V(z, q_k) s_k / Σ_k c_k      over patch samples k of the light (light.h) that are soft,
+//   f = Σ_k c_k(z) V(z, q_k) s_k / Σ_k c_k(c)      over patch samples k of the light (light.h) that are soft,
 //
-// c_k the patch's contribution at z, V the visibility past the proxy and the object itself, s_k the patch's
-// shadow factor (the object's shadow on the proxy it sees, from all of the light: the floor under an object
-// does not light its underside). "Soft": the texels split_light leaves in the soft map (mean RGB radiance at
-// most `threshold` × the map's mean; 0: every texel). The same samples in both sums make f a ratio estimate:
-// where nothing is hidden or shadowed it is exactly 1. proxy = false: the object's own occlusion alone (V past
-// the object, s = 1), which stays right while the object moves (iblkit view).
+// c_k(x) patch k's contribution at x with normal n, V the visibility past the proxy and the object itself, s_k the
+// patch's shadow factor (the object's shadow on the proxy it sees, from all of the light: the floor under an
+// object does not light its underside). The denominator estimates E_c(n) from the same samples, so f carries the
+// parallax between c and z as well as what is hidden (a triangle near a lit floor sees more of it than c does; one
+// facing down 15 cm below c does not see the walls between the two heights): f may exceed 1, and is clamped to
+// [0, 16]. Without the parallax (c_k(z) below too) the GL blob in low-scene2 was 4.4–5.2 % brighter than this
+// reference; with it, within 0.2 % (docs/augment.md). "Soft": the texels split_light leaves in the soft map (mean
+// RGB radiance at most `threshold` × the map's mean; 0: every texel). Where every sampled patch is distant and
+// nothing is hidden, f is exactly 1. proxy = false: the object's own occlusion alone (V past the object, s = 1,
+// both sums at z), which stays right while the object moves (iblkit view).
 struct SoftVisibilityDesc {
   int samples = 64;          // patch samples per triangle
   double threshold = 8;      // as SplitDesc::threshold

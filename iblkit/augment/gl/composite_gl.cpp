@@ -18,8 +18,8 @@ CompositeResult composite(const Image& photo, const geometry::Camera& cam, const
                           const geometry::TriMesh& object, const render::Material& material, const GlCompositeDesc& desc,
                           GlFrameTiming* timing) {
   auto t0 = std::chrono::steady_clock::now();
-  if (desc.visibility_samples < 0 || desc.visibility_samples > 65536)
-    fail(ErrorKind::Value, "visibility samples {} must lie in 0..65536", desc.visibility_samples);
+  if (desc.visibility_samples < -1 || desc.visibility_samples > 65536)
+    fail(ErrorKind::Value, "visibility samples {} must lie in 0..65536 (or -1: automatic)", desc.visibility_samples);
   render::gl::Context context;
   AlbedoEstimate est = estimate_albedo(photo, cam, proxy, light, desc.albedo_samples, desc.seed);
   SplitDesc sd = desc.split;
@@ -29,9 +29,12 @@ CompositeResult composite(const Image& photo, const geometry::Camera& cam, const
   {
     Compositor comp(photo, cam, proxy, split, est.albedo, desc);
     std::vector<Vec3> vis;
-    if (desc.visibility_samples > 0) {
+    // The noise a pixel shows depends on the rays per unit of the object's area: a fixed budget over the triangles.
+    const int samples = desc.visibility_samples >= 0 ? desc.visibility_samples
+                        : static_cast<int>(std::clamp<int64_t>(GlCompositeDesc::kVisibilityRays / std::max<int64_t>(object.triangle_count(), 1), 16, 1024));
+    if (samples > 0) {
       SoftVisibilityDesc vd;
-      vd.samples = desc.visibility_samples;
+      vd.samples = samples;
       vd.threshold = sd.lights > 0 ? sd.threshold : 0;
       vd.seed = desc.seed;
       vis = soft_visibility(light, proxy, object, vd);

@@ -21,14 +21,14 @@ using geometry::Mat4f;
 constexpr int kMaxLights = Compositor::kMaxLights;
 constexpr float kFar = 1e30f;   // a shadow-map texel nothing covers
 
-// Flat-shaded triangles: position, face normal, UV (0 for a mesh without UVs) and the soft light's share
+// Flat-shaded triangles: position, face normal, UV (0 for a mesh without UVs) and the soft light's factor
 // (composite.h's soft_visibility, smoothed over each vertex; 1 where none is given) per corner, 11 floats, so that both renders and the
 // CPU reference see the same per-triangle normals.
 struct Mesh {
   GLuint vao = 0, vbo = 0;
   GLsizei count = 0;
   void upload(const geometry::TriMesh& m, const std::vector<Vec3>* soft = nullptr) {
-    // The share at each corner is its vertex's mean over the triangles around it: one estimate per triangle (64
+    // The factor at each corner is its vertex's mean over the triangles around it: one estimate per triangle (64
     // rays) is grainy, the mean over the ~6 around a vertex about 2.4× less so, and it varies smoothly.
     std::vector<Vec3> corner_share;
     if (soft) {

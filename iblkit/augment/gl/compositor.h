@@ -15,9 +15,9 @@
 // against the proxy's depth (occluded where the proxy is in front), lit by the soft irradiance (the soft map's
 // cosine convolution: the proxy's light as the probe saw it) and the hard lights through both maps.
 //
-// Interreflection kept: proxy → object as captured, times the share of it each triangle receives when
-// one is given (set_object's soft_visibility: its own occlusion, the proxy's, and the floor under it darkened
-// by its shadow, ray traced once per placement on the CPU), object → proxy through the sphere (its face towards y lit by the soft irradiance and the hard
+// Interreflection kept: proxy → object as captured, times the factor that turns it into what each triangle
+// receives when one is given (set_object's soft_visibility: its own occlusion, the proxy's, the floor under it
+// darkened by its shadow, and the parallax from the map's centre, ray traced once per placement on the CPU), object → proxy through the sphere (its face towards y lit by the soft irradiance and the hard
 // lights, unshadowed; diffuse, with the texture's mean albedo). Not kept: the object's light on itself.
 //
 // The object's material is render::Material's, as on the CPU: the albedo times the texture at the mesh's
@@ -25,6 +25,7 @@
 // lights the lobe itself, from the soft map its Phong prefiltered map (render/prefilter.h, made once in
 // set_object, the exponent environment_exponent()) looked up along the reflected view ray.
 #pragma once
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -45,8 +46,10 @@ struct GlCompositeDesc {
   bool shadows = true;         // false: the object pasted without shadow or reflection (a baseline)
   bool bounce = true;          // the object's light on the proxy
   int albedo_samples = 64;     // composite(): light samples per pixel of the albedo estimate
-  int visibility_samples = 64; // composite(): patch samples per object triangle of its soft light's share
-                               // (augment::soft_visibility); 0: the object's soft light unoccluded
+  int visibility_samples = -1; // composite(): patch samples per object triangle of its soft light's factor
+                               // (augment::soft_visibility); 0: the object's soft light as the map's centre
+                               // sees it; −1: kVisibilityRays over the triangles, 16 to 1024 each
+  static constexpr int64_t kVisibilityRays = int64_t(1) << 22;  // 209 a triangle for the 20k-triangle blob
   uint64_t seed = 1;
 };
 
@@ -66,8 +69,8 @@ class Compositor {
   Compositor& operator=(const Compositor&) = delete;
 
   // The object (world space, at its place) and its material (albedo, texture, glossy lobe); uploaded once.
-  // soft_visibility: per triangle, the share of the soft irradiance that reaches it (augment::soft_visibility,
-  // composite.h: its own occlusion and the proxy's, the floor darkened by its shadow); none: all of it.
+  // soft_visibility: per triangle, the factor on the soft irradiance (augment::soft_visibility, composite.h: its
+  // own occlusion and the proxy's, the floor darkened by its shadow, the parallax); none: 1.
   // Throws ibl::Error on an empty mesh, a material out of range or a visibility of the wrong size.
   void set_object(const geometry::TriMesh& object, const render::Material& material, const std::vector<Vec3>* soft_visibility = nullptr);
   // A Lambertian object of albedo `albedo`.

@@ -4,6 +4,7 @@
 // CPU reference's. Skips where no OpenGL 4.5 context can be made.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -285,7 +286,9 @@ TEST(AugmentGl, SoftVisibilityDarkensTheUndersideAsTheCpuReferenceDoes) {
   // The blob a little above a floor under a sun and a sky that is constant everywhere (so the floor the
   // object sees carries the sky's radiance too): its underside sees the floor its own shadow darkens, its
   // bumps hide part of the sky. The GL object against the CPU's, whole and by half (pixel rows below the
-  // blob's centre face the floor), with the soft light's share per triangle and without it.
+  // blob's centre face the floor), with the soft light's factor per triangle (its share, and the parallax from
+  // the map's centre: from the blob's upper half the 6 m floor's edge sits lower than from the centre, a band
+  // of directions the CPU's patches leave dark) and without it.
   const Vec3 at{0, 0.25, 0};
   Image photo = constant_photo(0.4);
   LocalLight light = sky({0.5, 0.5, 0.5}, {3000, 3000, 3000}, at);
@@ -315,9 +318,9 @@ TEST(AugmentGl, SoftVisibilityDarkensTheUndersideAsTheCpuReferenceDoes) {
   ASSERT_GT(upper.n, 300);
   std::printf("blob over a floor, GL / CPU: lower half %.4f (unoccluded %.4f), upper half %.4f (%.4f), %d + %d pixels\n", lower.gl / lower.cpu,
               lower.gl0 / lower.cpu, upper.gl / upper.cpu, upper.gl0 / upper.cpu, lower.n, upper.n);
-  EXPECT_NEAR(lower.gl / lower.cpu, 1.0, 0.04);
-  EXPECT_NEAR(upper.gl / upper.cpu, 1.0, 0.04);
-  // Without the share the underside is lit by the floor as if the object cast no shadow on it.
+  EXPECT_NEAR(lower.gl / lower.cpu, 1.0, 0.015);
+  EXPECT_NEAR(upper.gl / upper.cpu, 1.0, 0.015);
+  // Without the factor the underside is lit by the floor as if the object cast no shadow on it.
   EXPECT_GT(lower.gl0 / lower.cpu, lower.gl / lower.cpu + 0.03);
 }
 
@@ -329,8 +332,16 @@ TEST(AugmentGl, SoftVisibilityIsOneWhereNothingIsHidden) {
   std::vector<Vec3> f = soft_visibility(sky({2, 2, 2}, {}, at), proxy, sphere_at(at, 0.6));
   ASSERT_FALSE(f.empty());
   int exact = 0;
-  for (const Vec3& v : f) exact += v.x == 1 && v.y == 1 && v.z == 1;
-  EXPECT_GE(exact, static_cast<int>(f.size() * 0.99));  // rays grazing a neighbouring facet may hit it
+  double worst = 0;
+  for (const Vec3& v : f) {
+    exact += v.x == 1 && v.y == 1 && v.z == 1;
+    worst = std::max({worst, std::abs(v.x - 1), std::abs(v.y - 1), std::abs(v.z - 1)});
+  }
+  // Exactly 1 where every sample is a distant patch; the few triangles that sampled the quad's patches (seen
+  // nearer or farther than from the centre: parallax) and rays grazing a neighbouring facet are near 1.
+  std::printf("soft factor exactly 1 on %d of %zu triangles, at most %.5f from 1\n", exact, f.size(), worst);
+  EXPECT_GE(exact, static_cast<int>(f.size() * 0.95));
+  EXPECT_LT(worst, 0.01);
   EXPECT_THROW(soft_visibility(sky({2, 2, 2}, {}, at), proxy, sphere_at(at, 0.6), SoftVisibilityDesc{0}), Error);
 }
 

@@ -1,13 +1,14 @@
 #version 450 core
 // The object: render::Material as on the CPU (augment/composite.cpp's object_radiance). Diffuse: the
 // albedo (times the texture at the UVs) over π times the soft environment's irradiance (which holds the
-// proxy's light as the probe saw it), times the share of it that reaches the triangle and the hard lights through both shadow maps (its own shadow, lamps
+// proxy's light as the probe saw it), times the factor that turns it into what reaches the triangle (occlusion, the object's shadow on the proxy
+// it sees, the parallax from the map's centre), and the hard lights through both shadow maps (its own shadow, lamps
 // the proxy hides). Glossy (u_specular > 0): the lobe of render::glossy_lobe per hard light, per unit
 // irradiance at normal incidence, and the soft map's Phong-prefiltered value along the reflected ray.
 in vec3 v_position;
 in vec3 v_normal;
 in vec2 v_uv;
-in vec3 v_soft;  // the share of the soft irradiance that reaches this triangle (augment::soft_visibility)
+in vec3 v_soft;  // that factor (augment::soft_visibility, ≤ 16)
 uniform sampler2D u_soft_irradiance;
 uniform sampler2D u_object_texture;  // linear RGB, uv (0,0) at the image's bottom-left, bilinear, repeating
 uniform sampler2D u_object_glossy;   // G_s of the soft map (render/prefilter.h), lat-long
@@ -36,7 +37,7 @@ void main() {
   vec3 r = reflect(-v, n);
   // Clamped: a multisampled edge pixel evaluates the attribute at its centre, which may lie outside the
   // triangle, where the corners' values extrapolate (below 0 next to a dark corner).
-  vec3 e = texture(u_soft_irradiance, latlong(n)).rgb * clamp(v_soft, 0.0, 1.0);
+  vec3 e = texture(u_soft_irradiance, latlong(n)).rgb * clamp(v_soft, 0.0, 16.0);
   vec3 g = glossy ? texture(u_object_glossy, latlong(r)).rgb : vec3(0.0);
   for (int l = 0; l < u_light_count; ++l) {
     vec2 s = shadow(l, v_position, n, 1.5);
