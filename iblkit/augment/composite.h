@@ -106,6 +106,8 @@ inline CompositeResult composite(const Image& photo, const geometry::Camera& cam
 // both sums at z), which stays right while the object moves (iblkit view).
 struct SoftVisibilityDesc {
   int samples = 64;          // patch samples per triangle
+  int pool_rays = 1536;      // each triangle's f pools the sums of the triangles around it (up to 3 rings of
+                             // shared vertices) until they hold this many rays (≤ samples: none pooled)
   double threshold = 8;      // as SplitDesc::threshold
   bool proxy = true;         // the proxy occludes and carries the object's shadow (as composite())
   int shadow_samples = 64;   // as CompositeDesc::light_samples, for the shadow on the proxy's patches
