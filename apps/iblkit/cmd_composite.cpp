@@ -160,7 +160,7 @@ void setup(CLI::App& app) {
   app.add_option("--samples", o->desc.light_samples, "light samples per proxy pixel (albedo and shadows)")->check(CLI::Range(1, 65536))
       ->capture_default_str();
   app.add_option("--object-samples", o->desc.object_samples, "light samples per object pixel")->check(CLI::Range(1, 65536))->capture_default_str();
-  app.add_option("--bounce-samples", o->desc.bounce_samples, "samples of the object's light per proxy pixel (0: no interreflection)")
+  app.add_option("--bounce-samples", o->desc.bounce_samples, "cone samples per proxy pixel towards the object: its light on the pixel and, with the light samples, its shadow (a square number is stratified; 0: no interreflection)")
       ->check(CLI::Range(0, 65536))->capture_default_str();
   app.add_option("--pixel-samples", o->desc.pixel_samples, "n×n camera rays per pixel (object edges)")->check(CLI::Range(1, 8))->capture_default_str();
   app.add_option("--seed", o->desc.seed, "random seed")->capture_default_str();

@@ -42,7 +42,7 @@ namespace ibl::augment {
 struct CompositeDesc {
   int light_samples = 64;      // patch samples per proxy pixel (albedo and shadow)
   int object_samples = 1024;   // patch samples per object pixel (split over its camera rays)
-  int bounce_samples = 16;     // cone samples per proxy pixel for the object's light on it (0: no bounce)
+  int bounce_samples = 64;     // cone samples per proxy pixel: the object's light on it (0: no bounce) and its shadow (MIS); a square is stratified
   int triangle_samples = 64;   // patch samples per object triangle (its radiance for the bounce)
   int pixel_samples = 2;       // n: n×n camera rays per pixel (object coverage at its edges)
   uint64_t seed = 1;           // random streams (same seed, same bytes)
@@ -111,7 +111,7 @@ struct SoftVisibilityDesc {
   double threshold = 8;      // as SplitDesc::threshold
   bool proxy = true;         // the proxy occludes and carries the object's shadow (as composite())
   int shadow_samples = 64;   // as CompositeDesc::light_samples, for the shadow on the proxy's patches
-  int shadow_cone = 16;      // as CompositeDesc::bounce_samples
+  int shadow_cone = 64;      // as CompositeDesc::bounce_samples
   uint64_t seed = 1;
 };
 std::vector<Vec3> soft_visibility(const LocalLight& light, const geometry::TriMesh& proxy, const geometry::TriMesh& object,

@@ -74,6 +74,7 @@ void init_augment(py::module_& m) {
       })
       .def_readonly("warnings", &ag::CompositeResult::warnings);
 
+  static const ag::CompositeDesc kDefaults;  // the sample counts default to the library's (and the CLI's)
   m.def(
       "composite",
       [](py::handle photo, ibl::geometry::Camera camera, const ibl::geometry::TriMesh& object, py::object probes, py::object light,
@@ -128,8 +129,9 @@ void init_augment(py::module_& m) {
       },
       py::arg("photo"), py::arg("camera"), py::arg("object"), py::arg("probes") = py::none(), py::arg("light") = py::none(),
       py::arg("proxy") = py::none(), py::arg("at_probe") = py::none(), py::arg("probe_depth") = "",
-      py::arg("albedo") = py::make_tuple(0.7, 0.7, 0.7), py::arg("median_cut") = 0, py::arg("light_samples") = 64,
-      py::arg("object_samples") = 256, py::arg("bounce_samples") = 16, py::arg("triangle_samples") = 64, py::arg("pixel_samples") = 2,
+      py::arg("albedo") = py::make_tuple(0.7, 0.7, 0.7), py::arg("median_cut") = 0, py::arg("light_samples") = kDefaults.light_samples,
+      py::arg("object_samples") = kDefaults.object_samples, py::arg("bounce_samples") = kDefaults.bounce_samples,
+      py::arg("triangle_samples") = kDefaults.triangle_samples, py::arg("pixel_samples") = kDefaults.pixel_samples,
       py::arg("seed") = 1, py::arg("shadows") = true, py::arg("progress") = py::none(),
       R"doc(Composites `object` (a TriMesh, e.g. TriMesh.object(at=…)) into the photograph (H, W, 3) seen by
 `camera` (its size becomes the photograph's), as `iblkit composite` (Debevec 1998): a CompositeResult
