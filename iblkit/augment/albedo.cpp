@@ -44,10 +44,11 @@ AlbedoEstimate estimate_albedo(const Image& photo, const geometry::Camera& cam, 
       if (dot(n, d) > 0) n = -n;
       Vec3 p = cam.eye + d * h.t + n * kRayEpsilon, e;
       uint64_t s = mix(mix(mix(seed) ^ 0x616c62 /* "alb" */) ^ (static_cast<uint64_t>(y) * photo.width() + x));
+      const int table = field.table_for(n);  // as composite.cpp: the table for the pixel's side of the proxy
       for (int k = 0; k < samples; ++k) {
         s += 0x9e3779b97f4a7c15ull;
         double u = (k + static_cast<double>(mix(s) >> 11) * 0x1.0p-53) / samples, pmf, dist;
-        size_t i = field.sample(u, &pmf);
+        size_t i = field.sample(u, &pmf, table);
         Vec3 w, c = field.contribution(i, p, n, &w, &dist);
         double tfar = std::isinf(dist) ? std::numeric_limits<double>::infinity() : dist * (1 - kShadowShorten) - kRayEpsilon;
         if (max_component(c) <= 0 || rt.occluded(p, w, kRayEpsilon, tfar)) continue;

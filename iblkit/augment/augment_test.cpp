@@ -2,12 +2,16 @@
 // lit by a constant sky (the white furnace: E = π L on the floor, L_obj = ρ L on an object) or a sun.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <random>
+#include <vector>
 
 #include "iblkit/augment/testing.h"
 #include "iblkit/augment/camera_io.h"
 #include "iblkit/augment/composite.h"
+#include "iblkit/augment/light.h"
 #include "iblkit/augment/measure.h"
 #include "iblkit/augment/object.h"
 #include "iblkit/core/error.h"
@@ -92,6 +96,78 @@ TEST(AugmentComposite, DifferenceIsExactlyZeroWhereAWallHidesTheObject) {
   EXPECT_EQ(changed_left, 0);  // the wall's back, seen from this side, does not see the object either
   auto r2 = composite(photo, top_camera(), proxy, constant_sky({1, 1, 1}, {-0.5, 0.5, 0}), sphere_at({-0.5, 0.25, 0}, 0.4), {0.7, 0.7, 0.7});
   EXPECT_GT(r2.stats.changed_pixels, 0);  // from above the object: its floor and the wall's front do change
+}
+
+TEST(AugmentLight, AFloorsTableLeavesOutWhatItCannotSeeAndStaysUnbiased) {
+  // A sky (1 above, a bright band low in the west) over the floor: the map's lower half sees the floor
+  // (radiance 0.5). A floor point's table must leave out the floor's own patches and the sky below its
+  // horizon, and its estimate of E must have the exact sum over the patches as its expectation, with less
+  // spread than the plain table's (which spends a quarter of its samples on the floor). The guided search
+  // must find the patch a search of the whole CDF finds.
+  LocalLight l;
+  Image img(64, 32, 3);
+  for (int y = 0; y < 32; ++y)
+    for (int x = 0; x < 64; ++x) img.set_rgb(x, y, y < 16 ? Vec3{1, 1, 1} : Vec3{0.5, 0.5, 0.5});
+  for (int x = 0; x < 8; ++x) img.set_rgb(x, 13, {40, 40, 40});
+  l.map = sphere::EnvMap(img, sphere::Mapping(sphere::MappingKind::LatLong, 64, 32));
+  l.centre = {0, 0.5, 0};
+  const geometry::TriMesh floor = floor_mesh();
+  geometry::RayTracer rt;
+  rt.add(floor);
+  rt.commit();
+  LightField field(l, floor, rt);
+  const Vec3 up{0, 1, 0}, x{0.3, 1e-4, -0.2};
+  const int table = field.table_for(up);
+  ASSERT_GE(table, 0);
+  EXPECT_EQ(field.tables(), 2u);  // the floor's two sides
+  EXPECT_GE(field.table_for(-up), 0);
+  EXPECT_NE(field.table_for(-up), table);
+  EXPECT_EQ(field.table_for(normalize(Vec3{0, 1, 0.5})), -1);  // 27° off: the plain table
+  double exact = 0, total = 0, floor_share = 0;
+  for (size_t i = 0; i < field.size(); ++i) {
+    Vec3 w;
+    double dist;
+    exact += field.contribution(i, x, up, &w, &dist).y;
+    total += field.pmf(i, table);
+    if (field.local(i)) floor_share += field.pmf(i, table);
+  }
+  EXPECT_NEAR(total, 1.0, 1e-9);
+  std::vector<double> cdf;  // the conditioned table's CDF, rebuilt from its probabilities
+  for (size_t i = 0; i < field.size(); ++i) cdf.push_back((cdf.empty() ? 0.0 : cdf.back()) + field.pmf(i, table));
+  for (int k = 0; k < 20000; ++k) {
+    const double u = (k + 0.5) / 20000;
+    double pmf;
+    const size_t want = std::min<size_t>(field.size() - 1, static_cast<size_t>(std::upper_bound(cdf.begin(), cdf.end(), u) - cdf.begin()));
+    ASSERT_EQ(field.sample(u, &pmf, table), want) << "u = " << u;
+  }
+  constexpr double kPlainShare = 0.3;  // the plain table's share of a conditioned one
+  EXPECT_LE(floor_share, kPlainShare);  // the floor's patches are what the plain part gives them
+  std::mt19937_64 gen(7);
+  std::uniform_real_distribution<double> uni(0, 1);
+  auto spread = [&](int t, double* mean) {
+    constexpr int kTrials = 4000, kSamples = 16;
+    double s1 = 0, s2 = 0;
+    for (int trial = 0; trial < kTrials; ++trial) {
+      double e = 0;
+      for (int k = 0; k < kSamples; ++k) {
+        double pmf;
+        size_t i = field.sample((k + uni(gen)) / kSamples, &pmf, t);
+        Vec3 w;
+        double dist;
+        e += field.contribution(i, x, up, &w, &dist).y / pmf;
+      }
+      e /= kSamples;
+      s1 += e;
+      s2 += e * e;
+    }
+    *mean = s1 / kTrials;
+    return std::sqrt(std::max(0.0, s2 / kTrials - *mean * *mean) / kTrials);  // the mean's standard error
+  };
+  double mean_table, mean_plain;
+  const double se_table = spread(table, &mean_table), se_plain = spread(-1, &mean_plain);
+  EXPECT_NEAR(mean_table, exact, 4 * se_table);
+  EXPECT_NEAR(mean_plain, exact, 4 * se_plain);
+  EXPECT_LT(se_table, 0.9 * se_plain);  // 0.87 measured: stratified, the plain table spends its floor samples in strata of their own
 }
 
 TEST(AugmentComposite, SunCastsAFullShadowAndLeavesTheSunlitFloorAlone) {

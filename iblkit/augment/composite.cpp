@@ -1,6 +1,7 @@
 #include "iblkit/augment/composite.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -142,10 +143,21 @@ void proxy_terms(const Scene& s, const std::vector<Vec3>* tri_radiance, Vec3 y, 
   const LightField& L = *s.light;
   const Cone cone(s.bound, y, n);
   const double n1 = count, n2 = cone_count, pc = cone_count > 0 ? 1 / cone.solid_angle : 0;
+  const int table = L.table_for(n);
   Vec3 a, b;
+  // The patches are drawn a batch at a time and their records fetched ahead: each is a cache miss in a map
+  // of 10⁴–10⁶ patches, and fetched together they overlap.
+  constexpr int kBatch = 32;
+  std::array<size_t, kBatch> drawn;
+  std::array<double, kBatch> drawn_pmf;
   for (int k = 0; k < count; ++k) {
-    double pmf;
-    size_t i = L.sample((k + rng.uniform()) / count, &pmf);
+    if (k % kBatch == 0)
+      for (int j = 0; j < kBatch && k + j < count; ++j) {
+        drawn[static_cast<size_t>(j)] = L.sample((k + j + rng.uniform()) / count, &drawn_pmf[static_cast<size_t>(j)], table);
+        L.prefetch(drawn[static_cast<size_t>(j)]);
+      }
+    const size_t i = drawn[static_cast<size_t>(k % kBatch)];
+    const double pmf = drawn_pmf[static_cast<size_t>(k % kBatch)];
     Vec3 w;
     double dist;
     Vec3 c = L.contribution(i, y, n, &w, &dist);
@@ -164,6 +176,8 @@ void proxy_terms(const Scene& s, const std::vector<Vec3>* tri_radiance, Vec3 y, 
   }
   *e0 = a / n1;
   *blocked = b / n1;
+  // A cone direction meets the object first (object_rt) and then, behind it, the proxy (proxy_rt): the proxy
+  // nearer than the object hides it; otherwise that proxy hit is the patch whose light the object blocks.
   Vec3 bl, li;
   auto m = static_cast<int>(std::lround(std::sqrt(n2)));
   for (int k = 0; k < cone_count; ++k) {
@@ -175,12 +189,14 @@ void proxy_terms(const Scene& s, const std::vector<Vec3>* tri_radiance, Vec3 y, 
     Vec3 w = cone.direction(u1, u2);
     double cn = dot(w, n);
     if (cn <= 0) continue;
-    geometry::Hit h = s.both_rt.intersect(y, w, kRayEpsilon);
-    if (!h.hit || h.mesh != 1) continue;  // the object is not in front along w
-    if (tri_radiance) li += (*tri_radiance)[h.triangle] * cn;
-    long i = L.patch_along(y, w, s.proxy_rt);
+    geometry::Hit ho = s.object_rt.intersect(y, w, kRayEpsilon);
+    if (!ho.hit) continue;
+    geometry::Hit hp = s.proxy_rt.intersect(y, w, kRayEpsilon);
+    if (hp.hit && hp.t < ho.t) continue;  // the proxy is in front of the object along w
+    if (tri_radiance) li += (*tri_radiance)[ho.triangle] * cn;
+    long i = L.patch_along(y, w, hp);
     if (i < 0) continue;
-    double pp = L.pmf(static_cast<size_t>(i)) / std::max(L.solid_angle_at(static_cast<size_t>(i), y), 1e-300);
+    double pp = L.pmf(static_cast<size_t>(i), table) / std::max(L.solid_angle_at(static_cast<size_t>(i), y), 1e-300);
     bl += L.radiance(static_cast<size_t>(i)) * (cn / (n1 * pp + n2 * pc));
   }
   *blocked += bl;

@@ -40,7 +40,7 @@
 namespace ibl::augment {
 
 struct CompositeDesc {
-  int light_samples = 64;      // patch samples per proxy pixel (albedo and shadow)
+  int light_samples = 96;      // patch samples per proxy pixel (albedo and shadow; 64 until 2026-12-02)
   int object_samples = 1024;   // patch samples per object pixel (split over its camera rays)
   int bounce_samples = 64;     // cone samples per proxy pixel: the object's light on it (0: no bounce) and its shadow (MIS); a square is stratified
   int triangle_samples = 64;   // patch samples per object triangle (its radiance for the bounce)

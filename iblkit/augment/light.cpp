@@ -21,7 +21,14 @@ constexpr double kPowerShare = 0.8;     // sampling: this share by power, the re
                                         // from dim but near patches)
 // A patch's power is its mean RGB radiance × solid angle (not luminance: a red lamp is as much a light as a white one).
 double power_of(Vec3 L) { return (std::max(0.0, L.x) + std::max(0.0, L.y) + std::max(0.0, L.z)) / 3; }
-constexpr double kDepthInFront = 0.98;  // a depth this much shorter than the proxy's hit is a free emitter (a lamp)
+constexpr double kDepthInFront = 0.98;
+// Normal-conditioned tables (table_for): receivers within 10° of a table's normal use it; the proxy's flat parts
+// are its triangles' normals clustered within that angle, the largest by area first; this many tables at most
+// (both sides of each normal), and no more than kTableEntries entries in all (bounded memory for large maps).
+constexpr double kTableCos = 0.98480775301220802;  // cos 10°
+constexpr size_t kMaxTables = 24;
+constexpr size_t kTableEntries = size_t{1} << 23;
+constexpr double kConditionedShare = 0.7;  // a depth this much shorter than the proxy's hit is a free emitter (a lamp)
 
 }  // namespace
 
@@ -148,21 +155,114 @@ LightField::LightField(const LocalLight& light, const geometry::TriMesh& proxy, 
   }
   total_ = power;
   if (!(power > 0)) fail(ErrorKind::Value, "the {} light has no positive radiance", light.source);
-  cdf_.resize(patches_.size());
+  if (patches_.size() > std::numeric_limits<uint32_t>::max() / 2) fail(ErrorKind::Value, "the {} light has too many texels", light.source);
+  std::vector<double>& cdf = cdf_.cdf;
+  cdf.resize(patches_.size());
   double acc = 0;
   for (size_t i = 0; i < patches_.size(); ++i) {
     const Patch& p = patches_[i];
     acc += kPowerShare * power_of(p.radiance) * p.omega / power + (1 - kPowerShare) * p.omega / solid;
-    cdf_[i] = acc;
+    cdf[i] = acc;
   }
-  for (auto& c : cdf_) c /= acc;
-  cdf_.back() = 1.0;
+  for (auto& c : cdf) c /= acc;
+  cdf.back() = 1.0;
+  cdf_.build_guide();
+  build_tables(proxy);
 }
 
-size_t LightField::sample(double u, double* pmf) const {
-  size_t i = static_cast<size_t>(std::upper_bound(cdf_.begin(), cdf_.end(), u) - cdf_.begin());
-  if (i >= cdf_.size()) i = cdf_.size() - 1;
-  *pmf = cdf_[i] - (i > 0 ? cdf_[i - 1] : 0.0);
+void LightField::build_tables(const geometry::TriMesh& proxy) {
+  // The proxy's flat parts: its triangles' normals, clustered greedily from the largest triangle down.
+  const size_t T = proxy.triangle_count();
+  std::vector<uint32_t> order(T);
+  for (uint32_t t = 0; t < T; ++t) order[t] = t;
+  std::vector<double> area(T);
+  for (size_t t = 0; t < T; ++t) area[t] = proxy.area(t);
+  std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return area[a] > area[b]; });
+  std::vector<Vec3> normal;
+  std::vector<double> mass;
+  constexpr size_t kMaxClusters = 256;
+  for (uint32_t t : order) {
+    Vec3 n = proxy.normal(t);
+    if (!(area[t] > 0) || !(dot(n, n) > 0.5)) continue;
+    size_t k = 0;
+    while (k < normal.size() && dot(normal[k], n) < kTableCos) ++k;
+    if (k == normal.size()) {
+      if (normal.size() == kMaxClusters) continue;
+      normal.push_back(n);
+      mass.push_back(0);
+    }
+    mass[k] += area[t];
+  }
+  std::vector<size_t> by_mass(normal.size());
+  for (size_t k = 0; k < by_mass.size(); ++k) by_mass[k] = k;
+  std::stable_sort(by_mass.begin(), by_mass.end(), [&](size_t a, size_t b) { return mass[a] > mass[b]; });
+  const size_t budget = std::min(kMaxTables, kTableEntries / std::max<size_t>(1, patches_.size())) / 2;
+  for (size_t j = 0; j < by_mass.size() && j < budget; ++j) {
+    table_normal_.push_back(normal[by_mass[j]]);
+    table_normal_.push_back(-normal[by_mass[j]]);
+  }
+  // Each table: kConditionedShare of the plain probabilities times what a receiver of that normal sees of the
+  // patch (light.h, table_for), the rest the plain probabilities.
+  tables_.resize(table_normal_.size());
+  parallel_for(0, static_cast<int64_t>(tables_.size()), [&](int64_t kk) {
+    const Vec3 nb = table_normal_[static_cast<size_t>(kk)];
+    std::vector<double>& cdf = tables_[static_cast<size_t>(kk)].cdf;
+    cdf.resize(patches_.size());
+    double acc = 0;
+    for (size_t i = 0; i < patches_.size(); ++i) {
+      const Patch& p = patches_[i];
+      double seen = p.distant ? std::max(0.0, dot(nb, p.point)) : (dot(nb, p.normal) >= kTableCos ? 0.0 : 1.0);
+      acc += pmf(i) * seen;
+      cdf[i] = acc;
+    }
+    const double cond = acc > 0 ? kConditionedShare / acc : 0, plain = acc > 0 ? 1 - kConditionedShare : 1;
+    for (size_t i = 0; i < patches_.size(); ++i) cdf[i] = cond * cdf[i] + plain * cdf_.cdf[i];
+    cdf.back() = 1.0;
+    tables_[static_cast<size_t>(kk)].build_guide();
+  });
+}
+
+int LightField::table_for(Vec3 n) const {
+  int best = -1;
+  double best_cos = kTableCos;
+  for (size_t k = 0; k < table_normal_.size(); ++k) {
+    double c = dot(table_normal_[k], n);
+    if (c >= best_cos) {
+      best_cos = c;
+      best = static_cast<int>(k);
+    }
+  }
+  return best;
+}
+
+void LightField::Cdf::build_guide() {
+  const size_t G = std::max<size_t>(1, cdf.size() / 2);
+  guide.assign(G + 1, 0);
+  size_t i = 0;
+  for (size_t j = 0; j <= G; ++j) {
+    const double u = static_cast<double>(j) / static_cast<double>(G);
+    while (i < cdf.size() && cdf[i] <= u) ++i;  // upper_bound(u)
+    guide[j] = static_cast<uint32_t>(i);
+  }
+}
+
+size_t LightField::Cdf::find(double u) const {
+  // upper_bound(u) over the whole CDF, searched between the guide's bounds of u's cell.
+  const size_t G = guide.size() - 1;
+  size_t j = static_cast<size_t>(u * static_cast<double>(G));
+  j = std::min(j, G - 1);
+  auto lo = cdf.begin() + guide[j], hi = cdf.begin() + std::min<size_t>(cdf.size(), static_cast<size_t>(guide[j + 1]) + 1);
+  if (!(u >= static_cast<double>(j) / static_cast<double>(G))) lo = cdf.begin();  // rounding at a cell's edge: search it all
+  if (!(u < static_cast<double>(j + 1) / static_cast<double>(G))) hi = cdf.end();
+  return static_cast<size_t>(std::upper_bound(lo, hi, u) - cdf.begin());
+}
+
+size_t LightField::sample(double u, double* pmf, int table) const {
+  const Cdf& t = table < 0 ? cdf_ : tables_[static_cast<size_t>(table)];
+  const std::vector<double>& c = t.cdf;
+  size_t i = t.find(u);
+  if (i >= c.size()) i = c.size() - 1;
+  *pmf = c[i] - (i > 0 ? c[i - 1] : 0.0);
   return i;
 }
 
@@ -177,9 +277,12 @@ double LightField::solid_angle_at(size_t i, Vec3 x) const {
 }
 
 long LightField::patch_along(Vec3 x, Vec3 w, const geometry::RayTracer& proxy_tracer) const {
-  constexpr double kRayStart = 1e-4;    // metres, as the composite's secondary rays
+  constexpr double kRayStart = 1e-4;  // metres, as the composite's secondary rays
+  return patch_along(x, w, proxy_tracer.intersect(x, w, kRayStart));
+}
+
+long LightField::patch_along(Vec3 x, Vec3 w, const geometry::Hit& h) const {
   constexpr double kDepthMatch = 0.05;  // the texel's patch within 5 % of the hit's distance from the centre
-  geometry::Hit h = proxy_tracer.intersect(x, w, kRayStart);
   Vec3 d = w;
   double dist = 0;
   if (h.hit) {

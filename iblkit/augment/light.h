@@ -8,7 +8,9 @@
 //
 // A_t = Ω_t r_t² / cos θ_c, the patch's area (r_t its distance from the map's centre c, θ_c the angle its
 // normal makes with the way back to c), so that Ω_t(c) = Ω_t; a distant patch keeps Ω_t for every x.
-// Estimates sample patches in proportion to a mix of their power and their solid angle (seen from c).
+// Estimates sample patches in proportion to a mix of their power and their solid angle (seen from c); a
+// receiver whose normal is one of the proxy's main ones (a floor, a wall) samples from a table conditioned on
+// it, which leaves out the patches its side cannot see (sky below its horizon, the floor it lies on).
 #pragma once
 #include <string>
 #include <vector>
@@ -46,8 +48,16 @@ class LightField {
   // `proxy_tracer` holds `proxy` as its mesh 0 (and nothing else).
   LightField(const LocalLight& light, const geometry::TriMesh& proxy, const geometry::RayTracer& proxy_tracer);
   size_t size() const { return patches_.size(); }
-  // The patch a uniform u in [0, 1) picks, and the probability of picking it.
-  size_t sample(double u, double* pmf) const;
+  // The sampling table for a receiver with unit normal n: one conditioned on one of the proxy's main normals
+  // (within 10°, either side; kept for the proxy's largest flat parts by area), or −1, the table for any normal.
+  // A conditioned table is 70 % the plain table weighted by what a surface of that normal can see of each
+  // patch — the cosine of a distant patch (none below its horizon), none of a patch on the proxy that faces the
+  // same way (a floor does not see the floor), all of any other — and 30 % the plain one, so that no patch a
+  // receiver within the 10° may see has probability 0 (the estimate stays unbiased).
+  int table_for(Vec3 n) const;
+  size_t tables() const { return tables_.size(); }
+  // The patch a uniform u in [0, 1) picks from `table`, and the probability of picking it.
+  size_t sample(double u, double* pmf, int table = -1) const;
   // L_t Ω_t(x) max(0, n·ω) of patch i at x with unit normal n (0 when either side faces away); *w the unit
   // direction towards it and *dist its distance (infinity for a distant patch).
   Vec3 contribution(size_t i, Vec3 x, Vec3 n, Vec3* w, double* dist, bool shadowed = false) const;
@@ -64,14 +74,25 @@ class LightField {
   // For estimators that sample directions themselves (multiple importance sampling with sample()):
   // the probability sample() picks patch i; its solid angle seen from x (0 when it faces away); whether it
   // is a free emitter (a lamp in front of the proxy, from the depth map) rather than the proxy or the sky.
-  double pmf(size_t i) const { return cdf_[i] - (i > 0 ? cdf_[i - 1] : 0.0); }
+  double pmf(size_t i, int table = -1) const {
+    const std::vector<double>& c = table < 0 ? cdf_.cdf : tables_[static_cast<size_t>(table)].cdf;
+    return c[i] - (i > 0 ? c[i - 1] : 0.0);
+  }
   double solid_angle_at(size_t i, Vec3 x) const;
   bool lamp(size_t i) const { return patches_[i].lamp; }
   // The patch a ray from x along unit w sees first (the proxy hit's texel seen from the centre, when that texel's
   // patch is that surface; the map's texel of w where the ray leaves the proxy), or −1: the radiance the patches
   // give that ray, lamps left out. `proxy_tracer` as in the constructor.
   long patch_along(Vec3 x, Vec3 w, const geometry::RayTracer& proxy_tracer) const;
+  // The same, given that ray's hit on the proxy (h.hit false: it leaves the proxy).
+  long patch_along(Vec3 x, Vec3 w, const geometry::Hit& h) const;
   Vec3 radiance(size_t i) const { return patches_[i].radiance; }
+  // Asks the CPU to fetch patch i's record (a hint; for estimators that draw patches ahead of using them).
+  void prefetch(size_t i) const {
+    const char* p = reinterpret_cast<const char*>(&patches_[i]);
+    __builtin_prefetch(p);
+    __builtin_prefetch(p + sizeof(Patch) - 1);
+  }
 
  private:
   struct Patch {
@@ -89,8 +110,19 @@ class LightField {
   sphere::Mapping mapping_{sphere::MappingKind::LatLong, 2, 1};
   Vec3 centre_;
   std::vector<long> texel_patch_;  // the patch of each texel (row-major), −1 for none
-  std::vector<double> cdf_;
+  // A CDF and its guide (Chen & Wu 1989): guide[j] the first index whose CDF exceeds j/G, so that sample()
+  // searches only [guide[j], guide[j + 1]] — the same index a search of the whole CDF finds.
+  struct Cdf {
+    std::vector<double> cdf;
+    std::vector<uint32_t> guide;
+    void build_guide();
+    size_t find(double u) const;
+  };
+  Cdf cdf_;
+  std::vector<Cdf> tables_;  // conditioned on table_normal_[k]
+  std::vector<Vec3> table_normal_;
   double total_ = 0;
+  void build_tables(const geometry::TriMesh& proxy);
 };
 
 }  // namespace ibl::augment

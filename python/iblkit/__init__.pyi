@@ -202,7 +202,7 @@ class CompositeResult:
 def composite(photo: ArrayLike, camera: Camera, object: TriMesh, probes: Optional[str] = None,
               light: Union[None, str, LocalLight] = None, proxy: Union[None, str, TriMesh] = None,
               at_probe: Optional[ArrayLike] = None, probe_depth: str = "", albedo: ArrayLike = (0.7, 0.7, 0.7),
-              median_cut: int = 0, light_samples: int = 64, object_samples: int = 1024, bounce_samples: int = 64,
+              median_cut: int = 0, light_samples: int = 96, object_samples: int = 1024, bounce_samples: int = 64,
               triangle_samples: int = 64, pixel_samples: int = 2, seed: int = 1, shadows: bool = True,
               progress: Progress = None) -> CompositeResult: ...
 def measure_composite(photo: ArrayLike, composite: ArrayLike, truth: ArrayLike, mask: ArrayLike, threshold: float = 0.02) -> dict: ...
