@@ -176,6 +176,9 @@ void setup(CLI::App& app) {
   app.add_option("--gl-visibility", o->gl.visibility_samples, "gl: rays per object triangle for the soft light that reaches it (its own "
                  "occlusion, the floor its shadow darkens, the parallax from the probe; 0: none; default: 4194304 rays over the "
                  "triangles, 16 to 1024 each)")->check(CLI::Range(0, 65536));
+  app.add_option("--gl-cut", o->gl.cut, "gl: the soft term is 0 where the object covers less than this cosine-weighted share of "
+                 "the hemisphere (faded in up to twice it; the pixels left exactly as photographed)")->check(CLI::Range(0.0, 0.5))
+      ->capture_default_str();
   app.add_option("--shadow-map-size", o->gl.shadow_map_size, "gl: texels per side of each light's shadow maps")->check(CLI::Range(16, 8192))
       ->capture_default_str();
 #endif

@@ -3,11 +3,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
 
 #include "iblkit/augment/object.h"
 #include "iblkit/augment/sphere_occlusion.h"
 #include "iblkit/augment/split_light.h"
 #include "iblkit/core/error.h"
+#include "iblkit/sphere/mapping.h"
 
 namespace ibl::augment {
 namespace {
@@ -50,6 +52,39 @@ TEST(AugmentSphereOcclusion, EquivalentSphereOfASphereAndOfAnOpenSquare) {
   EXPECT_NEAR(length(s.centre - Vec3{1, 2, 3}), 0, 1e-6);
   OccluderSphere q = equivalent_sphere(geometry::make_quad({0, 0, 0}, {0, 1, 0}, {0, 0, -1}, 1, 1));  // open: S/4 = π r²
   EXPECT_NEAR(q.radius, std::sqrt(1.0 / (4 * kPi)), 1e-9);
+}
+
+TEST(AugmentSphereOcclusion, FacingIrradianceOfASphereIsTheCosineMeanOfItsHemisphere) {
+  // E_c(n) = 1 + n_y on a sphere: the side facing d, weighted by projected area (A max(0, n·d)), has the mean
+  // normal (2/3) d, so its mean irradiance is 1 + (2/3) d_y. With the lower half's factor 0 (in a shadow),
+  // the side facing straight down receives nothing and the side facing up all of it.
+  ObjectDesc d;
+  d.kind = "sphere";
+  d.size = 0.4;
+  const geometry::TriMesh sphere = make_object(d);
+  Image irr(64, 32, 3);
+  const sphere::Mapping ll(sphere::MappingKind::LatLong, 64, 32);
+  for (int y = 0; y < 32; ++y)
+    for (int x = 0; x < 64; ++x) {
+      Vec3 n;
+      ll.to_direction(x + 0.5, y + 0.5, &n);
+      irr.set_rgb(x, y, Vec3{1, 1, 1} * (1 + n.y));
+    }
+  const Image f = facing_irradiance(sphere, nullptr, irr);
+  const sphere::Mapping out(sphere::MappingKind::LatLong, f.width(), f.height());
+  constexpr double kTol = 0.02;  // normals gathered into 11° cells, the map bilinear, the sphere tessellated
+  for (int y = 0; y < f.height(); ++y)
+    for (int x = 0; x < f.width(); ++x) {
+      Vec3 dir;
+      out.to_direction(x + 0.5, y + 0.5, &dir);
+      ASSERT_NEAR(f.rgb(x, y).y, 1 + 2.0 / 3 * dir.y, kTol) << "direction " << dir.x << " " << dir.y << " " << dir.z;
+    }
+  std::vector<Vec3> lit(sphere.triangle_count());
+  for (size_t t = 0; t < lit.size(); ++t) lit[t] = sphere.normal(t).y < 0 ? Vec3{} : Vec3{1, 1, 1};
+  const Image g = facing_irradiance(sphere, &lit, irr);
+  EXPECT_NEAR(g.rgb(0, g.height() - 1).y, 0.0, kTol);  // the bottom row faces (almost) straight down
+  EXPECT_NEAR(g.rgb(0, 0).y, f.rgb(0, 0).y, kTol);      // the top row: all of its side is lit
+  EXPECT_THROW(facing_irradiance(sphere, &lit, Image(10, 10, 3)), Error);
 }
 
 LocalLight sky_and_sun(Vec3 centre) {

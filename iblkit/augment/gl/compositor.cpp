@@ -174,6 +174,7 @@ struct Compositor::Impl {
   Vec3 object_albedo{0.7, 0.7, 0.7};  // the proxy's bounce: the albedo times the texture's mean
   bool have_object = false;
   GLuint object_texture = 0, object_glossy = 0;  // the material's albedo texture and prefiltered soft map (or 0)
+  GLuint facing_tex = 0;  // augment::facing_irradiance of the object (set_object): what its bounce sends back
   GLuint prog_gbuffer = 0, prog_depth = 0, prog_proxy = 0, prog_object = 0, prog_final = 0, empty_vao = 0;
   GLuint photo_tex = 0, albedo_tex = 0, soft_tex = 0, irr_tex = 0, gpos = 0, gnormal = 0, proxy_comp = 0, object_tex = 0, color = 0, diff = 0;
   GLuint object_map = 0, proxy_map = 0, map_depth = 0, depth_rb = 0, ms_color = 0, ms_depth = 0;
@@ -183,7 +184,7 @@ struct Compositor::Impl {
     for (GLuint p : {prog_gbuffer, prog_depth, prog_proxy, prog_object, prog_final})
       if (p) glDeleteProgram(p);
     GLuint texs[] = {photo_tex, albedo_tex, soft_tex, irr_tex, gpos, gnormal, proxy_comp, object_tex, color, diff, object_map, proxy_map,
-                     object_texture, object_glossy};
+                     object_texture, object_glossy, facing_tex};
     glDeleteTextures(static_cast<GLsizei>(std::size(texs)), texs);
     GLuint rbs[] = {map_depth, depth_rb, ms_color, ms_depth};
     glDeleteRenderbuffers(4, rbs);
@@ -377,6 +378,7 @@ Compositor::Compositor(const Image& photo, const geometry::Camera& cam, const ge
   set_int(m.prog_proxy, "u_gpos", 2);
   set_int(m.prog_proxy, "u_gnormal", 3);
   set_int(m.prog_proxy, "u_soft", 4);
+  set_int(m.prog_proxy, "u_facing_irradiance", 10);
   set_float(m.prog_proxy, "u_cut", desc.cut);
   set_float(m.prog_proxy, "u_soft_texel", (2 * kPi / light.soft.width()) * (kPi / light.soft.height()));
   set_int(m.prog_proxy, "u_bounce", desc.bounce ? 1 : 0);
@@ -407,6 +409,10 @@ void Compositor::set_object(const geometry::TriMesh& object, const render::Mater
   Impl& m = *impl_;
   m.object.upload(object, soft_visibility);
   m.sphere = equivalent_sphere(object);
+  // The soft light the object's faces receive, by the way they face (with each triangle's factor: the floor
+  // under it darkened by its shadow): what the sphere's bounce sends back to a proxy point.
+  if (m.facing_tex) glDeleteTextures(1, &m.facing_tex);
+  m.facing_tex = upload_rgb(facing_irradiance(object, soft_visibility, m.light.soft_irradiance), true);
   Vec3 mean_texture{1, 1, 1};
   if (m.object_texture) glDeleteTextures(1, &m.object_texture);
   if (m.object_glossy) glDeleteTextures(1, &m.object_glossy);
@@ -460,6 +466,7 @@ void Compositor::draw(Vec3 offset, bool gl_rows, GlFrameTiming* timing) {
   glViewport(0, 0, m.W, m.H);
   glDisable(GL_DEPTH_TEST);
   glUseProgram(m.prog_proxy);
+  glBindTextureUnit(10, m.facing_tex);
   glProgramUniform4f(m.prog_proxy, glGetUniformLocation(m.prog_proxy, "u_sphere"), static_cast<float>(c.x), static_cast<float>(c.y),
                      static_cast<float>(c.z), static_cast<float>(m.sphere.radius));
   set_vec3(m.prog_proxy, "u_object_albedo", m.object_albedo);

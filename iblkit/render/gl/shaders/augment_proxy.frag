@@ -3,7 +3,8 @@
 // the object changes — the hard lights it blocks (shadow maps) and, from its equivalent sphere, the soft
 // light it hides less the light it reflects (one bounce) — so that ΔE is exactly 0 wherever none of them
 // touches the pixel; composite = photo + min(ρ, 1)/π · ΔE.
-uniform sampler2D u_photo, u_albedo, u_gpos, u_gnormal, u_soft, u_soft_irradiance;
+uniform sampler2D u_photo, u_albedo, u_gpos, u_gnormal, u_soft;
+uniform sampler2D u_facing_irradiance;  // augment::facing_irradiance: the soft light on the object's side facing each way
 uniform vec4 u_sphere;        // the object's equivalent sphere: centre (moved), radius
 uniform vec3 u_object_albedo;
 uniform float u_cut;          // cosine-weighted share of the hemisphere below which the soft term is 0 (faded in up to 2×)
@@ -34,8 +35,17 @@ void main() {
       float cap = 2.0 * PI * (1.0 - sqrt(1.0 - s2));
       vec3 hidden = textureLod(u_soft, latlong(w), 0.5 * log2(max(cap / u_soft_texel, 1.0))).rgb, reflected = vec3(0.0);
       if (u_bounce != 0) {
-        vec3 face = -w, z = u_sphere.xyz + face * u_sphere.w, e = texture(u_soft_irradiance, latlong(face)).rgb;
-        for (int l = 0; l < u_light_count; ++l) e += light_at(l, z, face);
+        // The sphere's side that faces y, as y sees it (its points weighted by their projected area): the soft
+        // light it receives by the way it faces, and of each hard light the mean of max(0, n·l) over that side,
+        // (2/3π)((π − γ) cos γ + sin γ) for γ between the side and the light (2/3 when it faces the light),
+        // where the proxy does not hide it from the object's centre.
+        vec3 face = -w, c = u_sphere.xyz, e = texture(u_facing_irradiance, latlong(face)).rgb;
+        for (int l = 0; l < u_light_count; ++l) {
+          vec3 to_light = u_light_dir[l].w < 0.5 ? u_light_dir[l].xyz : normalize(u_light_pos[l].xyz - c);
+          float cg = clamp(dot(face, to_light), -1.0, 1.0), g = acos(cg);
+          float hidden_c = shadow(l, c, to_light, 0.0).x;  // a lamp the proxy hides from the object
+          e += light_at(l, c, to_light) * (1.0 - hidden_c) * (2.0 / (3.0 * PI)) * ((PI - g) * cg + sin(g));
+        }
         reflected = u_object_albedo / PI * e;
       }
       dE += om * (reflected - hidden);
