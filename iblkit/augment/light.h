@@ -110,7 +110,7 @@ class LightField {
   sphere::Mapping mapping_{sphere::MappingKind::LatLong, 2, 1};
   Vec3 centre_;
   std::vector<long> texel_patch_;  // the patch of each texel (row-major), −1 for none
-  // A CDF and its guide (Chen & Wu 1989): guide[j] the first index whose CDF exceeds j/G, so that sample()
+  // A CDF and its guide table (Chen & Asau 1974): guide[j] the first index whose CDF exceeds j/G, so that sample()
   // searches only [guide[j], guide[j + 1]] — the same index a search of the whole CDF finds.
   struct Cdf {
     std::vector<double> cdf;
