@@ -21,14 +21,14 @@ constexpr double kPowerShare = 0.8;     // sampling: this share by power, the re
                                         // from dim but near patches)
 // A patch's power is its mean RGB radiance × solid angle (not luminance: a red lamp is as much a light as a white one).
 double power_of(Vec3 L) { return (std::max(0.0, L.x) + std::max(0.0, L.y) + std::max(0.0, L.z)) / 3; }
-constexpr double kDepthInFront = 0.98;
+constexpr double kDepthInFront = 0.98;  // a depth this much shorter than the proxy's hit is a free emitter (a lamp)
 // Normal-conditioned tables (table_for): receivers within 10° of a table's normal use it; the proxy's flat parts
 // are its triangles' normals clustered within that angle, the largest by area first; this many tables at most
 // (both sides of each normal), and no more than kTableEntries entries in all (bounded memory for large maps).
 constexpr double kTableCos = 0.98480775301220802;  // cos 10°
 constexpr size_t kMaxTables = 24;
 constexpr size_t kTableEntries = size_t{1} << 23;
-constexpr double kConditionedShare = 0.7;  // a depth this much shorter than the proxy's hit is a free emitter (a lamp)
+constexpr double kConditionedShare = 0.7;  // a table's share for what its normal sees; the rest plain (never 0)
 
 }  // namespace
 
@@ -216,7 +216,7 @@ void LightField::build_tables(const geometry::TriMesh& proxy) {
       cdf[i] = acc;
     }
     const double cond = acc > 0 ? kConditionedShare / acc : 0, plain = acc > 0 ? 1 - kConditionedShare : 1;
-    for (size_t i = 0; i < patches_.size(); ++i) cdf[i] = cond * cdf[i] + plain * cdf_.cdf[i];
+    for (size_t i = 0; i < patches_.size(); ++i) cdf[i] = std::min(1.0, cond * cdf[i] + plain * cdf_.cdf[i]);  // rounding stays ≤ 1
     cdf.back() = 1.0;
     tables_[static_cast<size_t>(kk)].build_guide();
   });

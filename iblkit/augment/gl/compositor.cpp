@@ -412,6 +412,7 @@ void Compositor::set_object(const geometry::TriMesh& object, const render::Mater
   // The soft light the object's faces receive, by the way they face (with each triangle's factor: the floor
   // under it darkened by its shadow): what the sphere's bounce sends back to a proxy point.
   if (m.facing_tex) glDeleteTextures(1, &m.facing_tex);
+  m.facing_tex = 0;
   m.facing_tex = upload_rgb(facing_irradiance(object, soft_visibility, m.light.soft_irradiance), true);
   Vec3 mean_texture{1, 1, 1};
   if (m.object_texture) glDeleteTextures(1, &m.object_texture);

@@ -39,12 +39,12 @@ void main() {
         // light it receives by the way it faces, and of each hard light the mean of max(0, n·l) over that side,
         // (2/3π)((π − γ) cos γ + sin γ) for γ between the side and the light (2/3 when it faces the light),
         // where the proxy does not hide it from the object's centre.
-        vec3 face = -w, c = u_sphere.xyz, e = texture(u_facing_irradiance, latlong(face)).rgb;
+        vec3 face = -w, c = u_sphere.xyz, e = textureLod(u_facing_irradiance, latlong(face), 0.0).rgb;
         for (int l = 0; l < u_light_count; ++l) {
           vec3 to_light = u_light_dir[l].w < 0.5 ? u_light_dir[l].xyz : normalize(u_light_pos[l].xyz - c);
-          float cg = clamp(dot(face, to_light), -1.0, 1.0), g = acos(cg);
+          float cg = clamp(dot(face, to_light), -1.0, 1.0), gamma = acos(cg);
           float hidden_c = shadow(l, c, to_light, 0.0).x;  // a lamp the proxy hides from the object
-          e += light_at(l, c, to_light) * (1.0 - hidden_c) * (2.0 / (3.0 * PI)) * ((PI - g) * cg + sin(g));
+          e += light_at(l, c, to_light) * (1.0 - hidden_c) * (2.0 / (3.0 * PI)) * ((PI - gamma) * cg + sin(gamma));
         }
         reflected = u_object_albedo / PI * e;
       }
