@@ -16,7 +16,8 @@ namespace {
 using namespace ibl;
 
 fusion::ProbeSet corridor_set(bool with_depth) {
-  static const geometry::TriMesh proxy = geometry::read_mesh(std::string(IBLKIT_SOURCE_DIR) + "/examples/t-corridor-proxy.obj");
+  static const geometry::TriMesh proxy =
+      geometry::read_mesh(std::string(IBLKIT_SOURCE_DIR) + "/examples/t-corridor-proxy.obj");
   static const std::vector<Vec3> pos = {{-4, 1.5, -1}, {-2, 1.5, -1}, {0, 1.5, -1}, {2, 1.5, -1},
                                         {4, 1.5, -1},  {0, 1.5, 2},   {0, 1.5, 5},  {0, 1.5, 8}};
   fusion::ProbeSet set;
@@ -53,8 +54,14 @@ void BM_FusionCube64From8Probes(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * 6 * 64 * 64);
 }
 BENCHMARK(BM_FusionCube64From8Probes)
-    ->Args({2, 1, 2})->Args({1, 1, 2})->Args({0, 1, 2})->Args({2, 0, 2})->Args({2, 1, 1})
-    ->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+    ->Args({2, 1, 2})
+    ->Args({1, 1, 2})
+    ->Args({0, 1, 2})
+    ->Args({2, 0, 2})
+    ->Args({2, 1, 1})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(1.0);
 
 void BM_FusionDepth8Probes512(benchmark::State& state) {
   fusion::ProbeSet base = corridor_set(false);

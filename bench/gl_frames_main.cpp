@@ -14,9 +14,9 @@
 
 #include "iblkit/augment/gl/compositor.h"
 #include "iblkit/geometry/mesh.h"
+#include "iblkit/nearfield/spotlight.h"
 #include "iblkit/render/gl/context.h"
 #include "iblkit/render/gl/renderer.h"
-#include "iblkit/nearfield/spotlight.h"
 
 using namespace ibl;
 using namespace ibl::render;
@@ -41,7 +41,8 @@ ilf::SHGrid make_grid(int n, int bands) {
         for (int k = 0; k < K; ++k)
           for (int c = 0; c < 3; ++c) {
             size_t i = ((((static_cast<size_t>(z) * n + y) * n + x) * K + k) * 3 + c);
-            g.data()[i] = static_cast<float>((k == 0 ? 2.0 : 0.3 / (1 + k)) * (1 + 0.3 * std::sin(0.3 * x + 0.2 * y - 0.1 * z + c)));
+            g.data()[i] = static_cast<float>((k == 0 ? 2.0 : 0.3 / (1 + k)) *
+                                             (1 + 0.3 * std::sin(0.3 * x + 0.2 * y - 0.1 * z + c)));
           }
   return g;
 }
@@ -89,7 +90,9 @@ geometry::TriMesh read_obj(const std::string& path) {
       while (ls >> v) {
         const long i = std::stol(v.substr(0, v.find('/')));
         if (i < 1 || static_cast<size_t>(i) > m.positions.size())
-          throw std::runtime_error(path + ": vertex index " + std::to_string(i) + " is out of range (this reader takes positive indices of vertices listed before the face)");
+          throw std::runtime_error(
+              path + ": vertex index " + std::to_string(i) +
+              " is out of range (this reader takes positive indices of vertices listed before the face)");
         f.push_back(static_cast<uint32_t>(i - 1));
       }
       for (size_t k = 2; k < f.size(); ++k) m.triangles.push_back({f[0], f[k - 1], f[k]});
@@ -130,8 +133,8 @@ std::vector<nearfield::TexturedSpotlight> make_spotlights(Vec3 at, Vec3 forward,
 
 // One entry of the JSON object: the median GPU time and the wall time per frame.
 void report(const char* path, const std::string& name, const gl::GpuTiming& t) {
-  std::printf(",\n \"%s_%s_ms\": %.4f, \"%s_%s_wall_ms\": %.2f", path, name.c_str(), median(t.frame_ms), path, name.c_str(),
-              t.wall_ms_per_frame);
+  std::printf(",\n \"%s_%s_ms\": %.4f, \"%s_%s_wall_ms\": %.2f", path, name.c_str(), median(t.frame_ms), path,
+              name.c_str(), t.wall_ms_per_frame);
 }
 
 }  // namespace
@@ -145,9 +148,10 @@ int main(int argc, char** argv) {
     gl::Context ctx;
     geometry::TriMesh blob = geometry::make_blob(tris, 0.8);
     geometry::TriMesh crypt = read_obj(crypt_path);
-    if (crypt.triangles.empty()) std::fprintf(stderr, "iblkit_glbench: no %s, skipping the crypt case\n", crypt_path.c_str());
-    std::printf("{\"renderer\": \"%s\", \"triangles\": %zu, \"size\": \"%dx%d\", \"frames\": %d", ctx.renderer().c_str(),
-                blob.triangle_count(), width, height, frames);
+    if (crypt.triangles.empty())
+      std::fprintf(stderr, "iblkit_glbench: no %s, skipping the crypt case\n", crypt_path.c_str());
+    std::printf("{\"renderer\": \"%s\", \"triangles\": %zu, \"size\": \"%dx%d\", \"frames\": %d",
+                ctx.renderer().c_str(), blob.triangle_count(), width, height, frames);
     // A sixth argument "composite" runs the compositor's case alone (llvmpipe takes minutes for the others).
     const bool composite_only = argc > 6 && std::string(argv[6]) == "composite";
     for (bool deferred : {false, true}) {
@@ -177,7 +181,8 @@ int main(int argc, char** argv) {
         // instead of per-fragment polynomials.
         gl::Renderer table({.deferred = deferred, .sh_table_size = 64});
         for (bool glossy : {false, true}) {
-          d.objects[0].material = glossy ? Material{{0.6, 0.6, 0.6}, {0.3, 0.3, 0.3}, 30} : Material{{0.7, 0.7, 0.7}, {0, 0, 0}, 1};
+          d.objects[0].material =
+              glossy ? Material{{0.6, 0.6, 0.6}, {0.3, 0.3, 0.3}, 30} : Material{{0.7, 0.7, 0.7}, {0, 0, 0}, 1};
           gl::GpuTiming t;
           table.render(d, frames, &t);
           const char* name = glossy ? "shgrid32_b5_glossy_s30_table64" : "shgrid32_b5_diffuse_table64";
@@ -187,8 +192,8 @@ int main(int argc, char** argv) {
       d.lighting.grid.reset();
       for (int i = 0; i < 256; ++i) {
         double th = std::acos(1 - (i + 0.5) / 256.0), ph = 2.39996 * i;
-        d.lighting.lights.push_back({{std::sin(th) * std::cos(ph), std::cos(th), std::sin(th) * std::sin(ph)},
-                                     {0.02, 0.02, 0.02}, i < 16});
+        d.lighting.lights.push_back(
+            {{std::sin(th) * std::cos(ph), std::cos(th), std::sin(th) * std::sin(ph)}, {0.02, 0.02, 0.02}, i < 16});
       }
       run("lights256_16_shadowed");
       d.lighting.lights.resize(16);
@@ -202,7 +207,8 @@ int main(int argc, char** argv) {
       d.spot_shadow_map_size = 512;
       d.objects.clear();
       if (!crypt.triangles.empty()) {
-        d.lighting.spotlights = make_spotlights({-0.55, 0.45, -0.75}, Vec3{-1.3, 0.25, -1.6} - Vec3{-0.55, 0.45, -0.75}, 256);
+        d.lighting.spotlights =
+            make_spotlights({-0.55, 0.45, -0.75}, Vec3{-1.3, 0.25, -1.6} - Vec3{-0.55, 0.45, -0.75}, 256);
         d.objects = {{&crypt, Material{{0.62, 0.58, 0.5}, {0, 0, 0}, 1}}};
         d.camera.eye = {1.5, 1.7, 3.2};
         d.camera.target = {-0.8, 0.6, -1.2};
@@ -230,7 +236,8 @@ int main(int argc, char** argv) {
       geometry::TriMesh room = make_room(6, 4, 8);
       geometry::TriMesh small = blob;
       small.transform(0.5, {0, 0.2, 0});
-      d.objects = {{&small, Material{{0.7, 0.7, 0.7}, {0.2, 0.2, 0.2}, 20}}, {&room, Material{{0.6, 0.6, 0.6}, {0, 0, 0}, 1}}};
+      d.objects = {{&small, Material{{0.7, 0.7, 0.7}, {0.2, 0.2, 0.2}, 20}},
+                   {&room, Material{{0.6, 0.6, 0.6}, {0, 0, 0}, 1}}};
       d.camera.eye = {0.5, 1.6, 3.5};
       d.camera.target = {0, 0.5, 0};
       run("nearfield_9x7_shadowed_room");
@@ -278,7 +285,8 @@ int main(int argc, char** argv) {
         gpu.push_back(t.gpu_ms);
         wall += t.wall_ms;
       }
-      std::printf(",\n \"composite_16_lights_ms\": %.4f, \"composite_16_lights_wall_ms\": %.2f", median(gpu), wall / std::max(1, frames));
+      std::printf(",\n \"composite_16_lights_ms\": %.4f, \"composite_16_lights_wall_ms\": %.2f", median(gpu),
+                  wall / std::max(1, frames));
     }
     std::printf("}\n");
   } catch (const std::exception& e) {

@@ -40,7 +40,10 @@ void BM_IlfProjectBucket64(benchmark::State& state) {
     Vec3 d = normalize(Vec3{0.3, 0.5, 1.0} + Vec3{U(rng), U(rng), U(rng)} * 0.1);
     dirs.insert(dirs.end(), {float(d.x), float(d.y), float(d.z)});
   }
-  struct Ctx { const float* r; int stride; } ctx{rad.data(), nd * 3};
+  struct Ctx {
+    const float* r;
+    int stride;
+  } ctx{rad.data(), nd * 3};
   BucketRays rays;
   rays.dirs = dirs.data();
   rays.weights = w.data();
@@ -48,7 +51,10 @@ void BM_IlfProjectBucket64(benchmark::State& state) {
   rays.origins = origins.data();
   rays.n_probes = P;
   rays.ctx = &ctx;
-  rays.radiance = [](const void* c, int p) { auto* x = static_cast<const Ctx*>(c); return x->r + size_t(p) * x->stride; };
+  rays.radiance = [](const void* c, int p) {
+    auto* x = static_cast<const Ctx*>(c);
+    return x->r + size_t(p) * x->stride;
+  };
   ProjectScratch sc;
   std::vector<float> out(size_t(grid.count()) * 3);
   int64_t n = 0;

@@ -30,7 +30,8 @@ void BM_LabMirrorBall250(benchmark::State& state) {
   }
   state.SetItemsProcessed(state.iterations());
   // (iterations / 4397) batches per second, inverted: seconds per 4397 probes.
-  state.counters["s_per_4397"] = benchmark::Counter(state.iterations() / 4397.0, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.counters["s_per_4397"] =
+      benchmark::Counter(state.iterations() / 4397.0, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 BENCHMARK(BM_LabMirrorBall250)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
 

@@ -17,13 +17,17 @@ const char* kProbe = "/usr/share/blender/datafiles/studiolights/world/forest.exr
 
 const ibl::sphere::EnvMap* probe() {
   static std::unique_ptr<ibl::sphere::EnvMap> env;
-  if (!env && std::filesystem::exists(kProbe)) env = std::make_unique<ibl::sphere::EnvMap>(ibl::io::read_envmap(kProbe));
+  if (!env && std::filesystem::exists(kProbe))
+    env = std::make_unique<ibl::sphere::EnvMap>(ibl::io::read_envmap(kProbe));
   return env.get();
 }
 
 void BM_GroundTruth20480(benchmark::State& state) {
   auto* env = probe();
-  if (!env) { state.SkipWithError("blender-data probe missing"); return; }
+  if (!env) {
+    state.SkipWithError("blender-data probe missing");
+    return;
+  }
   auto normals = ibl::sphere::icosphere_face_centres(5);
   ibl::lights::GroundTruthDesc d;
   d.cull = state.range(0) != 0;
@@ -34,7 +38,10 @@ BENCHMARK(BM_GroundTruth20480)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond)->I
 
 void BM_MedianCut(benchmark::State& state) {
   auto* env = probe();
-  if (!env) { state.SkipWithError("blender-data probe missing"); return; }
+  if (!env) {
+    state.SkipWithError("blender-data probe missing");
+    return;
+  }
   ibl::lights::CutDesc d;
   d.count = static_cast<int>(state.range(0));
   d.power_of_two = true;
@@ -44,7 +51,10 @@ BENCHMARK(BM_MedianCut)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_MedianCutGridOnly(benchmark::State& state) {
   auto* env = probe();
-  if (!env) { state.SkipWithError("blender-data probe missing"); return; }
+  if (!env) {
+    state.SkipWithError("blender-data probe missing");
+    return;
+  }
   auto grid = ibl::lights::to_latlong_grid(*env);
   ibl::lights::CutDesc d;
   d.count = static_cast<int>(state.range(0));
@@ -55,7 +65,10 @@ BENCHMARK(BM_MedianCutGridOnly)->Arg(64)->Unit(benchmark::kMillisecond)->UseReal
 
 void BM_VarianceCut(benchmark::State& state) {
   auto* env = probe();
-  if (!env) { state.SkipWithError("blender-data probe missing"); return; }
+  if (!env) {
+    state.SkipWithError("blender-data probe missing");
+    return;
+  }
   ibl::lights::CutDesc d;
   d.count = static_cast<int>(state.range(0));
   for (auto _ : state) benchmark::DoNotOptimize(ibl::lights::variance_cut(*env, d));
@@ -65,7 +78,10 @@ BENCHMARK(BM_VarianceCut)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime()
 // Optimisation only: the 20480 normals' ground truth and the initial cut are computed outside the loop.
 void BM_Optimize(benchmark::State& state) {
   auto* env = probe();
-  if (!env) { state.SkipWithError("blender-data probe missing"); return; }
+  if (!env) {
+    state.SkipWithError("blender-data probe missing");
+    return;
+  }
   auto normals = ibl::sphere::icosphere_face_centres(5);
   auto gt = ibl::lights::irradiance_ground_truth(*env, normals);
   ibl::lights::CutDesc cd;
@@ -73,7 +89,8 @@ void BM_Optimize(benchmark::State& state) {
   auto init = ibl::lights::variance_cut(*env, cd);
   ibl::lights::OptimizeDesc od;
   ibl::lights::OptimizeReport rep;
-  for (auto _ : state) benchmark::DoNotOptimize(ibl::lights::optimize_lights_from(*env, normals, gt, init.lights, od, &rep));
+  for (auto _ : state)
+    benchmark::DoNotOptimize(ibl::lights::optimize_lights_from(*env, normals, gt, init.lights, od, &rep));
   state.counters["iterations"] = rep.iterations;
   state.counters["final_iterations"] = rep.final_iterations;
   state.counters["converged"] = rep.converged;

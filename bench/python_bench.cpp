@@ -18,20 +18,27 @@ const char* kForest = "/usr/share/blender/datafiles/studiolights/world/forest.ex
 
 const ibl::sphere::EnvMap* forest() {
   static std::unique_ptr<ibl::sphere::EnvMap> env;
-  if (!env && std::filesystem::exists(kForest)) env = std::make_unique<ibl::sphere::EnvMap>(ibl::io::read_envmap(kForest));
+  if (!env && std::filesystem::exists(kForest))
+    env = std::make_unique<ibl::sphere::EnvMap>(ibl::io::read_envmap(kForest));
   return env.get();
 }
 
 void BM_PyRef_ShProject(benchmark::State& state) {
   auto* env = forest();
-  if (!env) { state.SkipWithError("blender-data probe missing"); return; }
+  if (!env) {
+    state.SkipWithError("blender-data probe missing");
+    return;
+  }
   for (auto _ : state) benchmark::DoNotOptimize(ibl::sh::project(*env, 3));
 }
 BENCHMARK(BM_PyRef_ShProject)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_PyRef_MedianCut64(benchmark::State& state) {
   auto* env = forest();
-  if (!env) { state.SkipWithError("blender-data probe missing"); return; }
+  if (!env) {
+    state.SkipWithError("blender-data probe missing");
+    return;
+  }
   ibl::lights::ExtractDesc d;
   d.method = "median-cut";
   d.count = 64;
@@ -42,7 +49,10 @@ BENCHMARK(BM_PyRef_MedianCut64)->Unit(benchmark::kMillisecond)->UseRealTime();
 void BM_PyRef_IlfBuild(benchmark::State& state) {
   const char* seq = std::getenv("IBLKIT_PYBENCH_SEQ");
   const char* buckets = std::getenv("IBLKIT_PYBENCH_BUCKETS");
-  if (!seq || !buckets) { state.SkipWithError("IBLKIT_PYBENCH_SEQ / IBLKIT_PYBENCH_BUCKETS not set (bench/python_overhead.py sets them)"); return; }
+  if (!seq || !buckets) {
+    state.SkipWithError("IBLKIT_PYBENCH_SEQ / IBLKIT_PYBENCH_BUCKETS not set (bench/python_overhead.py sets them)");
+    return;
+  }
   for (auto _ : state) {
     auto s = ibl::ilf::read_sequence(seq);  // what ilf.build(path) does: read, then build (buckets reused)
     ibl::ilf::BuildDesc d;

@@ -1,8 +1,8 @@
 // libFuzzer harness: OBJ and PLY meshes through the mesh loader (geometry::read_mesh, assimp). The extension
 // follows the input: .ply when it starts with "ply", else .obj.
 // Build: make fuzz (clang-14, -fsanitize=fuzzer,address,undefined); replay: iblkit_fuzz_replay mesh FILE…
-#include "fuzz/fuzz_common.h"
 #include <cstring>
+#include "fuzz/fuzz_common.h"
 
 #include "iblkit/geometry/mesh_io.h"
 

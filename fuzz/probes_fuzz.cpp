@@ -1,7 +1,7 @@
-// libFuzzer harness: iblkit.probes/1 fusion probe sets (fusion::load_probe_set: manifest, proxy, probes, depth, prepare).
-// Beside the input lie room.obj (a cube proxy), probe.pfm (4x2 lat-long) and probe_depth.pfm for the
-// manifest to name; no depth cache is written.
-// Build: make fuzz (clang-14, -fsanitize=fuzzer,address,undefined); replay: iblkit_fuzz_replay probes FILE…
+// libFuzzer harness: iblkit.probes/1 fusion probe sets (fusion::load_probe_set: manifest, proxy, probes, depth,
+// prepare). Beside the input lie room.obj (a cube proxy), probe.pfm (4x2 lat-long) and probe_depth.pfm for the manifest
+// to name; no depth cache is written. Build: make fuzz (clang-14, -fsanitize=fuzzer,address,undefined); replay:
+// iblkit_fuzz_replay probes FILE…
 #include "fuzz/fuzz_common.h"
 #include "iblkit/fusion/probe_set.h"
 

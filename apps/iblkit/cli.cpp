@@ -1,7 +1,7 @@
 #include "cli.h"
 
-#include <cmath>
 #include <unistd.h>
+#include <cmath>
 
 #include <algorithm>
 #include <chrono>
@@ -142,7 +142,8 @@ ibl::io::EnvReadDesc& add_probe_read_options(CLI::App& app) {
       ->each([desc](const std::string& s) { desc->mapping = ibl::sphere::parse_mapping(s); });
   app.add_option("--dead-angle", desc->dead_angle_deg, "mirror ball: unusable cone behind the ball, degrees")
       ->check(CLI::Range(0.0, 89.0));
-  app.add_flag("--sanitize", desc->sanitize, "replace NaN/Inf/negative pixels by 0 (and say how many) instead of failing");
+  app.add_flag("--sanitize", desc->sanitize,
+               "replace NaN/Inf/negative pixels by 0 (and say how many) instead of failing");
   return *desc;
 }
 

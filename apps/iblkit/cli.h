@@ -49,9 +49,9 @@ std::vector<CommandEntry>& command_registry();
 
 // A step of `iblkit demo`, registered by the module's command file; steps run in `order`.
 struct DemoContext {
-  std::string out_dir;    // folder for pictures and numbers
-  std::string probe;      // the real probe the demo starts from
-  nlohmann::json summary; // numbers each step adds; written to OUT/summary.json
+  std::string out_dir;                                        // folder for pictures and numbers
+  std::string probe;                                          // the real probe the demo starts from
+  nlohmann::json summary;                                     // numbers each step adds; written to OUT/summary.json
   std::vector<std::pair<std::string, std::string>> pictures;  // (caption, png path) for the contact sheet
 };
 struct DemoStep {
@@ -78,7 +78,7 @@ void emit(const nlohmann::json& j, const std::function<void()>& table);
 void info(const std::string& msg);
 
 // Parsers for option values.
-ibl::Vec3 parse_vec3(const std::string& s, const std::string& what);  // "x,y,z"
+ibl::Vec3 parse_vec3(const std::string& s, const std::string& what);             // "x,y,z"
 std::vector<int> parse_int_list(const std::string& s, const std::string& what);  // "1,2,4"
 // Adds --mapping, --dead-angle, --sanitize to an app and returns the read settings they fill.
 ibl::io::EnvReadDesc& add_probe_read_options(CLI::App& app);

@@ -7,9 +7,9 @@
 #include <fmt/ranges.h>
 
 #include "cli.h"
-#include "render_setup.h"
-#include "iblkit/core/atomic_file.h"
 #include "iblkit/augment/composite.h"
+#include "iblkit/core/atomic_file.h"
+#include "render_setup.h"
 #ifdef IBLKIT_HAVE_GL
 #include "iblkit/augment/gl/compositor.h"
 #include "iblkit/render/gl/context.h"
@@ -27,8 +27,8 @@ namespace fs = std::filesystem;
 using ibl::Vec3;
 
 struct Opts {
-  std::string photo, probe_depth, object = "blob", at = "0,0.15,0", albedo = "0.7,0.7,0.7", out = "composite.exr", layers,
-      backend = "cpu";
+  std::string photo, probe_depth, object = "blob", at = "0,0.15,0", albedo = "0.7,0.7,0.7", out = "composite.exr",
+                                  layers, backend = "cpu";
   iblcli::PhotoSceneOptions scene;
   std::vector<std::string> light, truth;
   std::string lobe = "phong", texture;
@@ -55,7 +55,8 @@ void run(const Opts& o, const ibl::io::EnvReadDesc& read) {
     if (backend == "cpu") iblcli::info("--backend auto: no OpenGL context (" + why + "): the CPU reference composites");
   }
 #else
-  if (backend == "gl") ibl::fail(ibl::ErrorKind::Unsupported, "--backend gl: iblkit was built without OpenGL (IBLKIT_WITH_GL)");
+  if (backend == "gl")
+    ibl::fail(ibl::ErrorKind::Unsupported, "--backend gl: iblkit was built without OpenGL (IBLKIT_WITH_GL)");
   if (backend == "auto") backend = "cpu";
 #endif
   if (o.light.size() > 1) ibl::fail(ibl::ErrorKind::Value, "--light: give one light file");
@@ -121,76 +122,128 @@ void run(const Opts& o, const ibl::io::EnvReadDesc& read) {
     e = te.errors;
     noise = te.noise;
     if (!o.layers.empty()) write_layer(o.layers, "truth_error", ibl::augment::error_picture(r.composite, te.mean));
-    j["errors"] = {{"object", e.object},          {"shadow", e.shadow},       {"unchanged", e.unchanged},
-                   {"object_pixels", e.object_pixels}, {"shadow_pixels", e.shadow_pixels}, {"unchanged_pixels", e.unchanged_pixels},
-                   {"brightened_pixels", e.brightened_pixels}, {"shadow_signal", e.shadow_signal}};
-    if (o.truth.size() > 1) j["truth_noise"] = {{"object", noise.object}, {"shadow", noise.shadow}, {"unchanged", noise.unchanged}, {"truths", o.truth.size()}};
+    j["errors"] = {{"object", e.object},
+                   {"shadow", e.shadow},
+                   {"unchanged", e.unchanged},
+                   {"object_pixels", e.object_pixels},
+                   {"shadow_pixels", e.shadow_pixels},
+                   {"unchanged_pixels", e.unchanged_pixels},
+                   {"brightened_pixels", e.brightened_pixels},
+                   {"shadow_signal", e.shadow_signal}};
+    if (o.truth.size() > 1)
+      j["truth_noise"] = {{"object", noise.object},
+                          {"shadow", noise.shadow},
+                          {"unchanged", noise.unchanged},
+                          {"truths", o.truth.size()}};
   }
   iblcli::emit(j, [&] {
-    fmt::print("composited the object into {} ({}x{}, light: {}, backend {}) in {:.2f} s: {}\n", o.photo, cam.width, cam.height,
-               L.light.source, backend, s.seconds, o.out);
-    fmt::print("  {} object pixels, {} proxy pixels changed by its shadow and light\n", s.object_pixels, s.changed_pixels);
-    if (!o.layers.empty()) fmt::print("  layers: {}/mask, difference, albedo, render_with, render_without (.exr)\n", o.layers);
+    fmt::print("composited the object into {} ({}x{}, light: {}, backend {}) in {:.2f} s: {}\n", o.photo, cam.width,
+               cam.height, L.light.source, backend, s.seconds, o.out);
+    fmt::print("  {} object pixels, {} proxy pixels changed by its shadow and light\n", s.object_pixels,
+               s.changed_pixels);
+    if (!o.layers.empty())
+      fmt::print("  layers: {}/mask, difference, albedo, render_with, render_without (.exr)\n", o.layers);
     if (!o.truth.empty())
-      fmt::print("  against {}: object {:.1f} % ({} px), shadow {:.1f} % of the shadow signal ({} px, {:.0f} % darker), unchanged {:.2f} % ({} px)\n",
-                 fmt::join(o.truth, " + "), 100 * e.object, e.object_pixels, 100 * e.shadow, e.shadow_pixels, 100 * e.shadow_signal, 100 * e.unchanged,
-                 e.unchanged_pixels);
+      fmt::print(
+          "  against {}: object {:.1f} % ({} px), shadow {:.1f} % of the shadow signal ({} px, {:.0f} % darker), "
+          "unchanged {:.2f} % ({} px)\n",
+          fmt::join(o.truth, " + "), 100 * e.object, e.object_pixels, 100 * e.shadow, e.shadow_pixels,
+          100 * e.shadow_signal, 100 * e.unchanged, e.unchanged_pixels);
     if (o.truth.size() > 1)
-      fmt::print("  the truths' mean's own noise (from their spread): object {:.1f} %, shadow {:.1f} %, unchanged {:.2f} %\n", 100 * noise.object,
-                 100 * noise.shadow, 100 * noise.unchanged);
+      fmt::print(
+          "  the truths' mean's own noise (from their spread): object {:.1f} %, shadow {:.1f} %, unchanged {:.2f} %\n",
+          100 * noise.object, 100 * noise.shadow, 100 * noise.unchanged);
   });
 }
 
 void setup(CLI::App& app) {
   auto* o = iblcli::app_owned<Opts>();
-  app.add_option("photo", o->photo, "the background photograph (HDR, linear; any format OpenImageIO reads)")->required();
+  app.add_option("photo", o->photo, "the background photograph (HDR, linear; any format OpenImageIO reads)")
+      ->required();
   iblcli::add_photo_scene_options(app, &o->scene, "");
   app.add_option("--light", o->light, "an SH grid (.shgrid) or a probe image (with --at-probe), with --proxy");
-  app.add_option("--probe-depth", o->probe_depth, "the --light probe's depth map (metres; lights in front of the proxy)");
+  app.add_option("--probe-depth", o->probe_depth,
+                 "the --light probe's depth map (metres; lights in front of the proxy)");
   auto& rd = iblcli::add_probe_read_options(app);
   app.add_option("--object", o->object, "blob, sphere, or a mesh file")->capture_default_str();
   app.add_option("--at", o->at, "where the object's centre goes")->capture_default_str();
-  app.add_option("--object-size", o->object_size, "largest extent, metres (0 keeps a mesh file's own size and place)")->capture_default_str();
+  app.add_option("--object-size", o->object_size, "largest extent, metres (0 keeps a mesh file's own size and place)")
+      ->capture_default_str();
   app.add_option("--albedo", o->albedo, "the object's Lambertian albedo r,g,b")->capture_default_str();
   app.add_option("--gloss", o->gloss, "weight of the object's glossy lobe (0..1)")->check(CLI::Range(0.0, 1.0));
-  app.add_option("--exponent", o->exponent, "exponent of the glossy lobe")->check(CLI::Range(1.0, 10000.0))->capture_default_str();
-  app.add_option("--lobe", o->lobe, "glossy lobe: phong, or blinn (Blinn-Phong)")->check(CLI::IsMember({"phong", "blinn"}))->capture_default_str();
-  app.add_option("--texture", o->texture, "albedo texture of the object (sRGB PNG/JPG or linear EXR) at its UVs (the blob's and sphere's own)");
-  app.add_option("--triangles", o->triangles, "triangles of the blob")->check(CLI::Range(100, 5000000))->capture_default_str();
-  app.add_option("--samples", o->desc.light_samples, "light samples per proxy pixel (albedo and shadows)")->check(CLI::Range(1, 65536))
+  app.add_option("--exponent", o->exponent, "exponent of the glossy lobe")
+      ->check(CLI::Range(1.0, 10000.0))
       ->capture_default_str();
-  app.add_option("--object-samples", o->desc.object_samples, "light samples per object pixel")->check(CLI::Range(1, 65536))->capture_default_str();
-  app.add_option("--bounce-samples", o->desc.bounce_samples, "cone samples per proxy pixel towards the object: its light on the pixel and, with the light samples, its shadow (a square number is stratified; 0: no interreflection)")
-      ->check(CLI::Range(0, 65536))->capture_default_str();
-  app.add_option("--pixel-samples", o->desc.pixel_samples, "n×n camera rays per pixel (object edges)")->check(CLI::Range(1, 8))->capture_default_str();
+  app.add_option("--lobe", o->lobe, "glossy lobe: phong, or blinn (Blinn-Phong)")
+      ->check(CLI::IsMember({"phong", "blinn"}))
+      ->capture_default_str();
+  app.add_option("--texture", o->texture,
+                 "albedo texture of the object (sRGB PNG/JPG or linear EXR) at its UVs (the blob's and sphere's own)");
+  app.add_option("--triangles", o->triangles, "triangles of the blob")
+      ->check(CLI::Range(100, 5000000))
+      ->capture_default_str();
+  app.add_option("--samples", o->desc.light_samples, "light samples per proxy pixel (albedo and shadows)")
+      ->check(CLI::Range(1, 65536))
+      ->capture_default_str();
+  app.add_option("--object-samples", o->desc.object_samples, "light samples per object pixel")
+      ->check(CLI::Range(1, 65536))
+      ->capture_default_str();
+  app.add_option("--bounce-samples", o->desc.bounce_samples,
+                 "cone samples per proxy pixel towards the object: its light on the pixel and, with the light samples, "
+                 "its shadow (a square number is stratified; 0: no interreflection)")
+      ->check(CLI::Range(0, 65536))
+      ->capture_default_str();
+  app.add_option("--pixel-samples", o->desc.pixel_samples, "n×n camera rays per pixel (object edges)")
+      ->check(CLI::Range(1, 8))
+      ->capture_default_str();
   app.add_option("--seed", o->desc.seed, "random seed")->capture_default_str();
-  app.add_option("--median-cut", o->median_cut, "baseline: the light cut into N median-cut lights (shadows and shading from those only)")
+  app.add_option("--median-cut", o->median_cut,
+                 "baseline: the light cut into N median-cut lights (shadows and shading from those only)")
       ->check(CLI::Range(1, 4096));
-  app.add_flag("--no-shadows", [o](int64_t) { o->desc.shadows = false; }, "baseline: the object pasted without its shadow and light on the scene");
-  app.add_option("--backend", o->backend, "cpu (the ray-traced reference), gl (OpenGL: shadow maps and a soft sphere term), auto (gl "
-                 "when a GL context can be made)")->capture_default_str();
-#ifdef IBLKIT_HAVE_GL
-  app.add_option("--gl-lights", o->gl.split.lights, "gl: most hard lights with shadow maps")->check(CLI::Range(0, 16))->capture_default_str();
-  app.add_option("--gl-threshold", o->gl.split.threshold, "gl: a texel brighter than this x the mean radiance is a hard light's")
-      ->check(CLI::Range(0.0, 1e6))->capture_default_str();
-  app.add_option("--gl-visibility", o->gl.visibility_samples, "gl: rays per object triangle for the soft light that reaches it (its own "
-                 "occlusion, the floor its shadow darkens, the parallax from the probe; 0: none; default: 4194304 rays over the "
-                 "triangles, 16 to 1024 each)")->check(CLI::Range(0, 65536));
-  app.add_option("--gl-cut", o->gl.cut, "gl: the soft term is 0 where the object covers less than this cosine-weighted share of "
-                 "the hemisphere (faded in up to twice it; the pixels left exactly as photographed)")->check(CLI::Range(0.0, 0.5))
+  app.add_flag(
+      "--no-shadows", [o](int64_t) { o->desc.shadows = false; },
+      "baseline: the object pasted without its shadow and light on the scene");
+  app.add_option("--backend", o->backend,
+                 "cpu (the ray-traced reference), gl (OpenGL: shadow maps and a soft sphere term), auto (gl "
+                 "when a GL context can be made)")
       ->capture_default_str();
-  app.add_option("--shadow-map-size", o->gl.shadow_map_size, "gl: texels per side of each light's shadow maps")->check(CLI::Range(16, 8192))
+#ifdef IBLKIT_HAVE_GL
+  app.add_option("--gl-lights", o->gl.split.lights, "gl: most hard lights with shadow maps")
+      ->check(CLI::Range(0, 16))
+      ->capture_default_str();
+  app.add_option("--gl-threshold", o->gl.split.threshold,
+                 "gl: a texel brighter than this x the mean radiance is a hard light's")
+      ->check(CLI::Range(0.0, 1e6))
+      ->capture_default_str();
+  app.add_option("--gl-visibility", o->gl.visibility_samples,
+                 "gl: rays per object triangle for the soft light that reaches it (its own "
+                 "occlusion, the floor its shadow darkens, the parallax from the probe; 0: none; default: 4194304 rays "
+                 "over the "
+                 "triangles, 16 to 1024 each)")
+      ->check(CLI::Range(0, 65536));
+  app.add_option("--gl-cut", o->gl.cut,
+                 "gl: the soft term is 0 where the object covers less than this cosine-weighted share of "
+                 "the hemisphere (faded in up to twice it; the pixels left exactly as photographed)")
+      ->check(CLI::Range(0.0, 0.5))
+      ->capture_default_str();
+  app.add_option("--shadow-map-size", o->gl.shadow_map_size, "gl: texels per side of each light's shadow maps")
+      ->check(CLI::Range(16, 8192))
       ->capture_default_str();
 #endif
   app.add_option("-o,--out", o->out, "the composite (.exr linear, .png tone mapped)")->capture_default_str();
   app.add_option("--layers", o->layers, "folder for mask, difference, albedo, render_with, render_without (.exr)");
-  app.add_option("--truth", o->truth, "a photograph with the object really there (iblkit lab photograph): print the errors; repeat with other seeds to "
-                 "measure against their mean and estimate its noise");
+  app.add_option(
+      "--truth", o->truth,
+      "a photograph with the object really there (iblkit lab photograph): print the errors; repeat with other seeds to "
+      "measure against their mean and estimate its noise");
   app.footer(
-      "Examples:\n  iblkit composite photo.exr --eye 0,1.2,2.4 --target 0,0.3,0 --fov 40 --probes fusion/probes.json --object blob "
+      "Examples:\n  iblkit composite photo.exr --eye 0,1.2,2.4 --target 0,0.3,0 --fov 40 --probes fusion/probes.json "
+      "--object blob "
       "--at 0,0.2,0 --out comp.exr --layers layers\n"
-      "  iblkit composite photo.exr --camera cam.json --light grid.shgrid --proxy room.obj --object sphere --at 0,0.2,0\n"
-      "  iblkit composite photo.exr --camera cam.json --light probe.exr --at-probe 0,0.5,0 --proxy floor.obj --at 0,0.2,0");
+      "  iblkit composite photo.exr --camera cam.json --light grid.shgrid --proxy room.obj --object sphere --at "
+      "0,0.2,0\n"
+      "  iblkit composite photo.exr --camera cam.json --light probe.exr --at-probe 0,0.5,0 --proxy floor.obj --at "
+      "0,0.2,0");
   app.callback([o, &rd] { run(*o, rd); });
 }
 

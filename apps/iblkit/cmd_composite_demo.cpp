@@ -63,12 +63,18 @@ ibl::lab::View photograph(const ibl::lab::Scene& scene, const ibl::geometry::Cam
   vd.samples = kTruthSamples;
   vd.render = scene.render;
   vd.render.bounces = bounces;
-  return ibl::lab::photograph(scene, [&](double px, double py, Vec3* o, Vec3* d) { *o = cam.eye; *d = cam.ray_direction(px, py); }, vd);
+  return ibl::lab::photograph(
+      scene,
+      [&](double px, double py, Vec3* o, Vec3* d) {
+        *o = cam.eye;
+        *d = cam.ray_direction(px, py);
+      },
+      vd);
 }
 
 // low-scene2 with the blob at `at`: photograph, truth, one probe at the object, composite, errors.
-nlohmann::json lab_case(iblcli::DemoContext& ctx, const fs::path& dir, const ibl::geometry::Camera& cam, const Image& photo, Vec3 at,
-                        const std::string& name) {
+nlohmann::json lab_case(iblcli::DemoContext& ctx, const fs::path& dir, const ibl::geometry::Camera& cam,
+                        const Image& photo, Vec3 at, const std::string& name) {
   auto t0 = std::chrono::steady_clock::now();
   ibl::augment::ObjectDesc od;
   od.at = at;
@@ -96,10 +102,12 @@ nlohmann::json lab_case(iblcli::DemoContext& ctx, const fs::path& dir, const ibl
   ibl::augment::CompositeResult r = ibl::augment::composite(photo, cam, L.proxy, L.light, object, od.albedo);
   ibl::augment::CompositeErrors e = ibl::augment::measure(photo, r.composite, truth, r.mask);
   std::string png = (dir / (name + ".png")).string();
-  ibl::io::write_image(png, strip({{"photograph", photo},
-                                   {"composite (one probe)", r.composite},
-                                   {"truth (lab, object in it)", truth},
-                                   {fmt::format("{} x |composite - truth|", kDiffGain), abs_difference(r.composite, truth, kDiffGain)}}));
+  ibl::io::write_image(
+      png,
+      strip({{"photograph", photo},
+             {"composite (one probe)", r.composite},
+             {"truth (lab, object in it)", truth},
+             {fmt::format("{} x |composite - truth|", kDiffGain), abs_difference(r.composite, truth, kDiffGain)}}));
   ctx.pictures.push_back({fmt::format("composite: low-scene2, blob at ({:g}, {:g}, {:g})", at.x, at.y, at.z), png});
   return {{"at", {at.x, at.y, at.z}},
           {"object_error", e.object},
@@ -140,9 +148,10 @@ nlohmann::json real_case(iblcli::DemoContext& ctx, const fs::path& dir) {
   object.transform(1.0, {0, 0.002 - lo.y, 0});  // standing on the floor, 2 mm above it
   ibl::augment::CompositeResult r = ibl::augment::composite(photo, cam, floor, light, object, od.albedo);
   std::string png = (dir / "real_probe.png").string();
-  ibl::io::write_image(png, strip({{"probe seen from its centre", photo},
-                                   {"composite (floor proxy)", r.composite},
-                                   {fmt::format("{} x |difference|", kDiffGain), abs_difference(r.composite, photo, kDiffGain)}}));
+  ibl::io::write_image(
+      png, strip({{"probe seen from its centre", photo},
+                  {"composite (floor proxy)", r.composite},
+                  {fmt::format("{} x |difference|", kDiffGain), abs_difference(r.composite, photo, kDiffGain)}}));
   ctx.pictures.push_back({"composite: blob on a floor under " + fs::path(ctx.probe).filename().string(), png});
   return {{"probe", ctx.probe},
           {"probe_height_m", kProbeHeight},

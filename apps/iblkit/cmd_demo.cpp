@@ -68,7 +68,9 @@ void setup(CLI::App& app) {
   app.add_option("--probe", o->probe, "probe to start from (default: blender-data's forest.exr)");
   app.add_option("--only", o->only, "run only these steps, comma-separated (mappings, sh, lights, lab, ilf, render, …)")
       ->delimiter(',');
-  app.footer("Examples:\n  iblkit demo --out demo-out --only sh,lights\n  iblkit demo --out d --probe ../shared/probes/ict/uffizi_latlong_256.hdr --only mappings,sh");
+  app.footer(
+      "Examples:\n  iblkit demo --out demo-out --only sh,lights\n  iblkit demo --out d --probe "
+      "../shared/probes/ict/uffizi_latlong_256.hdr --only mappings,sh");
   app.callback([o] {
     iblcli::DemoContext ctx;
     ctx.out_dir = o->out;
@@ -98,7 +100,8 @@ void setup(CLI::App& app) {
     for (auto& [caption, path] : ctx.pictures) pics.push_back({caption, ibl::io::read_image(path)});
     std::string sheet = (fs::path(ctx.out_dir) / "contact_sheet.png").string();
     if (!pics.empty())
-      ibl::io::write_image(sheet, ibl::io::contact_sheet(pics, 4, 300, 170, "iblkit demo: " + fs::path(ctx.probe).filename().string()));
+      ibl::io::write_image(
+          sheet, ibl::io::contact_sheet(pics, 4, 300, 170, "iblkit demo: " + fs::path(ctx.probe).filename().string()));
     ibl::write_json_file((fs::path(ctx.out_dir) / "summary.json").string(), ctx.summary, 2);
     iblcli::emit(ctx.summary, [&] {
       fmt::print("demo wrote {} pictures into {}/\n", ctx.pictures.size(), ctx.out_dir);

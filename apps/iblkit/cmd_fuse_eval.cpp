@@ -15,9 +15,9 @@
 #include "fusion_pictures.h"
 #include "iblkit/core/atomic_file.h"
 #include "iblkit/core/error.h"
-#include "iblkit/fusion/evaluate.h"
 #include "iblkit/core/json_file.h"
 #include "iblkit/core/parallel.h"
+#include "iblkit/fusion/evaluate.h"
 #include "iblkit/fusion/local_lights.h"
 #include "iblkit/io/draw.h"
 #include "iblkit/io/image_io.h"
@@ -66,8 +66,9 @@ std::string point_name(Vec3 x) { return fmt::format("({:g}, {:g}, {:g})", x.x, x
 
 // Evaluates every blend × visibility at each point (fusion/evaluate.h); returns the rows and writes
 // pictures into dir.
-std::vector<fu::EvalRow> evaluate(const fu::ProbeSet& set, const ibl::lab::Scene& scene, const std::vector<Vec3>& points,
-                                  const FuseOpts& fo, int truth_samples, int area_samples, const fs::path& dir,
+std::vector<fu::EvalRow> evaluate(const fu::ProbeSet& set, const ibl::lab::Scene& scene,
+                                  const std::vector<Vec3>& points, const FuseOpts& fo, int truth_samples,
+                                  int area_samples, const fs::path& dir,
                                   std::vector<std::pair<std::string, std::string>>* pictures, const std::string& view) {
   ibl::make_output_folders(fs::path(dir).string());
   const fu::Reference ref = lab_reference(scene, truth_samples, area_samples);
@@ -82,22 +83,25 @@ std::vector<fu::EvalRow> evaluate(const fu::ProbeSet& set, const ibl::lab::Scene
     std::vector<std::pair<std::string, Image>> sheet = {{"lab truth " + pname, tone(pe.truth.image, scale)}};
     for (size_t i = 0; i < pe.rows.size(); ++i) {
       const auto& r = pe.rows[i];
-      sheet.push_back({fmt::format("{}{}: RMSE {:.3f}, E err {:.1f}%", fu::blend_name(r.blend), r.visibility ? "" : " no visibility",
-                                   r.image_rmse, 100 * r.irradiance_mean_rel),
+      sheet.push_back({fmt::format("{}{}: RMSE {:.3f}, E err {:.1f}%", fu::blend_name(r.blend),
+                                   r.visibility ? "" : " no visibility", r.image_rmse, 100 * r.irradiance_mean_rel),
                        tone(pe.maps[i].radiance.image, scale)});
       if (r.blend == fu::Blend::Footprint && r.visibility)
-        sheet.push_back({"coverage (footprint, visibility)", coverage_picture(pe.maps[i], static_cast<int>(set.probes.size()))});
+        sheet.push_back(
+            {"coverage (footprint, visibility)", coverage_picture(pe.maps[i], static_cast<int>(set.probes.size()))});
       rows.push_back(r);
     }
     std::string png = (dir / fmt::format("point{}.png", k)).string();
-    ibl::io::write_image(png, ibl::io::contact_sheet(sheet, 2, 512, 256, "fused vs lab truth at " + pname + " (same exposure)"));
+    ibl::io::write_image(
+        png, ibl::io::contact_sheet(sheet, 2, 512, 256, "fused vs lab truth at " + pname + " (same exposure)"));
     if (pictures) pictures->push_back({"fusion vs truth at " + pname, png});
     if (ed.view) {
       // The thesis's Fig. 7.8: the back-projected probes seen from x, angle blend, visibility off/on.
       double s = ibl::io::auto_exposure_scale(pe.view_truth);
       std::vector<std::pair<std::string, Image>> vs = {{"lab truth", tone(pe.view_truth, s)}};
       for (const auto& v : pe.views)
-        vs.push_back({fmt::format("{} blend, visibility {}", fu::blend_name(v.blend), v.visibility ? "on" : "off (thesis Fig. 7.8)"),
+        vs.push_back({fmt::format("{} blend, visibility {}", fu::blend_name(v.blend),
+                                  v.visibility ? "on" : "off (thesis Fig. 7.8)"),
                       tone(v.image, s)});
       std::string vpng = (dir / fmt::format("point{}_view.png", k)).string();
       ibl::io::write_image(vpng, ibl::io::contact_sheet(vs, 3, 320, 200, "view from " + pname + " along " + view));
@@ -110,20 +114,27 @@ std::vector<fu::EvalRow> evaluate(const fu::ProbeSet& set, const ibl::lab::Scene
 nlohmann::json rows_json(const std::vector<fu::EvalRow>& rows) {
   nlohmann::json a = nlohmann::json::array();
   for (const auto& r : rows)
-    a.push_back({{"point", point_name(r.point)}, {"blend", fu::blend_name(r.blend)}, {"visibility", r.visibility},
-                 {"image_rmse", r.image_rmse}, {"irradiance_mean_rel", r.irradiance_mean_rel},
-                 {"irradiance_max_rel", r.irradiance_max_rel}, {"fused", r.coverage.fused}, {"unseen", r.coverage.unseen},
+    a.push_back({{"point", point_name(r.point)},
+                 {"blend", fu::blend_name(r.blend)},
+                 {"visibility", r.visibility},
+                 {"image_rmse", r.image_rmse},
+                 {"irradiance_mean_rel", r.irradiance_mean_rel},
+                 {"irradiance_max_rel", r.irradiance_max_rel},
+                 {"fused", r.coverage.fused},
+                 {"unseen", r.coverage.unseen},
                  {"left_proxy", r.coverage.left_proxy}});
   return a;
 }
 
 void print_rows(const std::vector<fu::EvalRow>& rows) {
-  fmt::print("| point | blend | visibility | image RMSE (rel.) | irradiance error mean / max | fused / unseen / left |\n");
+  fmt::print(
+      "| point | blend | visibility | image RMSE (rel.) | irradiance error mean / max | fused / unseen / left |\n");
   fmt::print("| --- | --- | --- | --- | --- | --- |\n");
   for (const auto& r : rows)
     fmt::print("| {} | {} | {} | {:.3f} | {:.1f}% / {:.1f}% | {:.1f}% / {:.1f}% / {:.1f}% |\n", point_name(r.point),
                fu::blend_name(r.blend), r.visibility ? "on" : "off", r.image_rmse, 100 * r.irradiance_mean_rel,
-               100 * r.irradiance_max_rel, 100 * r.coverage.fused, 100 * r.coverage.unseen, 100 * r.coverage.left_proxy);
+               100 * r.irradiance_max_rel, 100 * r.coverage.fused, 100 * r.coverage.unseen,
+               100 * r.coverage.left_proxy);
 }
 
 void run_eval(const EvalOpts& o) {
@@ -135,12 +146,13 @@ void run_eval(const EvalOpts& o) {
   auto t0 = std::chrono::steady_clock::now();
   auto rows = evaluate(set, scene, pts, o.f, o.truth_samples, o.area_samples, o.out, nullptr, o.view);
   double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  nlohmann::json j = {{"scene", scene.name}, {"probes", o.probes}, {"size", o.f.size}, {"samples", o.f.samples},
-                      {"rows", rows_json(rows)}, {"seconds", secs}};
+  nlohmann::json j = {{"scene", scene.name},    {"probes", o.probes},      {"size", o.f.size},
+                      {"samples", o.f.samples}, {"rows", rows_json(rows)}, {"seconds", secs}};
   ibl::write_json_file((fs::path(o.out) / "eval.json").string(), j);
   emit(j, [&] {
-    fmt::print("{} fused with {} probes, {}×{} lat-long, {}×{} rays per pixel; truth {}×{} samples ({:.1f} s)\n", scene.name,
-               set.probes.size(), 2 * o.f.size, o.f.size, o.f.samples, o.f.samples, o.truth_samples, o.truth_samples, secs);
+    fmt::print("{} fused with {} probes, {}×{} lat-long, {}×{} rays per pixel; truth {}×{} samples ({:.1f} s)\n",
+               scene.name, set.probes.size(), 2 * o.f.size, o.f.size, o.f.samples, o.f.samples, o.truth_samples,
+               o.truth_samples, secs);
     print_rows(rows);
     fmt::print("wrote {}/eval.json and point*.png\n", o.out);
   });
@@ -149,7 +161,8 @@ void run_eval(const EvalOpts& o) {
 }  // namespace
 
 void setup_eval(CLI::App& fuse) {
-  auto* c = fuse.add_subcommand("eval", "Fused maps against the lab's exact local radiance map (every blend, visibility on/off)");
+  auto* c = fuse.add_subcommand(
+      "eval", "Fused maps against the lab's exact local radiance map (every blend, visibility on/off)");
   auto* o = iblcli::app_owned<EvalOpts>();
   o->f.size = 64;
   o->f.samples = 2;
@@ -161,8 +174,9 @@ void setup_eval(CLI::App& fuse) {
   c->add_option("--view", o->view, "also a pinhole view (90°) from each point along this direction x,y,z");
   c->add_option("-o,--out", o->out, "folder for eval.json and pictures")->required();
   add_fuse_options(*c, o->f);
-  c->footer("Example:\n  iblkit lab capture t-corridor --fusion --probe 0,1.5,-1 --probe 0,1.5,5 --size 128 --out tc\n"
-            "  iblkit fuse eval tc/probes.json --scene t-corridor --at -2,1.5,-1 --view 1,0,0 --out eval");
+  c->footer(
+      "Example:\n  iblkit lab capture t-corridor --fusion --probe 0,1.5,-1 --probe 0,1.5,5 --size 128 --out tc\n"
+      "  iblkit fuse eval tc/probes.json --scene t-corridor --at -2,1.5,-1 --view 1,0,0 --out eval");
   c->callback([o] { run_eval(*o); });
 }
 
@@ -199,7 +213,8 @@ void demo_step(DemoContext& ctx) {
   fu::LocalMap ll = fu::fuse(set, {0, 1.5, 1.0}, fuse_desc(lo));
   auto ls = fu::localize_lights(ll, {16});
   std::string png = (dir / "fused_lights.png").string();
-  ibl::io::write_image(png, fused_sheet(ll, 2, &ls, "t-corridor fused at (0, 1.5, 1): map, coverage, 16 localised lights"));
+  ibl::io::write_image(png,
+                       fused_sheet(ll, 2, &ls, "t-corridor fused at (0, 1.5, 1): map, coverage, 16 localised lights"));
   ctx.pictures.push_back({"fusion: map, coverage, lights", png});
   nlohmann::json s = {{"capture_seconds", capture_s}, {"rows", rows_json(rows)}, {"coverage_fused", ll.stats.fused}};
   ctx.summary["fusion"] = s;

@@ -14,8 +14,8 @@
 #include "iblkit/ilf/adaptive.h"
 #include "iblkit/ilf/analytic.h"
 #include "iblkit/ilf/build.h"
-#include "iblkit/ilf/threejs_grid.h"
 #include "iblkit/ilf/distributed.h"
+#include "iblkit/ilf/threejs_grid.h"
 #include "iblkit/io/image_io.h"
 #include "iblkit/io/tonemap.h"
 
@@ -58,8 +58,11 @@ size_t parse_bytes(const std::string& s) {
   char* end = nullptr;
   double v = std::strtod(s.c_str(), &end);
   std::string unit = end ? std::string(end) : "";
-  double mul = unit.empty() || unit == "B" ? 1 : unit == "K" || unit == "KB" ? 1e3 * 1.024 : unit == "M" || unit == "MB" ? 1048576.0
-             : unit == "G" || unit == "GB" ? 1073741824.0 : -1;
+  double mul = unit.empty() || unit == "B"   ? 1
+               : unit == "K" || unit == "KB" ? 1e3 * 1.024
+               : unit == "M" || unit == "MB" ? 1048576.0
+               : unit == "G" || unit == "GB" ? 1073741824.0
+                                             : -1;
   if (!(v > 0) || mul < 0) fail(ErrorKind::Value, "--memory: \"{}\" is not a size (e.g. 2G, 512M)", s);
   size_t bytes = size_t(v * mul);
   if (bytes < (size_t(64) << 20)) fail(ErrorKind::Value, "--memory: {} is below the 64M minimum", s);
@@ -67,12 +70,27 @@ size_t parse_bytes(const std::string& s) {
 }
 
 nlohmann::json report_json(const ilf::BuildReport& r) {
-  return {{"probes_in", r.probes_in}, {"probes_used", r.probes_used}, {"skipped", r.skipped}, {"subsampled_out", r.subsampled_out},
-          {"buckets", r.buckets}, {"blocks", r.blocks}, {"octahedral", r.octahedral}, {"samples", r.samples},
-          {"fraction_uncovered", r.fraction_uncovered}, {"buckets_reused", r.buckets_reused},
-          {"seconds", {{"subsample", r.t_subsample}, {"sort", r.t_sort}, {"project", r.t_project}, {"repair", r.t_repair},
-                       {"accumulate", r.t_accumulate}, {"crossval", r.t_choose + r.t_crossval}, {"total", r.t_total}}},
-          {"gemm_gflop", r.gemm_flops * 1e-9}, {"resolution", {r.nx, r.ny, r.nz}}, {"kernel", r.kernel_cells},
+  return {{"probes_in", r.probes_in},
+          {"probes_used", r.probes_used},
+          {"skipped", r.skipped},
+          {"subsampled_out", r.subsampled_out},
+          {"buckets", r.buckets},
+          {"blocks", r.blocks},
+          {"octahedral", r.octahedral},
+          {"samples", r.samples},
+          {"fraction_uncovered", r.fraction_uncovered},
+          {"buckets_reused", r.buckets_reused},
+          {"seconds",
+           {{"subsample", r.t_subsample},
+            {"sort", r.t_sort},
+            {"project", r.t_project},
+            {"repair", r.t_repair},
+            {"accumulate", r.t_accumulate},
+            {"crossval", r.t_choose + r.t_crossval},
+            {"total", r.t_total}}},
+          {"gemm_gflop", r.gemm_flops * 1e-9},
+          {"resolution", {r.nx, r.ny, r.nz}},
+          {"kernel", r.kernel_cells},
           {"ball_radius", r.ball_radius},
           {"gemm_gflops_per_s", r.t_accumulate > 0 ? r.gemm_flops * 1e-9 / r.t_accumulate : 0.0},
           {"samples_per_s", r.t_total > 0 ? r.samples / r.t_total : 0.0}};
@@ -82,31 +100,50 @@ nlohmann::json report_json(const ilf::BuildReport& r) {
 void add_crossval_json(nlohmann::json& j, const ilf::BuildReport& r) {
   if (r.choice) {
     nlohmann::json trials = nlohmann::json::array();
-    for (const auto& t : r.choice->trials) trials.push_back({{"grid", t.n}, {"kernel", t.kernel}, {"cv_error", t.cv_error}});
-    j["choice"] = {{"resolution", {r.choice->nx, r.choice->ny, r.choice->nz}}, {"kernel", r.choice->kernel},
-                   {"buckets_used", r.choice->buckets_used}, {"seconds", r.choice->seconds}, {"trials", trials}};
+    for (const auto& t : r.choice->trials)
+      trials.push_back({{"grid", t.n}, {"kernel", t.kernel}, {"cv_error", t.cv_error}});
+    j["choice"] = {{"resolution", {r.choice->nx, r.choice->ny, r.choice->nz}},
+                   {"kernel", r.choice->kernel},
+                   {"buckets_used", r.choice->buckets_used},
+                   {"seconds", r.choice->seconds},
+                   {"trials", trials}};
   }
   if (r.crossval) {
     const auto& c = *r.crossval;
     nlohmann::json regions = nlohmann::json::array();
     for (size_t i = 0; i < c.region_error.size(); ++i)
-      regions.push_back({{"index", {int(i) % c.regions, int(i) / c.regions % c.regions, int(i) / (c.regions * c.regions)}},
-                         {"probes", c.region_probes[i]},
-                         {"rel_error", std::isfinite(c.region_error[i]) ? nlohmann::json(c.region_error[i]) : nlohmann::json()}});
-    j["crossval"] = {{"folds", c.folds}, {"evaluated", c.evaluated}, {"rel_error", c.rel_error},
-                     {"median_probe_error", c.median_probe_error}, {"regions_per_axis", c.regions}, {"regions", regions}};
+      regions.push_back(
+          {{"index", {int(i) % c.regions, int(i) / c.regions % c.regions, int(i) / (c.regions * c.regions)}},
+           {"probes", c.region_probes[i]},
+           {"rel_error", std::isfinite(c.region_error[i]) ? nlohmann::json(c.region_error[i]) : nlohmann::json()}});
+    j["crossval"] = {{"folds", c.folds},
+                     {"evaluated", c.evaluated},
+                     {"rel_error", c.rel_error},
+                     {"median_probe_error", c.median_probe_error},
+                     {"regions_per_axis", c.regions},
+                     {"regions", regions}};
   }
 }
 
 // "--grid auto" or a resolution; "--kernel auto" or a width.
 bool is_auto(const std::string& s) { return s == "auto"; }
 
-
 nlohmann::json mpi_json(const ilf::DistributedReport& d) {
-  return {{"ranks", d.ranks}, {"chunk", d.chunk}, {"blocks_per_rank", {d.blocks_min, d.blocks_max}},
-          {"seconds", {{"subsample", d.t_subsample}, {"read", d.t_read}, {"exchange", d.t_exchange}, {"project", d.t_project},
-                       {"repair", d.t_repair}, {"accumulate", d.t_accumulate}, {"reduce", d.t_reduce}, {"crossval", d.t_crossval}}},
-          {"bytes_sent", d.bytes_sent}, {"bytes_received", d.bytes_received}, {"bytes_reduced", d.bytes_reduced},
+  return {{"ranks", d.ranks},
+          {"chunk", d.chunk},
+          {"blocks_per_rank", {d.blocks_min, d.blocks_max}},
+          {"seconds",
+           {{"subsample", d.t_subsample},
+            {"read", d.t_read},
+            {"exchange", d.t_exchange},
+            {"project", d.t_project},
+            {"repair", d.t_repair},
+            {"accumulate", d.t_accumulate},
+            {"reduce", d.t_reduce},
+            {"crossval", d.t_crossval}}},
+          {"bytes_sent", d.bytes_sent},
+          {"bytes_received", d.bytes_received},
+          {"bytes_reduced", d.bytes_reduced},
           {"bytes_crossval", d.bytes_crossval},
           {"peak_rss_bytes", d.peak_rss_bytes}};
 }
@@ -135,7 +172,8 @@ std::string positive_number(const std::string& v) {
 struct BuildOptions {
   ilf::BuildDesc bd;
   std::string seq, out, volume, buckets, vdb, error_grid, kernel = "auto";
-  std::string grid = bd.nx == bd.ny && bd.ny == bd.nz ? std::to_string(bd.nx) : fmt::format("{},{},{}", bd.nx, bd.ny, bd.nz);
+  std::string grid =
+      bd.nx == bd.ny && bd.ny == bd.nz ? std::to_string(bd.nx) : fmt::format("{},{},{}", bd.nx, bd.ny, bd.nz);
   std::string repair = ilf::repair_name(bd.project.repair), memory = format_bytes(bd.buckets.memory_bytes);
   std::string directions = directions_name(bd.buckets.octahedral);
   double subsample = -1, subsample_dist = ilf::SubsampleDesc{}.max_distance;  // off unless given
@@ -157,7 +195,8 @@ void run_build(const BuildOptions& opts, const ilf::SequenceReadDesc& rd, const 
   if (job) {
     job->agree([&] { seq = ilf::read_sequence(o->seq, rd, &srep); });
     // Rank 0 draws the one bar of the job; under mpirun its stderr is a pipe and its stdout the terminal.
-    auto bar = job->rank() == 0 ? iblcli::progress_bar(isatty(STDERR_FILENO) || isatty(STDOUT_FILENO)) : ibl::ProgressFn{};
+    auto bar =
+        job->rank() == 0 ? iblcli::progress_bar(isatty(STDERR_FILENO) || isatty(STDOUT_FILENO)) : ibl::ProgressFn{};
     g = job->build(seq, bd, bar, &rep, &drep);
     iblcli::progress_done();
     if (job->rank() != 0) return;
@@ -184,14 +223,18 @@ void run_build(const BuildOptions& opts, const ilf::SequenceReadDesc& rd, const 
   add_crossval_json(j, rep);
   if (!o->error_grid.empty()) j["error_grid"] = o->error_grid;
   iblcli::emit(j, [&] {
-    fmt::print("wrote {} ({}x{}x{}, {} coefficients)\n", o->out, g.grid().nx, g.grid().ny, g.grid().nz, bd.bands * bd.bands);
+    fmt::print("wrote {} ({}x{}x{}, {} coefficients)\n", o->out, g.grid().nx, g.grid().ny, g.grid().nz,
+               bd.bands * bd.bands);
     fmt::print("kernel    {:g} grid cells{}{}\n", rep.choice ? rep.kernel_cells : bd.project.kernel_cells,
-               rep.choice ? fmt::format(" (chosen of {} cross-validated trials on {} buckets in {:.1f}s{})", rep.choice->trials.size(),
-                                        rep.choice->buckets_used, rep.choice->seconds, bd.auto_grid ? ", with the grid" : "") : "",
+               rep.choice ? fmt::format(" (chosen of {} cross-validated trials on {} buckets in {:.1f}s{})",
+                                        rep.choice->trials.size(), rep.choice->buckets_used, rep.choice->seconds,
+                                        bd.auto_grid ? ", with the grid" : "")
+                          : "",
                rep.ball_radius > 0 ? fmt::format("; rays start on the ball (radius {:g} m)", rep.ball_radius) : "");
     if (rep.crossval) {
       const auto& c = *rep.crossval;
-      fmt::print("cv error  {:.4f} relative ({}-fold, {} probes; median probe {:.4f})\n", c.rel_error, c.folds, c.evaluated, c.median_probe_error);
+      fmt::print("cv error  {:.4f} relative ({}-fold, {} probes; median probe {:.4f})\n", c.rel_error, c.folds,
+                 c.evaluated, c.median_probe_error);
       std::string regs;
       for (size_t i = 0; i < c.region_error.size(); ++i)
         regs += std::isfinite(c.region_error[i]) ? fmt::format(" {:.3f}", c.region_error[i]) : " -";
@@ -201,17 +244,22 @@ void run_build(const BuildOptions& opts, const ilf::SequenceReadDesc& rd, const 
     fmt::print("probes    {} used of {} in the manifest{}{}\n", rep.probes_used, rep.probes_in + srep.skipped,
                rep.skipped ? fmt::format(", {} skipped as bad", rep.skipped) : "",
                rep.subsampled_out ? fmt::format(", {} dropped by --subsample", rep.subsampled_out) : "");
-    fmt::print("buckets   {} ({}), {} blocks{}\n", rep.buckets, rep.octahedral ? fmt::format("{0}x{0} octahedral", rep.octahedral) : "one per pixel",
-               rep.blocks, rep.buckets_reused ? ", reused" : "");
+    fmt::print("buckets   {} ({}), {} blocks{}\n", rep.buckets,
+               rep.octahedral ? fmt::format("{0}x{0} octahedral", rep.octahedral) : "one per pixel", rep.blocks,
+               rep.buckets_reused ? ", reused" : "");
     fmt::print("samples   {} ({:.3g}/s), {:.2f}% of grid point × bucket pairs repaired\n", rep.samples,
                rep.samples / std::max(rep.t_total, 1e-9), 100 * rep.fraction_uncovered);
-    fmt::print("time      sort {:.1f}s, project+repair {:.1f}s, SH products {:.1f}s ({:.1f} GFLOP/s), total {:.1f}s\n", rep.t_sort,
-               rep.t_project, rep.t_accumulate, rep.gemm_flops * 1e-9 / std::max(rep.t_accumulate, 1e-9), rep.t_total);
+    fmt::print("time      sort {:.1f}s, project+repair {:.1f}s, SH products {:.1f}s ({:.1f} GFLOP/s), total {:.1f}s\n",
+               rep.t_sort, rep.t_project, rep.t_accumulate, rep.gemm_flops * 1e-9 / std::max(rep.t_accumulate, 1e-9),
+               rep.t_total);
     if (job)
-      fmt::print("ranks     {}: read {:.1f}s, exchange {:.1f}s ({:.3g} MB sent by the busiest rank), cross-validation {:.1f}s, "
-                 "project {:.1f}s (repair {:.1f}s), SH {:.1f}s, reduce {:.1f}s, write {:.1f}s; peak memory {:.0f} MB per rank\n",
-                 drep.ranks, drep.t_read, drep.t_exchange, drep.bytes_sent * 1e-6, drep.t_crossval, drep.t_project, drep.t_repair,
-                 drep.t_accumulate, drep.t_reduce, t_write, drep.peak_rss_bytes * 1e-6);
+      fmt::print(
+          "ranks     {}: read {:.1f}s, exchange {:.1f}s ({:.3g} MB sent by the busiest rank), cross-validation "
+          "{:.1f}s, "
+          "project {:.1f}s (repair {:.1f}s), SH {:.1f}s, reduce {:.1f}s, write {:.1f}s; peak memory {:.0f} MB per "
+          "rank\n",
+          drep.ranks, drep.t_read, drep.t_exchange, drep.bytes_sent * 1e-6, drep.t_crossval, drep.t_project,
+          drep.t_repair, drep.t_accumulate, drep.t_reduce, t_write, drep.peak_rss_bytes * 1e-6);
   });
 }
 
@@ -221,12 +269,17 @@ void setup_build(CLI::App& app) {
   auto& bd0 = o->bd;
   app.add_option("sequence", o->seq, "iblkit.sequence/1 manifest")->required();
   app.add_option("-o,--out", o->out, "output .shgrid")->required();
-  app.add_option("--grid", o->grid, "grid points: N, NX,NY,NZ, or auto (cross-validated choice among 8…64 within --memory)")->capture_default_str();
-  app.add_option("--bands", bd0.bands, "SH bands (5 = 25 coefficients)")->capture_default_str()
+  app.add_option("--grid", o->grid,
+                 "grid points: N, NX,NY,NZ, or auto (cross-validated choice among 8…64 within --memory)")
+      ->capture_default_str();
+  app.add_option("--bands", bd0.bands, "SH bands (5 = 25 coefficients)")
+      ->capture_default_str()
       ->check(CLI::Range(ilf::kMinBuildBands, ilf::kMaxBuildBands));
   app.add_option("--volume", o->volume, "grid volume minx,miny,minz,maxx,maxy,maxz (default: the sequence's)");
-  app.add_option("--kernel", o->kernel, "Gaussian kernel support diameter in grid cells, or auto (cross-validated choice among 1.5…4)")
-      ->capture_default_str()->check([](const std::string& v) {
+  app.add_option("--kernel", o->kernel,
+                 "Gaussian kernel support diameter in grid cells, or auto (cross-validated choice among 1.5…4)")
+      ->capture_default_str()
+      ->check([](const std::string& v) {
         if (v == "auto") return std::string();
         char* end = nullptr;
         std::strtod(v.c_str(), &end);
@@ -234,49 +287,72 @@ void setup_build(CLI::App& app) {
         return positive_number(v);
       });
   bd0.crossval.folds = 5;  // the CLI cross-validates by default
-  app.add_option("--cv-folds", bd0.crossval.folds, "k-fold cross-validation of the grid against its own probes (0: off)")
-      ->capture_default_str()->check([](const std::string& v) {
+  app.add_option("--cv-folds", bd0.crossval.folds,
+                 "k-fold cross-validation of the grid against its own probes (0: off)")
+      ->capture_default_str()
+      ->check([](const std::string& v) {
         char* end = nullptr;
         long n = std::strtol(v.c_str(), &end, 10);
-        return end != v.c_str() && *end == '\0' && (n == 0 || (n >= 2 && n <= 255)) ? std::string() : "expected 0 or 2 to 255, got " + v;
+        return end != v.c_str() && *end == '\0' && (n == 0 || (n >= 2 && n <= 255))
+                   ? std::string()
+                   : "expected 0 or 2 to 255, got " + v;
       });
-  app.add_option("--error-grid", o->error_grid, "write the cross-validated error volume here (a one-band .shgrid; ilf slice shows it)");
-  app.add_option("--repair", o->repair, "filling of grid points no ray reached: mip (the paper's), pullpush, none")->capture_default_str();
+  app.add_option("--error-grid", o->error_grid,
+                 "write the cross-validated error volume here (a one-band .shgrid; ilf slice shows it)");
+  app.add_option("--repair", o->repair, "filling of grid points no ray reached: mip (the paper's), pullpush, none")
+      ->capture_default_str();
   app.add_option("--memory", o->memory, "peak memory budget (e.g. 2G, 512M)")->capture_default_str();
   app.add_option("--buckets", o->buckets, "folder for the direction buckets (default: OUT.buckets; reused by re-runs)");
-  app.add_option("--directions", o->directions, "direction buckets: auto, pixel (one per probe pixel, the paper's) or N (N×N octahedral cells)")->capture_default_str();
-  o->subsample_opt = app.add_option("--subsample", o->subsample, "drop probes whose difference energy to both neighbours is below this (e.g. 0.05)");
-  app.add_option("--subsample-distance", o->subsample_dist, "… and whose neighbours lie within this many metres")->capture_default_str();
+  app.add_option("--directions", o->directions,
+                 "direction buckets: auto, pixel (one per probe pixel, the paper's) or N (N×N octahedral cells)")
+      ->capture_default_str();
+  o->subsample_opt = app.add_option("--subsample", o->subsample,
+                                    "drop probes whose difference energy to both neighbours is below this (e.g. 0.05)");
+  app.add_option("--subsample-distance", o->subsample_dist, "… and whose neighbours lie within this many metres")
+      ->capture_default_str();
   app.add_option("--vdb", o->vdb, "also write the grid as OpenVDB (one Vec3f grid per coefficient)");
-  app.add_flag("--skip-bad", bd0.buckets.skip_bad, "skip bad probes (missing/unreadable frames, wrong size, NaN, outside the volume, duplicates) and report how many");
+  app.add_flag("--skip-bad", bd0.buckets.skip_bad,
+               "skip bad probes (missing/unreadable frames, wrong size, NaN, outside the volume, duplicates) and "
+               "report how many");
   app.add_flag("--sanitize", bd0.buckets.sanitize, "replace NaN/Inf/negative pixels by 0 instead of failing");
   app.add_flag("--no-reuse", o->no_reuse, "rebuild the direction buckets even when an earlier run's match");
-  app.add_flag("--drop-buckets", o->drop_buckets, "remove the direction buckets once the grid is written (a re-run sorts again)");
-  app.add_flag("--no-parallax", o->no_parallax, "ignore the manifest's ball_radius: every ray through the probe position (single viewpoint)");
-  app.add_flag("--mpi", o->mpi, "build as a rank of an MPI job (the default under mpirun): mpirun -np N iblkit ilf build …");
-  app.footer("Examples:\n  iblkit ilf build cap/sequence.json --grid 8 --bands 5 --out room8.shgrid\n"
-             "  mpirun -np 4 iblkit ilf build captures/sequence.json --grid 32 --out room.shgrid   (docs/ilf.md, \"On a cluster\")");
+  app.add_flag("--drop-buckets", o->drop_buckets,
+               "remove the direction buckets once the grid is written (a re-run sorts again)");
+  app.add_flag("--no-parallax", o->no_parallax,
+               "ignore the manifest's ball_radius: every ray through the probe position (single viewpoint)");
+  app.add_flag("--mpi", o->mpi,
+               "build as a rank of an MPI job (the default under mpirun): mpirun -np N iblkit ilf build …");
+  app.footer(
+      "Examples:\n  iblkit ilf build cap/sequence.json --grid 8 --bands 5 --out room8.shgrid\n"
+      "  mpirun -np 4 iblkit ilf build captures/sequence.json --grid 32 --out room.shgrid   (docs/ilf.md, \"On a "
+      "cluster\")");
   app.callback([o, &app] {
     bool grid_auto = is_auto(o->grid);
     auto grid = grid_auto ? std::vector<int>{16, 16, 16} : parse_grid(o->grid);
     if (!o->vdb.empty() && !ilf::have_vdb()) ilf::write_vdb(o->vdb, ilf::SHGrid());  // fails now, not after the build
     ilf::BuildDesc bd = o->bd;
-    bd.nx = grid[0]; bd.ny = grid[1]; bd.nz = grid[2];
+    bd.nx = grid[0];
+    bd.ny = grid[1];
+    bd.nz = grid[2];
     bd.auto_grid = grid_auto;
     bd.auto_kernel = is_auto(o->kernel);
     if (!bd.auto_kernel) bd.project.kernel_cells = std::stod(o->kernel);
-    if (!o->error_grid.empty() && bd.crossval.folds < 2) fail(ErrorKind::Value, "--error-grid needs the cross-validation (--cv-folds ≥ 2)");
+    if (!o->error_grid.empty() && bd.crossval.folds < 2)
+      fail(ErrorKind::Value, "--error-grid needs the cross-validation (--cv-folds ≥ 2)");
     if (!o->volume.empty()) bd.volume = parse_box(o->volume);
     bd.project.repair = ilf::parse_repair(o->repair);
     bd.buckets.memory_bytes = parse_bytes(o->memory);
     bd.buckets.dir = o->buckets.empty() ? o->out + ".buckets" : o->buckets;
     bd.buckets.reuse = !o->no_reuse;
     bd.ball_parallax = !o->no_parallax;
-    if (o->directions == "auto") bd.buckets.octahedral = -1;
-    else if (o->directions == "pixel") bd.buckets.octahedral = 0;
+    if (o->directions == "auto")
+      bd.buckets.octahedral = -1;
+    else if (o->directions == "pixel")
+      bd.buckets.octahedral = 0;
     else {
       auto v = iblcli::parse_int_list(o->directions, "--directions");
-      if (v.size() != 1 || v[0] < 2 || v[0] > 1024) fail(ErrorKind::Value, "--directions: expected auto, pixel or N in [2, 1024]");
+      if (v.size() != 1 || v[0] < 2 || v[0] > 1024)
+        fail(ErrorKind::Value, "--directions: expected auto, pixel or N in [2, 1024]");
       bd.buckets.octahedral = v[0];
     }
     if (o->subsample_opt->count() > 0) bd.subsample = ilf::SubsampleDesc{o->subsample, o->subsample_dist};
@@ -291,7 +367,10 @@ void setup_build(CLI::App& app) {
 }
 
 // `ilf query` on a dense or an adaptive grid (the same lookups).
-struct QueryOpts { std::string grid, at, normal, dir, points; double exponent = 4; };
+struct QueryOpts {
+  std::string grid, at, normal, dir, points;
+  double exponent = 4;
+};
 
 // --points: the coefficients at every point of a JSON array [[x, y, z], …].
 template <typename Grid>
@@ -318,14 +397,17 @@ void query(const Grid& g, const QueryOpts& opts) {
   const QueryOpts* o = &opts;
   if (!o->points.empty()) return query_points(g, o->points);
   if (o->at.empty()) fail(ErrorKind::Value, "ilf query: give --at x,y,z or --points FILE");
-  Vec3 p = iblcli::parse_vec3(o->at, "--at"), n = o->normal.empty() ? Vec3{0, 1, 0} : iblcli::parse_vec3(o->normal, "--normal");
+  Vec3 p = iblcli::parse_vec3(o->at, "--at"),
+       n = o->normal.empty() ? Vec3{0, 1, 0} : iblcli::parse_vec3(o->normal, "--normal");
   require_point("--at", p);
-  if (!g.grid().volume.contains(p)) iblcli::info("note: the point lies outside the grid volume; values are clamped to its boundary");
+  if (!g.grid().volume.contains(p))
+    iblcli::info("note: the point lies outside the grid volume; values are clamped to its boundary");
   auto c = g.coeffs_at(p);
   Vec3 e = g.irradiance(p, n);
   nlohmann::json coeffs = nlohmann::json::array();
   for (auto& v : c.c) coeffs.push_back({v.x, v.y, v.z});
-  nlohmann::json j = {{"at", {p.x, p.y, p.z}}, {"normal", {n.x, n.y, n.z}}, {"irradiance", {e.x, e.y, e.z}}, {"coefficients", coeffs}};
+  nlohmann::json j = {
+      {"at", {p.x, p.y, p.z}}, {"normal", {n.x, n.y, n.z}}, {"irradiance", {e.x, e.y, e.z}}, {"coefficients", coeffs}};
   if constexpr (std::is_same_v<Grid, ilf::AdaptiveGrid>) j["level"] = g.level_at(p);
   Vec3 L, G;
   if (!o->dir.empty()) {
@@ -351,14 +433,19 @@ void setup_query(CLI::App& app) {
   auto* o = iblcli::app_owned<QueryOpts>();
   app.add_option("grid", o->grid, ".shgrid or .shtree file")->required();
   app.add_option("--at", o->at, "point x,y,z");
-  app.add_option("--points", o->points, "instead of --at: a JSON array of points [[x, y, z], …]; --json prints the coefficients at each");
+  app.add_option("--points", o->points,
+                 "instead of --at: a JSON array of points [[x, y, z], …]; --json prints the coefficients at each");
   app.add_option("--normal", o->normal, "irradiance for this normal x,y,z (default +Y)");
   app.add_option("--dir", o->dir, "also radiance towards, and Phong-glossy response around, this direction");
   app.add_option("--exponent", o->exponent, "Phong exponent for --dir")->capture_default_str();
-  app.footer("Examples:\n  iblkit ilf query room.shgrid --at 0.1,0.5,0 --normal 0,1,0\n  iblkit ilf query room.shtree --at 0.1,0.5,0 --normal 0,1,0");
+  app.footer(
+      "Examples:\n  iblkit ilf query room.shgrid --at 0.1,0.5,0 --normal 0,1,0\n  iblkit ilf query room.shtree --at "
+      "0.1,0.5,0 --normal 0,1,0");
   app.callback([o] {
-    if (ilf::is_adaptive_file(o->grid)) query(ilf::read_adaptive(o->grid), *o);
-    else query(ilf::read_shgrid(o->grid), *o);
+    if (ilf::is_adaptive_file(o->grid))
+      query(ilf::read_adaptive(o->grid), *o);
+    else
+      query(ilf::read_shgrid(o->grid), *o);
   });
 }
 
@@ -393,20 +480,30 @@ Image irradiance_slice(const Grid& g, int axis, double value, int size, double n
 }
 
 void setup_slice(CLI::App& app) {
-  struct Opts { std::string grid, plane, out; int size = 256; bool down = false, levels = false; double exposure = 0, max_error = 0.5; };
+  struct Opts {
+    std::string grid, plane, out;
+    int size = 256;
+    bool down = false, levels = false;
+    double exposure = 0, max_error = 0.5;
+  };
   auto* o = iblcli::app_owned<Opts>();
   app.add_option("grid", o->grid, ".shgrid or .shtree file")->required();
   app.add_option("--plane", o->plane, "axis-aligned plane, e.g. y=0.3")->required();
   app.add_option("-o,--out", o->out, "output image (.png tone mapped, .exr linear W/m²)")->required();
   app.add_option("--size", o->size, "image width in pixels")->capture_default_str()->check(CLI::Range(8, 8192));
   app.add_flag("--down", o->down, "normal along the negative axis (default: positive)");
-  app.add_flag("--levels", o->levels, "adaptive grids (.shtree): draw the level that answers at each pixel (white: the fine grid's, black: the top)");
+  app.add_flag(
+      "--levels", o->levels,
+      "adaptive grids (.shtree): draw the level that answers at each pixel (white: the fine grid's, black: the top)");
   app.add_option("--max-error", o->max_error, "error volumes (ilf build --error-grid): the relative error shown red")
-      ->capture_default_str()->check(positive_number);
-  app.footer("An error volume (ilf build --error-grid) is drawn as its relative error in false colour (.png: black 0,\n"
-             "blue, green, yellow, red at --max-error; grey: under one probe's weight near, no figure) or as its three channels (.exr: relative, absolute, weight).\n"
-             "Examples:\n  iblkit ilf slice room.shgrid --plane y=0.3 --out slice.png\n"
-             "  iblkit ilf slice room.shtree --plane y=0.3 --levels --out levels.png");
+      ->capture_default_str()
+      ->check(positive_number);
+  app.footer(
+      "An error volume (ilf build --error-grid) is drawn as its relative error in false colour (.png: black 0,\n"
+      "blue, green, yellow, red at --max-error; grey: under one probe's weight near, no figure) or as its three "
+      "channels (.exr: relative, absolute, weight).\n"
+      "Examples:\n  iblkit ilf slice room.shgrid --plane y=0.3 --out slice.png\n"
+      "  iblkit ilf slice room.shtree --plane y=0.3 --levels --out levels.png");
   app.callback([o] {
     const bool adaptive = ilf::is_adaptive_file(o->grid);
     if (o->levels && !adaptive) fail(ErrorKind::Value, "--levels: {} is not an adaptive grid (.shtree)", o->grid);
@@ -416,7 +513,9 @@ void setup_slice(CLI::App& app) {
     int axis = ax == "x" ? 0 : ax == "y" ? 1 : ax == "z" ? 2 : -1;
     if (axis < 0) fail(ErrorKind::Value, "--plane: expected x=V, y=V or z=V, got \"{}\"", o->plane);
     double val;
-    try { val = std::stod(o->plane.substr(eq + 1)); } catch (const std::exception&) {
+    try {
+      val = std::stod(o->plane.substr(eq + 1));
+    } catch (const std::exception&) {
       fail(ErrorKind::Value, "--plane: \"{}\" is not a number", o->plane.substr(eq + 1));
     }
     if (!std::isfinite(val) || std::abs(val) > kMaxCoordinate)
@@ -425,13 +524,15 @@ void setup_slice(CLI::App& app) {
     std::string ext = fs::path(o->out).extension().string();
     if (g.content() == "cv-error") {
       Image e = ilf::error_slice(g, axis, val, o->size);
-      if (ext == ".png" || ext == ".jpg") io::write_image(o->out, io::tonemap(ilf::error_colours(e, o->max_error), [] {
-        io::ToneMapDesc td;
-        td.auto_exposure = false;
-        td.curve = io::ToneCurve::Clamp;
-        return td;
-      }()));
-      else io::write_image(o->out, e);
+      if (ext == ".png" || ext == ".jpg")
+        io::write_image(o->out, io::tonemap(ilf::error_colours(e, o->max_error), [] {
+                          io::ToneMapDesc td;
+                          td.auto_exposure = false;
+                          td.curve = io::ToneCurve::Clamp;
+                          return td;
+                        }()));
+      else
+        io::write_image(o->out, e);
       double mx = 0, sum = 0;
       for (int y = 0; y < e.height(); ++y)
         for (int x = 0; x < e.width(); ++x) {
@@ -439,30 +540,45 @@ void setup_slice(CLI::App& app) {
           sum += e.rgb(x, y).x;
         }
       double mean = sum / (double(e.width()) * e.height());
-      iblcli::emit({{"out", o->out}, {"width", e.width()}, {"height", e.height()}, {"content", "cv-error"}, {"max_rel_error", mx},
+      iblcli::emit({{"out", o->out},
+                    {"width", e.width()},
+                    {"height", e.height()},
+                    {"content", "cv-error"},
+                    {"max_rel_error", mx},
                     {"mean_rel_error", mean}},
-                   [&] { fmt::print("wrote {} ({}x{}), cross-validated relative error: mean {:.3f}, max {:.3f}\n", o->out, e.width(), e.height(), mean, mx); });
+                   [&] {
+                     fmt::print("wrote {} ({}x{}), cross-validated relative error: mean {:.3f}, max {:.3f}\n", o->out,
+                                e.width(), e.height(), mean, mx);
+                   });
       return;
     }
-    if (!g.content().empty()) fail(ErrorKind::Value, "{}: content \"{}\" is neither radiance SH nor cv-error", o->grid, g.content());
-    Image img = adaptive ? irradiance_slice(ilf::read_adaptive(o->grid), axis, val, o->size, o->down ? -1 : 1, o->levels)
-                         : irradiance_slice(g, axis, val, o->size, o->down ? -1 : 1);
+    if (!g.content().empty())
+      fail(ErrorKind::Value, "{}: content \"{}\" is neither radiance SH nor cv-error", o->grid, g.content());
+    Image img = adaptive
+                    ? irradiance_slice(ilf::read_adaptive(o->grid), axis, val, o->size, o->down ? -1 : 1, o->levels)
+                    : irradiance_slice(g, axis, val, o->size, o->down ? -1 : 1);
     if (o->levels) {
       io::ToneMapDesc td;
       td.auto_exposure = false;
       td.curve = io::ToneCurve::Clamp;
-      if (ext == ".png" || ext == ".jpg") io::write_image(o->out, io::tonemap(img, td));
-      else io::write_image(o->out, img);
-      iblcli::emit({{"out", o->out}, {"width", img.width()}, {"height", img.height()}, {"content", "levels"}},
-                   [&] { fmt::print("wrote {} ({}x{}), the answering level (white: level 0)\n", o->out, img.width(), img.height()); });
+      if (ext == ".png" || ext == ".jpg")
+        io::write_image(o->out, io::tonemap(img, td));
+      else
+        io::write_image(o->out, img);
+      iblcli::emit({{"out", o->out}, {"width", img.width()}, {"height", img.height()}, {"content", "levels"}}, [&] {
+        fmt::print("wrote {} ({}x{}), the answering level (white: level 0)\n", o->out, img.width(), img.height());
+      });
       return;
     }
-    if (ext == ".png" || ext == ".jpg") io::write_image(o->out, io::tonemap(img));
-    else io::write_image(o->out, img);
+    if (ext == ".png" || ext == ".jpg")
+      io::write_image(o->out, io::tonemap(img));
+    else
+      io::write_image(o->out, img);
     double mx = 0;
     for (size_t i = 0; i < img.size(); ++i) mx = std::max<double>(mx, img.data()[i]);
-    iblcli::emit({{"out", o->out}, {"width", img.width()}, {"height", img.height()}, {"max_irradiance", mx}},
-                 [&] { fmt::print("wrote {} ({}x{}), max irradiance {:.4g} W/m²\n", o->out, img.width(), img.height(), mx); });
+    iblcli::emit({{"out", o->out}, {"width", img.width()}, {"height", img.height()}, {"max_irradiance", mx}}, [&] {
+      fmt::print("wrote {} ({}x{}), max irradiance {:.4g} W/m²\n", o->out, img.width(), img.height(), mx);
+    });
   });
 }
 
@@ -471,7 +587,10 @@ nlohmann::json levels_json(const ilf::AdaptiveGrid& t) {
   nlohmann::json levels = nlohmann::json::array();
   for (int l = 0; l < t.levels(); ++l) {
     const auto& L = t.level(l);
-    levels.push_back({{"level", l}, {"step", L.step}, {"points", {L.n[0], L.n[1], L.n[2]}}, {"bricks", L.bricks.size()},
+    levels.push_back({{"level", l},
+                      {"step", L.step},
+                      {"points", {L.n[0], L.n[1], L.n[2]}},
+                      {"bricks", L.bricks.size()},
                       {"brick_slots", L.map.size()}});
   }
   return levels;
@@ -483,26 +602,36 @@ double dense_file_bytes(const ilf::AdaptiveGrid& t) { return double(t.grid().cou
 void print_levels(const ilf::AdaptiveGrid& t) {
   for (int l = 0; l < t.levels(); ++l) {
     const auto& L = t.level(l);
-    fmt::print("  level {:<2} step {:<4} {}x{}x{} points, {} of {} bricks\n", l, L.step, L.n[0], L.n[1], L.n[2], L.bricks.size(), L.map.size());
+    fmt::print("  level {:<2} step {:<4} {}x{}x{} points, {} of {} bricks\n", l, L.step, L.n[0], L.n[1], L.n[2],
+               L.bricks.size(), L.map.size());
   }
 }
 
 void adaptive_info(const std::string& path, const ilf::AdaptiveGrid& t) {
   const auto& gd = t.grid();
   const double bytes = double(t.file_bytes()), dense = dense_file_bytes(t);
-  nlohmann::json j = {{"file", path}, {"adaptive", true}, {"bands", t.bands()}, {"coefficients", t.coeff_count()},
-                      {"resolution", {gd.nx, gd.ny, gd.nz}}, {"min", {gd.volume.min.x, gd.volume.min.y, gd.volume.min.z}},
-                      {"max", {gd.volume.max.x, gd.volume.max.y, gd.volume.max.z}}, {"brick", t.brick()}, {"tolerance", t.tolerance()},
-                      {"rms", t.rms()}, {"stored_points", t.stored_points()}, {"bytes", bytes}, {"dense_bytes", dense},
+  nlohmann::json j = {{"file", path},
+                      {"adaptive", true},
+                      {"bands", t.bands()},
+                      {"coefficients", t.coeff_count()},
+                      {"resolution", {gd.nx, gd.ny, gd.nz}},
+                      {"min", {gd.volume.min.x, gd.volume.min.y, gd.volume.min.z}},
+                      {"max", {gd.volume.max.x, gd.volume.max.y, gd.volume.max.z}},
+                      {"brick", t.brick()},
+                      {"tolerance", t.tolerance()},
+                      {"rms", t.rms()},
+                      {"stored_points", t.stored_points()},
+                      {"bytes", bytes},
+                      {"dense_bytes", dense},
                       {"levels", levels_json(t)}};
   iblcli::emit(j, [&] {
     fmt::print("file        {}\n", path);
-    fmt::print("grid        adaptive, fine grid {}x{}x{}, {} bands ({} coefficients), bricks of {}³ cells\n", gd.nx, gd.ny, gd.nz,
-               t.bands(), t.coeff_count(), t.brick());
-    fmt::print("volume      ({:.4g}, {:.4g}, {:.4g}) .. ({:.4g}, {:.4g}, {:.4g})\n", gd.volume.min.x, gd.volume.min.y, gd.volume.min.z,
-               gd.volume.max.x, gd.volume.max.y, gd.volume.max.z);
-    fmt::print("stored      {} points, {:.2f} MB ({:.1f}% of the dense fine grid's {:.2f} MB)\n", t.stored_points(), bytes / 1048576.0,
-               100 * bytes / dense, dense / 1048576.0);
+    fmt::print("grid        adaptive, fine grid {}x{}x{}, {} bands ({} coefficients), bricks of {}³ cells\n", gd.nx,
+               gd.ny, gd.nz, t.bands(), t.coeff_count(), t.brick());
+    fmt::print("volume      ({:.4g}, {:.4g}, {:.4g}) .. ({:.4g}, {:.4g}, {:.4g})\n", gd.volume.min.x, gd.volume.min.y,
+               gd.volume.min.z, gd.volume.max.x, gd.volume.max.y, gd.volume.max.z);
+    fmt::print("stored      {} points, {:.2f} MB ({:.1f}% of the dense fine grid's {:.2f} MB)\n", t.stored_points(),
+               bytes / 1048576.0, 100 * bytes / dense, dense / 1048576.0);
     fmt::print("tolerance   {:g} × RMS {:.6g} (per fine point, L2 of the coefficients)\n", t.tolerance(), t.rms());
     print_levels(t);
   });
@@ -524,33 +653,47 @@ void setup_info(CLI::App& app) {
         lo = std::min(lo, v);
         hi = std::max(hi, v);
       }
-    nlohmann::json j = {{"file", *path}, {"bands", g.bands()}, {"coefficients", K}, {"resolution", {gd.nx, gd.ny, gd.nz}},
+    nlohmann::json j = {{"file", *path},
+                        {"bands", g.bands()},
+                        {"coefficients", K},
+                        {"resolution", {gd.nx, gd.ny, gd.nz}},
                         {"min", {gd.volume.min.x, gd.volume.min.y, gd.volume.min.z}},
                         {"max", {gd.volume.max.x, gd.volume.max.y, gd.volume.max.z}},
-                        {"bytes", g.data().size() * 4}, {"c00_range", {lo, hi}}};
+                        {"bytes", g.data().size() * 4},
+                        {"c00_range", {lo, hi}}};
     if (!g.content().empty()) j["content"] = g.content();
     iblcli::emit(j, [&] {
       fmt::print("file        {}\n", *path);
-      fmt::print("grid        {}x{}x{}, {} bands ({} coefficients), {:.1f} MB\n", gd.nx, gd.ny, gd.nz, g.bands(), K, g.data().size() * 4 / 1048576.0);
-      fmt::print("volume      ({:.4g}, {:.4g}, {:.4g}) .. ({:.4g}, {:.4g}, {:.4g})\n", gd.volume.min.x, gd.volume.min.y, gd.volume.min.z,
-                 gd.volume.max.x, gd.volume.max.y, gd.volume.max.z);
+      fmt::print("grid        {}x{}x{}, {} bands ({} coefficients), {:.1f} MB\n", gd.nx, gd.ny, gd.nz, g.bands(), K,
+                 g.data().size() * 4 / 1048576.0);
+      fmt::print("volume      ({:.4g}, {:.4g}, {:.4g}) .. ({:.4g}, {:.4g}, {:.4g})\n", gd.volume.min.x, gd.volume.min.y,
+                 gd.volume.min.z, gd.volume.max.x, gd.volume.max.y, gd.volume.max.z);
       fmt::print("c00 range   {:.6g} .. {:.6g}\n", lo, hi);
-      if (!g.content().empty()) fmt::print("content     {} (channel 1: relative error, 2: absolute, 3: probe weight)\n", g.content());
+      if (!g.content().empty())
+        fmt::print("content     {} (channel 1: relative error, 2: absolute, 3: probe weight)\n", g.content());
     });
   });
 }
 
 void setup_adapt(CLI::App& app) {
-  struct Opts { std::string grid, out; ilf::AdaptDesc d; };
+  struct Opts {
+    std::string grid, out;
+    ilf::AdaptDesc d;
+  };
   auto* o = iblcli::app_owned<Opts>();
   app.add_option("grid", o->grid, "dense .shgrid (the fine grid)")->required();
   app.add_option("-o,--out", o->out, "output .shtree")->required();
-  app.add_option("--tolerance", o->d.tolerance, "largest error kept at any fine point: L2 of its coefficients' difference, relative to the grid's RMS")
-      ->capture_default_str()->check(CLI::Range(0.0, 1e6));
-  app.add_option("--brick", o->d.brick, "cells per brick axis")->capture_default_str()->check(CLI::Range(ilf::kMinBrick, ilf::kMaxBrick));
-  app.footer("Keeps the fine grid's points only where a coarser level (each halves the resolution) misses them by more\n"
-             "than --tolerance; query, slice, info read the result, densify writes a dense grid back (docs/ilf.md).\n"
-             "Example:\n  iblkit ilf adapt room.shgrid --tolerance 0.02 --out room.shtree");
+  app.add_option("--tolerance", o->d.tolerance,
+                 "largest error kept at any fine point: L2 of its coefficients' difference, relative to the grid's RMS")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1e6));
+  app.add_option("--brick", o->d.brick, "cells per brick axis")
+      ->capture_default_str()
+      ->check(CLI::Range(ilf::kMinBrick, ilf::kMaxBrick));
+  app.footer(
+      "Keeps the fine grid's points only where a coarser level (each halves the resolution) misses them by more\n"
+      "than --tolerance; query, slice, info read the result, densify writes a dense grid back (docs/ilf.md).\n"
+      "Example:\n  iblkit ilf adapt room.shgrid --tolerance 0.02 --out room.shtree");
   app.callback([o] {
     auto t0 = std::chrono::steady_clock::now();
     auto fine = ilf::read_shgrid(o->grid);
@@ -573,37 +716,52 @@ void setup_adapt(CLI::App& app) {
     }
     const double rel_l2 = den > 0 ? std::sqrt(num / den) : 0.0, bytes = double(t.file_bytes());
     const double dense = double(std::filesystem::file_size(o->grid));
-    nlohmann::json j = {{"grid", o->grid}, {"out", o->out}, {"tolerance", t.tolerance()}, {"brick", t.brick()}, {"rms", t.rms()},
-                        {"stored_points", t.stored_points()}, {"fine_points", fine.grid().count()}, {"bytes", bytes},
-                        {"dense_bytes", dense}, {"ratio", bytes / dense}, {"max_point_error", t.rms() > 0 ? worst / t.rms() : 0.0},
-                        {"rel_l2_to_fine", rel_l2}, {"seconds", seconds}, {"levels", levels_json(t)}};
+    nlohmann::json j = {{"grid", o->grid},
+                        {"out", o->out},
+                        {"tolerance", t.tolerance()},
+                        {"brick", t.brick()},
+                        {"rms", t.rms()},
+                        {"stored_points", t.stored_points()},
+                        {"fine_points", fine.grid().count()},
+                        {"bytes", bytes},
+                        {"dense_bytes", dense},
+                        {"ratio", bytes / dense},
+                        {"max_point_error", t.rms() > 0 ? worst / t.rms() : 0.0},
+                        {"rel_l2_to_fine", rel_l2},
+                        {"seconds", seconds},
+                        {"levels", levels_json(t)}};
     iblcli::emit(j, [&] {
-      fmt::print("wrote {} ({:.2f} MB, {:.1f}% of {}'s {:.2f} MB) in {:.2f}s\n", o->out, bytes / 1048576.0, 100 * bytes / dense, o->grid,
-                 dense / 1048576.0, seconds);
-      fmt::print("to the fine grid: largest point error {:.4g} × RMS (tolerance {:g}), relative L2 {:.4g}\n", t.rms() > 0 ? worst / t.rms() : 0.0,
-                 t.tolerance(), rel_l2);
+      fmt::print("wrote {} ({:.2f} MB, {:.1f}% of {}'s {:.2f} MB) in {:.2f}s\n", o->out, bytes / 1048576.0,
+                 100 * bytes / dense, o->grid, dense / 1048576.0, seconds);
+      fmt::print("to the fine grid: largest point error {:.4g} × RMS (tolerance {:g}), relative L2 {:.4g}\n",
+                 t.rms() > 0 ? worst / t.rms() : 0.0, t.tolerance(), rel_l2);
       print_levels(t);
     });
   });
 }
 
 void setup_densify(CLI::App& app) {
-  struct Opts { std::string tree, out, grid; };
+  struct Opts {
+    std::string tree, out, grid;
+  };
   auto* o = iblcli::app_owned<Opts>();
   app.add_option("tree", o->tree, "adaptive grid (.shtree)")->required();
   app.add_option("-o,--out", o->out, "output .shgrid")->required();
   app.add_option("--grid", o->grid, "points N or NX,NY,NZ (default: the fine grid's)");
-  app.footer("The dense grid the renderers, export-threejs and the viewer load (they also read .shtree this way).\n"
-             "Example:\n  iblkit ilf densify room.shtree --out room-dense.shgrid");
+  app.footer(
+      "The dense grid the renderers, export-threejs and the viewer load (they also read .shtree this way).\n"
+      "Example:\n  iblkit ilf densify room.shtree --out room-dense.shgrid");
   app.callback([o] {
     auto t = ilf::read_adaptive(o->tree);
     auto n = o->grid.empty() ? std::vector<int>{t.grid().nx, t.grid().ny, t.grid().nz} : parse_grid(o->grid);
-    require_allocation(fmt::format("densify: {}x{}x{} points of {} bands", n[0], n[1], n[2], t.bands()), double(n[0]) * n[1] * n[2] * t.coeff_count() * 3,
-                       sizeof(float), "choose a coarser --grid");
+    require_allocation(fmt::format("densify: {}x{}x{} points of {} bands", n[0], n[1], n[2], t.bands()),
+                       double(n[0]) * n[1] * n[2] * t.coeff_count() * 3, sizeof(float), "choose a coarser --grid");
     auto g = t.to_dense(n[0], n[1], n[2]);
     ilf::write_shgrid(o->out, g);
-    iblcli::emit({{"tree", o->tree}, {"out", o->out}, {"resolution", {n[0], n[1], n[2]}}, {"bytes", g.data().size() * 4}},
-                 [&] { fmt::print("wrote {} ({}x{}x{}, {:.2f} MB)\n", o->out, n[0], n[1], n[2], g.data().size() * 4 / 1048576.0); });
+    iblcli::emit(
+        {{"tree", o->tree}, {"out", o->out}, {"resolution", {n[0], n[1], n[2]}}, {"bytes", g.data().size() * 4}}, [&] {
+          fmt::print("wrote {} ({}x{}x{}, {:.2f} MB)\n", o->out, n[0], n[1], n[2], g.data().size() * 4 / 1048576.0);
+        });
   });
 }
 
@@ -612,13 +770,18 @@ void setup_synth(CLI::App& app) {
   bool* pfm = iblcli::app_owned<bool>(!d->half);
   app.add_option("-o,--out", d->out_dir, "output folder (frames/ and sequence.json)")->required();
   app.add_option("--probes", d->probes, "number of probes")->capture_default_str()->check(CLI::Range(1, 1000000));
-  app.add_option("--size", d->size, "mirror-ball frame size in pixels")->capture_default_str()->check(CLI::Range(8, 4096));
-  app.add_option("--supersample", d->supersample, "sub-samples per pixel axis")->capture_default_str()->check(CLI::Range(1, 16));
+  app.add_option("--size", d->size, "mirror-ball frame size in pixels")
+      ->capture_default_str()
+      ->check(CLI::Range(8, 4096));
+  app.add_option("--supersample", d->supersample, "sub-samples per pixel axis")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 16));
   app.add_option("--seed", d->seed, "random positions seed")->capture_default_str();
   app.add_flag("--pfm", *pfm, "float PFM frames instead of half-float EXR");
-  app.footer("A closed-form light field (three emitting spheres outside a 1 m cube and a sky) captured by\n"
-             "mirror balls at random positions in the cube: for tests, benchmarks and trying the pipeline.\n"
-             "Example:\n  iblkit ilf synth --out synth --probes 50 --size 32");
+  app.footer(
+      "A closed-form light field (three emitting spheres outside a 1 m cube and a sky) captured by\n"
+      "mirror balls at random positions in the cube: for tests, benchmarks and trying the pipeline.\n"
+      "Example:\n  iblkit ilf synth --out synth --probes 50 --size 32");
   app.callback([d, pfm] {
     d->half = !*pfm;
     auto m = ilf::write_synthetic_sequence(ilf::AnalyticField::three_spheres(), *d, iblcli::progress_bar());
@@ -629,7 +792,9 @@ void setup_synth(CLI::App& app) {
 
 // The grid as three.js r187's LightProbeGridWebGL loads it (ilf/threejs_grid.h, docs/web.md).
 void setup_export_threejs(CLI::App& app) {
-  struct Opts { std::string grid, out, name = "grid"; };
+  struct Opts {
+    std::string grid, out, name = "grid";
+  };
   auto* o = iblcli::app_owned<Opts>();
   app.add_option("grid", o->grid, ".shgrid or .shtree file (resampled at its fine resolution)")->required();
   app.add_option("-o,--out", o->out, "output folder (NAME.json and NAME_atlas.bin)")->required();
@@ -641,28 +806,35 @@ void setup_export_threejs(CLI::App& app) {
     auto g = ilf::read_dense(o->grid);
     std::string json = ilf::write_threejs_grid(g, o->out, o->name);
     const auto& gd = g.grid();
-    iblcli::emit({{"grid", o->grid}, {"out", json}, {"resolution", {gd.nx, gd.ny, gd.nz}}, {"bands_kept", std::min(g.bands(), 3)},
+    iblcli::emit({{"grid", o->grid},
+                  {"out", json},
+                  {"resolution", {gd.nx, gd.ny, gd.nz}},
+                  {"bands_kept", std::min(g.bands(), 3)},
                   {"bands", g.bands()}},
                  [&] {
-                   fmt::print("wrote {} and its atlas: {}x{}x{} probes, 3 of {} bands, atlas {}x{}x{} RGBA float32\n", json, gd.nx, gd.ny,
-                              gd.nz, g.bands(), gd.nx, gd.ny, ilf::kThreeAtlasVolumes * (gd.nz + 2 * ilf::kThreeAtlasPadding));
+                   fmt::print("wrote {} and its atlas: {}x{}x{} probes, 3 of {} bands, atlas {}x{}x{} RGBA float32\n",
+                              json, gd.nx, gd.ny, gd.nz, g.bands(), gd.nx, gd.ny,
+                              ilf::kThreeAtlasVolumes * (gd.nz + 2 * ilf::kThreeAtlasPadding));
                  });
   });
 }
 
 void setup(CLI::App& app) {
   app.require_subcommand(1);
-  app.footer("Examples:\n  iblkit lab capture low-scene2 --grid 4,4,4 --mapping mirrorball --size 64 --out cap\n"
-             "  iblkit ilf build cap/sequence.json --grid 16 --bands 5 --out room.shgrid\n"
-             "  iblkit ilf query room.shgrid --at 0,1,0");
+  app.footer(
+      "Examples:\n  iblkit lab capture low-scene2 --grid 4,4,4 --mapping mirrorball --size 64 --out cap\n"
+      "  iblkit ilf build cap/sequence.json --grid 16 --bands 5 --out room.shgrid\n"
+      "  iblkit ilf query room.shgrid --at 0,1,0");
   setup_build(*app.add_subcommand("build", "Resample a probe sequence into an SH grid (.shgrid)"));
-  setup_adapt(*app.add_subcommand("adapt", "Store a grid adaptively (.shtree): fine bricks only where coarser levels miss it"));
+  setup_adapt(
+      *app.add_subcommand("adapt", "Store a grid adaptively (.shtree): fine bricks only where coarser levels miss it"));
   setup_densify(*app.add_subcommand("densify", "Resample an adaptive grid (.shtree) into a dense .shgrid"));
   setup_query(*app.add_subcommand("query", "SH, irradiance, radiance and glossy response at a point of a grid"));
   setup_slice(*app.add_subcommand("slice", "Irradiance on a plane through the grid, as a picture"));
   setup_info(*app.add_subcommand("info", "Describe an .shgrid or .shtree"));
   setup_synth(*app.add_subcommand("synth", "Write a synthetic probe sequence of a closed-form light field"));
-  setup_export_threejs(*app.add_subcommand("export-threejs", "Write the grid as three.js LightProbeGridWebGL loads it (atlas + JSON)"));
+  setup_export_threejs(
+      *app.add_subcommand("export-threejs", "Write the grid as three.js LightProbeGridWebGL loads it (atlas + JSON)"));
 }
 
 iblcli::Command reg("ilf", setup);

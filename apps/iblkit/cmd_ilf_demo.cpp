@@ -27,7 +27,8 @@ namespace {
 namespace fs = std::filesystem;
 using namespace ibl;
 
-constexpr int kSlice = 16;  // slices are kSlice² irradiance samples (the lab truth costs ~0.2 s a point; upscaled for display)
+constexpr int kSlice =
+    16;  // slices are kSlice² irradiance samples (the lab truth costs ~0.2 s a point; upscaled for display)
 
 // Irradiance (normal +Y) on the plane y = middle of the volume, kSlice² points, x right, z down.
 template <typename F>
@@ -109,17 +110,20 @@ void ilf_step(iblcli::DemoContext& ctx) {
     ilf::BuildReport rep;
     auto g = ilf::build_shgrid(seq, bd, {}, &rep);
     cv_errs[fmt::format("{}^3", n)] = rep.crossval->rel_error;
-    iblcli::info(fmt::format("demo: ilf {}^3: cross-validated error {:.3f} ({}-fold over {} probes)", n, rep.crossval->rel_error,
-                             rep.crossval->folds, rep.crossval->evaluated));
+    iblcli::info(fmt::format("demo: ilf {}^3: cross-validated error {:.3f} ({}-fold over {} probes)", n,
+                             rep.crossval->rel_error, rep.crossval->folds, rep.crossval->evaluated));
     {  // the error volume's slice through the same plane
       auto ev = ilf::error_volume(*rep.crossval, g.grid());
       ilf::write_shgrid((dir / fmt::format("error{}.shgrid", n)).string(), ev);
       std::string epng = (dir / fmt::format("cv_error_{}.png", n)).string();
-      Image es = ilf::error_colours(ilf::error_slice(ev, 1, seq.volume.centre().y, kSlice * 4), 0.5), flipped(es.width(), es.height(), 3);
+      Image es = ilf::error_colours(ilf::error_slice(ev, 1, seq.volume.centre().y, kSlice * 4), 0.5),
+            flipped(es.width(), es.height(), 3);
       for (int y = 0; y < es.height(); ++y)  // error_slice puts +z at the top; the irradiance slices above put −z there
         for (int x = 0; x < es.width(); ++x) flipped.set_rgb(x, es.height() - 1 - y, es.rgb(x, y));
       io::write_image(epng, io::resize(flipped, 256, 256));
-      ctx.pictures.push_back({fmt::format("ILF {}^3 cross-validated error (black 0, red >= 0.5; overall {:.3f})", n, rep.crossval->rel_error), epng});
+      ctx.pictures.push_back({fmt::format("ILF {}^3 cross-validated error (black 0, red >= 0.5; overall {:.3f})", n,
+                                          rep.crossval->rel_error),
+                              epng});
     }
     ilf::write_shgrid((dir / fmt::format("grid{}.shgrid", n)).string(), g);
     Image s = slice(seq.volume, [&](Vec3 p) { return g.irradiance(p, {0, 1, 0}); });
@@ -136,7 +140,9 @@ void ilf_step(iblcli::DemoContext& ctx) {
   std::string png = (dir / "slice_truth.png").string();
   io::write_image(png, io::resize(io::tonemap(gt, td), 256, 256));
   ctx.pictures.push_back({fmt::format("ILF truth, {} irradiance y = mid", scene_name), png});
-  ctx.summary["ilf"] = {{"scene", scene_name}, {"probes", seq.probes.size()}, {"slice_irradiance_rel_error", errs},
+  ctx.summary["ilf"] = {{"scene", scene_name},
+                        {"probes", seq.probes.size()},
+                        {"slice_irradiance_rel_error", errs},
                         {"cv_sh_rel_error", cv_errs}};
 }
 

@@ -22,10 +22,17 @@ namespace fs = std::filesystem;
 using namespace ibl::lights;
 
 nlohmann::json opt_json(const OptimizeReport& r) {
-  return {{"iterations", r.iterations}, {"final_iterations", r.final_iterations},
-          {"coarse_iterations", r.coarse_iterations}, {"initial_cost", r.initial_cost}, {"final_cost", r.final_cost},
-          {"last_decrease", r.last_decrease}, {"decrement", r.decrement}, {"dark_lights", r.dark_lights},
-          {"seconds", r.seconds}, {"converged", r.converged}, {"termination", r.termination}};
+  return {{"iterations", r.iterations},
+          {"final_iterations", r.final_iterations},
+          {"coarse_iterations", r.coarse_iterations},
+          {"initial_cost", r.initial_cost},
+          {"final_cost", r.final_cost},
+          {"last_decrease", r.last_decrease},
+          {"decrement", r.decrement},
+          {"dark_lights", r.dark_lights},
+          {"seconds", r.seconds},
+          {"converged", r.converged},
+          {"termination", r.termination}};
 }
 
 // ---- iblkit lights ------------------------------------------------------------------------------
@@ -68,11 +75,13 @@ void run_lights(const LightsOpts& o, const ibl::io::EnvReadDesc& rd) {
                  l.solid_angle, ibl::luminance(l.radiance()), static_cast<int>(i) < o.shadows ? "yes" : "");
     }
     fmt::print("Σ irradiance {:.6g} {:.6g} {:.6g}   probe ∫L dω {:.6g} {:.6g} {:.6g}\n", total.x, total.y, total.z,
-               integral[0], integral.size() > 1 ? integral[1] : integral[0], integral.size() > 2 ? integral[2] : integral[0]);
+               integral[0], integral.size() > 1 ? integral[1] : integral[0],
+               integral.size() > 2 ? integral[2] : integral[0]);
     if (o.ex.method == "optimize")
-      fmt::print("optimiser: {} iterations ({} on the coarse normals, {} on all {}), cost {:.6g} -> {:.6g}, {:.2f} s, {}\n",
-                 ex.optimizer.iterations, ex.optimizer.coarse_iterations, ex.optimizer.final_iterations, ex.normals,
-                 ex.optimizer.initial_cost, ex.optimizer.final_cost, ex.optimizer.seconds, ex.optimizer.termination);
+      fmt::print(
+          "optimiser: {} iterations ({} on the coarse normals, {} on all {}), cost {:.6g} -> {:.6g}, {:.2f} s, {}\n",
+          ex.optimizer.iterations, ex.optimizer.coarse_iterations, ex.optimizer.final_iterations, ex.normals,
+          ex.optimizer.initial_cost, ex.optimizer.final_cost, ex.optimizer.seconds, ex.optimizer.termination);
     for (auto* f : {&o.out, &o.gltf, &o.overlay})
       if (!f->empty()) fmt::print("wrote {}\n", *f);
   });
@@ -82,16 +91,20 @@ void run_lights(const LightsOpts& o, const ibl::io::EnvReadDesc& rd) {
 void add_optimiser_options(CLI::App& app, int* iterations, double* tolerance) {
   app.add_option("--iterations", *iterations,
                  "optimize: safety cap on Levenberg–Marquardt steps per stage (the stopping rule is --tolerance)")
-      ->check(CLI::Range(1, 100000))->capture_default_str();
+      ->check(CLI::Range(1, 100000))
+      ->capture_default_str();
   app.add_option("--tolerance", *tolerance,
                  "optimize: converged when the last step and a full Gauss–Newton step each lower the cost by less "
-                 "than this fraction")->check(CLI::Range(1e-15, 0.1))->capture_default_str();
+                 "than this fraction")
+      ->check(CLI::Range(1e-15, 0.1))
+      ->capture_default_str();
 }
 
 // --normals-level, in the optimiser's range.
 CLI::Option* add_normals_level_option(CLI::App& app, int* level, const std::string& help) {
   return app.add_option("--normals-level", *level, help)
-      ->check(CLI::Range(kMinNormalsLevel, kMaxNormalsLevel))->capture_default_str();
+      ->check(CLI::Range(kMinNormalsLevel, kMaxNormalsLevel))
+      ->capture_default_str();
 }
 
 void setup_lights(CLI::App& app) {
@@ -100,16 +113,22 @@ void setup_lights(CLI::App& app) {
   app.add_option("probe", o->probe, "HDR probe image")->required();
   app.add_option("-m,--method", ex.method, "extraction method: " + extraction_method_list())->capture_default_str();
   app.add_option("-n,--count", ex.count, "number of lights N (median-cut-2k: a power of two)")->capture_default_str();
-  app.add_option("--min-separation", ex.min_separation_deg, "merge lights closer than this many degrees, then cut further (0: off)");
+  app.add_option("--min-separation", ex.min_separation_deg,
+                 "merge lights closer than this many degrees, then cut further (0: off)");
   app.add_option("-o,--out", o->out, "write the lights as iblkit.lights/1 JSON");
   app.add_option("--gltf", o->gltf, "write the lights as a glTF 2.0 scene (KHR_lights_punctual)");
-  app.add_option("--lux-per-unit", o->gltf_desc.lux_per_unit, "glTF: lux per unit of probe irradiance")->capture_default_str();
+  app.add_option("--lux-per-unit", o->gltf_desc.lux_per_unit, "glTF: lux per unit of probe irradiance")
+      ->capture_default_str();
   app.add_option("--overlay", o->overlay, "write a PNG of the probe with every light and its region marked");
-  app.add_option("--shadows", o->shadows, "how many lights (in priority order) deserve shadow maps")->capture_default_str();
-  add_normals_level_option(app, &ex.optimize.normals_level, "optimize: icosphere level of the fitted normals (5: 20480)");
+  app.add_option("--shadows", o->shadows, "how many lights (in priority order) deserve shadow maps")
+      ->capture_default_str();
+  add_normals_level_option(app, &ex.optimize.normals_level,
+                           "optimize: icosphere level of the fitted normals (5: 20480)");
   add_optimiser_options(app, &ex.optimize.max_iterations, &ex.optimize.tolerance);
   auto& rd = iblcli::add_probe_read_options(app);
-  app.footer("Example:\n  iblkit lights forest.exr --method median-cut --count 16 --out lights.json --gltf lights.gltf --overlay lights.png");
+  app.footer(
+      "Example:\n  iblkit lights forest.exr --method median-cut --count 16 --out lights.json --gltf lights.gltf "
+      "--overlay lights.png");
   app.callback([o, &rd] { run_lights(*o, rd); });
 }
 
@@ -134,7 +153,10 @@ std::vector<iblcli::ErrorCurve> curves_of(const EvalResult& r) {
   for (const auto& row : r.rows) {
     if (row.count < 1 || row.method.find("(file)") != std::string::npos) continue;
     auto it = std::find_if(curves.begin(), curves.end(), [&](const auto& c) { return c.name == row.method; });
-    if (it == curves.end()) { curves.push_back({row.method, {}, {}, {}}); it = curves.end() - 1; }
+    if (it == curves.end()) {
+      curves.push_back({row.method, {}, {}, {}});
+      it = curves.end() - 1;
+    }
     it->counts.push_back(row.count);
     it->mean.push_back(row.err.mean_rel);
     it->max.push_back(row.err.max_rel);
@@ -162,7 +184,10 @@ void write_eval_pictures(const ibl::sphere::EnvMap& env, const EvalResult& r, co
                          const std::string& plot, const std::string& cmp) {
   iblcli::ErrorPlotDesc pd;
   pd.title = fmt::format("{}: irradiance error at {} normals", fs::path(probe).filename().string(), r.normals);
-  if (r.have_sh) { pd.reference_mean = r.sh.mean_rel; pd.reference_max = r.sh.max_rel; }
+  if (r.have_sh) {
+    pd.reference_mean = r.sh.mean_rel;
+    pd.reference_max = r.sh.max_rel;
+  }
   ibl::io::write_image(plot, iblcli::error_plot(curves_of(r), pd));
   ibl::Image sheet;
   for (const auto& [m, set] : r.picture_sets) {
@@ -191,25 +216,32 @@ void run_eval(const EvalOpts& o, const ibl::io::EnvReadDesc& rd) {
   if (!o.no_pictures) write_eval_pictures(env, r, o.probe, plot, cmp);
   nlohmann::json rows = nlohmann::json::array();
   for (const auto& row : r.rows) {
-    nlohmann::json jr = {{"method", row.method}, {"count", row.count}, {"mean_rel", row.err.mean_rel},
+    nlohmann::json jr = {{"method", row.method},       {"count", row.count},         {"mean_rel", row.err.mean_rel},
                          {"max_rel", row.err.max_rel}, {"rms_rel", row.err.rms_rel}, {"rms_abs", row.err.rms_abs},
                          {"seconds", row.seconds}};
     if (row.optimizer) jr["optimizer"] = opt_json(*row.optimizer);
     rows.push_back(jr);
   }
-  nlohmann::json j = {{"probe", o.probe}, {"normals", r.normals},
-                      {"ground_truth_seconds", r.ground_truth_seconds}, {"rows", rows}, {"csv", csv}};
-  if (r.have_sh) j["sh"] = {{"bands", r.sh_bands}, {"mean_rel", r.sh.mean_rel}, {"max_rel", r.sh.max_rel}, {"rms_rel", r.sh.rms_rel}};
+  nlohmann::json j = {{"probe", o.probe},
+                      {"normals", r.normals},
+                      {"ground_truth_seconds", r.ground_truth_seconds},
+                      {"rows", rows},
+                      {"csv", csv}};
+  if (r.have_sh)
+    j["sh"] = {
+        {"bands", r.sh_bands}, {"mean_rel", r.sh.mean_rel}, {"max_rel", r.sh.max_rel}, {"rms_rel", r.sh.rms_rel}};
   if (!o.no_pictures) j["pictures"] = {plot, cmp};
   iblcli::emit(j, [&] {
     fmt::print("{}: ground truth at {} normals in {:.2f} s\n", o.probe, r.normals, r.ground_truth_seconds);
-    fmt::print("{:<16} {:>5} {:>9} {:>9} {:>9} {:>9}  {}\n", "method", "N", "mean %", "max %", "rms %", "time s", "optimiser");
+    fmt::print("{:<16} {:>5} {:>9} {:>9} {:>9} {:>9}  {}\n", "method", "N", "mean %", "max %", "rms %", "time s",
+               "optimiser");
     for (const auto& row : r.rows)
-      fmt::print("{:<16} {:>5} {:>9.3f} {:>9.3f} {:>9.3f} {:>9.3f}  {}\n", row.method, row.count, 100 * row.err.mean_rel,
-                 100 * row.err.max_rel, 100 * row.err.rms_rel, row.seconds, row.optimizer ? optimiser_note(*row.optimizer) : "");
+      fmt::print("{:<16} {:>5} {:>9.3f} {:>9.3f} {:>9.3f} {:>9.3f}  {}\n", row.method, row.count,
+                 100 * row.err.mean_rel, 100 * row.err.max_rel, 100 * row.err.rms_rel, row.seconds,
+                 row.optimizer ? optimiser_note(*row.optimizer) : "");
     if (r.have_sh)
-      fmt::print("{:<16} {:>5} {:>9.3f} {:>9.3f} {:>9.3f}  (reference: {}-band SH irradiance)\n", "sh", r.sh_bands * r.sh_bands,
-                 100 * r.sh.mean_rel, 100 * r.sh.max_rel, 100 * r.sh.rms_rel, r.sh_bands);
+      fmt::print("{:<16} {:>5} {:>9.3f} {:>9.3f} {:>9.3f}  (reference: {}-band SH irradiance)\n", "sh",
+                 r.sh_bands * r.sh_bands, 100 * r.sh.mean_rel, 100 * r.sh.max_rel, 100 * r.sh.rms_rel, r.sh_bands);
     fmt::print("wrote {}{}\n", csv, o.no_pictures ? "" : fmt::format(", {}, {}", plot, cmp));
   });
 }
@@ -225,11 +257,14 @@ void setup_eval(CLI::App& app) {
   add_optimiser_options(app, &ev.optimize.max_iterations, &ev.optimize.tolerance);
   app.add_option("--sh-bands", ev.sh_bands, "SH reference line bands (0: none)")->capture_default_str();
   app.add_option("--min-separation", ev.min_separation_deg, "minimum angular separation of lights in degrees (0: off)");
-  app.add_option("--picture-count", ev.picture_count, "N of the sets drawn in the irradiance comparison")->capture_default_str();
-  app.add_option("-o,--out", o->out, "output prefix: PREFIX.csv, PREFIX_fig4.png, PREFIX_irradiance.png")->capture_default_str();
+  app.add_option("--picture-count", ev.picture_count, "N of the sets drawn in the irradiance comparison")
+      ->capture_default_str();
+  app.add_option("-o,--out", o->out, "output prefix: PREFIX.csv, PREFIX_fig4.png, PREFIX_irradiance.png")
+      ->capture_default_str();
   app.add_flag("--no-pictures", o->no_pictures, "write only the CSV");
   auto& rd = iblcli::add_probe_read_options(app);
-  app.footer("Example:\n  iblkit eval forest.exr --methods median-cut,variance-cut,optimize --counts 1,4,16 --out forest");
+  app.footer(
+      "Example:\n  iblkit eval forest.exr --methods median-cut,variance-cut,optimize --counts 1,4,16 --out forest");
   app.callback([o, &rd] { run_eval(*o, rd); });
 }
 
@@ -250,7 +285,10 @@ void demo_step(iblcli::DemoContext& ctx) {
   write_eval_csv(base + "/eval.csv", r);
   iblcli::ErrorPlotDesc pd;
   pd.title = fmt::format("{}: irradiance error at {} normals", fs::path(ctx.probe).filename().string(), r.normals);
-  if (r.have_sh) { pd.reference_mean = r.sh.mean_rel; pd.reference_max = r.sh.max_rel; }
+  if (r.have_sh) {
+    pd.reference_mean = r.sh.mean_rel;
+    pd.reference_max = r.sh.max_rel;
+  }
   ibl::io::write_image(base + "/fig4.png", iblcli::error_plot(curves_of(r), pd));
   ctx.pictures.push_back({"lights: error vs N", base + "/fig4.png"});
   for (const auto& [m, set] : r.picture_sets) {
@@ -261,7 +299,8 @@ void demo_step(iblcli::DemoContext& ctx) {
     write_gltf(base + "/" + m + "_16.gltf", set);
   }
   nlohmann::json sum = nlohmann::json::object();
-  for (const auto& row : r.rows) sum[row.method][std::to_string(row.count)] = {{"mean_rel", row.err.mean_rel}, {"max_rel", row.err.max_rel}};
+  for (const auto& row : r.rows)
+    sum[row.method][std::to_string(row.count)] = {{"mean_rel", row.err.mean_rel}, {"max_rel", row.err.max_rel}};
   if (r.have_sh) sum[sh_reference_name(r.sh_bands)] = {{"mean_rel", r.sh.mean_rel}, {"max_rel", r.sh.max_rel}};
   ctx.summary["lights"] = sum;
 }

@@ -33,7 +33,8 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 }
 
 json stats_json(const nf::ErrorStats& s) {
-  return {{"rel_rms", s.rel_rms}, {"rel_mean_abs", s.rel_mean_abs}, {"rel_max", s.rel_max}, {"power_ratio", s.power_ratio}};
+  return {
+      {"rel_rms", s.rel_rms}, {"rel_mean_abs", s.rel_mean_abs}, {"rel_max", s.rel_max}, {"power_ratio", s.power_ratio}};
 }
 
 // Tone maps a set of images with one exposure: the first image's 99th-percentile luminance lands on
@@ -78,7 +79,8 @@ Image fig3_plot(bool two_d) {
     ibl::io::draw_text(img, static_cast<int>(X(t)) - 8, y0 + 18, fmt::format("{:.0f}", t), 13, black);
   }
   ibl::io::draw_text(img, x0 + pw / 2 - 40, y0 + 36, "theta0 (degrees)", 13, black);
-  ibl::io::draw_text(img, x0 + 10, 22, two_d ? "E_r(theta0), 2-D square support" : "E_r(theta0), Granier et al. Fig. 3", 15, black);
+  ibl::io::draw_text(img, x0 + 10, 22, two_d ? "E_r(theta0), 2-D square support" : "E_r(theta0), Granier et al. Fig. 3",
+                     15, black);
   const double widths[] = {0.01, 0.02, 0.04, 0.08};
   const Vec3 cols[] = {{0.1, 0.4, 0.9}, {0.1, 0.7, 0.2}, {0.9, 0.3, 0.1}, {0.6, 0.1, 0.7}};
   for (int k = 0; k < 4; ++k) {
@@ -120,17 +122,29 @@ void run_simulate(const SimOpts& o) {
   double secs = seconds_since(t0);
   if (o.out.empty()) ibl::fail(ibl::ErrorKind::Value, "--out MANIFEST.json is required");
   nf::write_dataset(o.out, ds);
-  json j = {{"manifest", o.out}, {"name", ds.name}, {"luminaire", lum.name}, {"grid", {ds.nx, ds.ny}},
-            {"basis", nf::basis_name(ds.basis)}, {"spacing", ds.spacing}, {"filter_width", ds.filter_width},
-            {"distance", ds.distance}, {"extent", ds.m_max.x}, {"resolution", d.resolution}, {"seconds", secs},
-            {"luminaire_half_size", {half.x, half.y}}, {"full_reconstruction_half_size", {pou_x, pou_y}}};
+  json j = {{"manifest", o.out},
+            {"name", ds.name},
+            {"luminaire", lum.name},
+            {"grid", {ds.nx, ds.ny}},
+            {"basis", nf::basis_name(ds.basis)},
+            {"spacing", ds.spacing},
+            {"filter_width", ds.filter_width},
+            {"distance", ds.distance},
+            {"extent", ds.m_max.x},
+            {"resolution", d.resolution},
+            {"seconds", secs},
+            {"luminaire_half_size", {half.x, half.y}},
+            {"full_reconstruction_half_size", {pou_x, pou_y}}};
   iblcli::emit(j, [&] {
-    fmt::print("simulated {} ({} filter positions, {} dual filter {:.1f} mm wide, h = {:.1f} mm, d = {:.2f} m) in {:.2f} s\n",
-               ds.name, ds.count(), nf::basis_name(ds.basis), ds.filter_width * 1e3, ds.spacing * 1e3, ds.distance, secs);
+    fmt::print(
+        "simulated {} ({} filter positions, {} dual filter {:.1f} mm wide, h = {:.1f} mm, d = {:.2f} m) in {:.2f} s\n",
+        ds.name, ds.count(), nf::basis_name(ds.basis), ds.filter_width * 1e3, ds.spacing * 1e3, ds.distance, secs);
     fmt::print("  images {}x{} over ±{:.3f} m on M\n  manifest: {}\n", d.resolution, d.resolution, ds.m_max.x, o.out);
     if (half.x > pou_x || half.y > pou_y)
-      fmt::print("  note: the luminaire ({:.1f} x {:.1f} mm half size) reaches beyond the grid's full-reconstruction region (±{:.1f} x ±{:.1f} mm)\n",
-                 half.x * 1e3, half.y * 1e3, pou_x * 1e3, pou_y * 1e3);
+      fmt::print(
+          "  note: the luminaire ({:.1f} x {:.1f} mm half size) reaches beyond the grid's full-reconstruction region "
+          "(±{:.1f} x ±{:.1f} mm)\n",
+          half.x * 1e3, half.y * 1e3, pou_x * 1e3, pou_y * 1e3);
   });
 }
 
@@ -154,21 +168,34 @@ void run_info(const std::string& path) {
       for (int y = 0; y < H; ++y)
         for (int x = 0; x < W; ++x) power += m.rgb(x, y) * px;
     }
-  json j = {{"manifest", path}, {"name", ds.name}, {"luminaire", ds.luminaire}, {"grid", {ds.nx, ds.ny}},
-            {"basis", nf::basis_name(ds.basis)}, {"m_basis", nf::basis_name(ds.m_basis)}, {"spacing", ds.spacing},
-            {"filter_width", ds.filter_width}, {"distance", ds.distance},
+  json j = {{"manifest", path},
+            {"name", ds.name},
+            {"luminaire", ds.luminaire},
+            {"grid", {ds.nx, ds.ny}},
+            {"basis", nf::basis_name(ds.basis)},
+            {"m_basis", nf::basis_name(ds.m_basis)},
+            {"spacing", ds.spacing},
+            {"filter_width", ds.filter_width},
+            {"distance", ds.distance},
             {"m_extent", {{"min", {ds.m_min.x, ds.m_min.y}}, {"max", {ds.m_max.x, ds.m_max.y}}}},
-            {"image_size", {W, H}}, {"power_through_m", {power.x, power.y, power.z}},
+            {"image_size", {W, H}},
+            {"power_through_m", {power.x, power.y, power.z}},
             {"negative_texel_fraction", neg / std::max(pos + neg, 1e-300)},
-            {"relative_support_width", s}, {"worst_shift_invariance_error_2d", worst}};
+            {"relative_support_width", s},
+            {"worst_shift_invariance_error_2d", worst}};
   iblcli::emit(j, [&] {
-    fmt::print("{}: {} ({}x{} filter positions{})\n", path, ds.name, ds.nx, ds.ny, ds.luminaire.empty() ? "" : ", lab luminaire " + ds.luminaire);
-    fmt::print("  basis {} (dual filter {:.1f} mm), spacing {:.2f} mm, planes {:.3f} m apart, M basis {}\n", nf::basis_name(ds.basis),
-               ds.filter_width * 1e3, ds.spacing * 1e3, ds.distance, nf::basis_name(ds.m_basis));
-    fmt::print("  images {}x{} over [{:.3f}, {:.3f}] x [{:.3f}, {:.3f}] m\n", W, H, ds.m_min.x, ds.m_max.x, ds.m_min.y, ds.m_max.y);
+    fmt::print("{}: {} ({}x{} filter positions{})\n", path, ds.name, ds.nx, ds.ny,
+               ds.luminaire.empty() ? "" : ", lab luminaire " + ds.luminaire);
+    fmt::print("  basis {} (dual filter {:.1f} mm), spacing {:.2f} mm, planes {:.3f} m apart, M basis {}\n",
+               nf::basis_name(ds.basis), ds.filter_width * 1e3, ds.spacing * 1e3, ds.distance,
+               nf::basis_name(ds.m_basis));
+    fmt::print("  images {}x{} over [{:.3f}, {:.3f}] x [{:.3f}, {:.3f}] m\n", W, H, ds.m_min.x, ds.m_max.x, ds.m_min.y,
+               ds.m_max.y);
     fmt::print("  power through M: ({:.4g}, {:.4g}, {:.4g}) W\n", power.x, power.y, power.z);
-    fmt::print("  E' textures: {:.1f}% of |texel| mass negative (dual filter lobes)\n", 100 * neg / std::max(pos + neg, 1e-300));
-    fmt::print("  Φ support / d = {:.4f}: shift-invariance error E_r up to {:.1f}% (2-D support, θ0 < 80°)\n", s, 100 * worst);
+    fmt::print("  E' textures: {:.1f}% of |texel| mass negative (dual filter lobes)\n",
+               100 * neg / std::max(pos + neg, 1e-300));
+    fmt::print("  Φ support / d = {:.4f}: shift-invariance error E_r up to {:.1f}% (2-D support, θ0 < 80°)\n", s,
+               100 * worst);
   });
 }
 
@@ -216,11 +243,19 @@ void run_render(const RenderOpts& o) {
   const nf::SceneRender r = nf::render_scene(sv, d, iblcli::progress_bar());
   iblcli::progress_done();
   const std::string& label = r.label;
-  json j = {{"dataset", label}, {"scene", scene.name}, {"out", o.out}, {"size", o.size}, {"spotlights", r.spotlights},
-            {"shadows", !o.no_shadows}, {"setup_seconds", r.setup_seconds}, {"render_seconds", r.render_seconds}};
+  json j = {{"dataset", label},
+            {"scene", scene.name},
+            {"out", o.out},
+            {"size", o.size},
+            {"spotlights", r.spotlights},
+            {"shadows", !o.no_shadows},
+            {"setup_seconds", r.setup_seconds},
+            {"render_seconds", r.render_seconds}};
   if (r.srgbe_error)
-    j["srgbe_passes"] = {{"passes", r.srgbe_passes}, {"error_vs_float", stats_json(*r.srgbe_error)},
-                         {"frame_buffer_bytes_float", 12 * o.size * o.size}, {"frame_buffer_bytes_srgbe", 4 * o.size * o.size}};
+    j["srgbe_passes"] = {{"passes", r.srgbe_passes},
+                         {"error_vs_float", stats_json(*r.srgbe_error)},
+                         {"frame_buffer_bytes_float", 12 * o.size * o.size},
+                         {"frame_buffer_bytes_srgbe", 4 * o.size * o.size}};
   std::vector<Image> imgs{r.near_field};
   std::vector<std::string> names{"near-field (Eq. 14)"};
   if (r.exact) {
@@ -245,30 +280,35 @@ void run_render(const RenderOpts& o) {
     std::vector<std::pair<std::string, Image>> pics;
     for (size_t k = 0; k < tm.size(); ++k) pics.push_back({names[k], tm[k]});
     std::string sheet = base + "_compare.png";
-    ibl::io::write_image(sheet, ibl::io::contact_sheet(pics, static_cast<int>(pics.size()), o.size, o.size, label + " in " + scene.name));
+    ibl::io::write_image(sheet, ibl::io::contact_sheet(pics, static_cast<int>(pics.size()), o.size, o.size,
+                                                       label + " in " + scene.name));
     j["comparison"] = sheet;
   }
   iblcli::emit(j, [&] {
-    fmt::print("rendered {} in {} at {}x{} with {} spotlight{}{}: {:.2f} s (+{:.2f} s reading and E' textures)\n", label,
-               scene.name, o.size, o.size, r.spotlights, r.spotlights == 1 ? "" : "s", o.no_shadows ? "" : " and shadow rays",
-               r.render_seconds, r.setup_seconds);
+    fmt::print("rendered {} in {} at {}x{} with {} spotlight{}{}: {:.2f} s (+{:.2f} s reading and E' textures)\n",
+               label, scene.name, o.size, o.size, r.spotlights, r.spotlights == 1 ? "" : "s",
+               o.no_shadows ? "" : " and shadow rays", r.render_seconds, r.setup_seconds);
     fmt::print("  wrote {}\n", o.out);
     if (j.contains("near_field_error")) {
       auto& a = j["near_field_error"];
-      fmt::print("  near field vs exact: RMS {:.1f}%, mean |Δ| {:.1f}% of the mean, max {:.1f}% of the max, power ×{:.3f}\n",
-                 100 * a["rel_rms"].get<double>(), 100 * a["rel_mean_abs"].get<double>(), 100 * a["rel_max"].get<double>(),
-                 a["power_ratio"].get<double>());
+      fmt::print(
+          "  near field vs exact: RMS {:.1f}%, mean |Δ| {:.1f}% of the mean, max {:.1f}% of the max, power ×{:.3f}\n",
+          100 * a["rel_rms"].get<double>(), 100 * a["rel_mean_abs"].get<double>(), 100 * a["rel_max"].get<double>(),
+          a["power_ratio"].get<double>());
     }
     if (j.contains("far_field_error")) {
       auto& a = j["far_field_error"];
-      fmt::print("  far field  vs exact: RMS {:.1f}%, mean |Δ| {:.1f}% of the mean, max {:.1f}% of the max, power ×{:.3f}\n",
-                 100 * a["rel_rms"].get<double>(), 100 * a["rel_mean_abs"].get<double>(), 100 * a["rel_max"].get<double>(),
-                 a["power_ratio"].get<double>());
+      fmt::print(
+          "  far field  vs exact: RMS {:.1f}%, mean |Δ| {:.1f}% of the mean, max {:.1f}% of the max, power ×{:.3f}\n",
+          100 * a["rel_rms"].get<double>(), 100 * a["rel_mean_abs"].get<double>(), 100 * a["rel_max"].get<double>(),
+          a["power_ratio"].get<double>());
     }
     if (j.contains("srgbe_passes")) {
       auto& a = j["srgbe_passes"]["error_vs_float"];
-      fmt::print("  sRGBE frame buffer ({} passes of 3, 4 instead of 12 bytes a pixel): RMS {:.3f}%, max {:.3f}% of the max vs float\n",
-                 j["srgbe_passes"]["passes"].get<int>(), 100 * a["rel_rms"].get<double>(), 100 * a["rel_max"].get<double>());
+      fmt::print(
+          "  sRGBE frame buffer ({} passes of 3, 4 instead of 12 bytes a pixel): RMS {:.3f}%, max {:.3f}% of the max "
+          "vs float\n",
+          j["srgbe_passes"]["passes"].get<int>(), 100 * a["rel_rms"].get<double>(), 100 * a["rel_max"].get<double>());
     }
     if (j.contains("comparison")) fmt::print("  side by side: {}\n", j["comparison"].get<std::string>());
   });
@@ -281,7 +321,8 @@ struct IrrOpts {
 };
 
 void run_irradiance(const IrrOpts& o) {
-  if (o.plane.rfind("z=", 0) != 0) ibl::fail(ibl::ErrorKind::Value, "--plane '{}': expected z=DISTANCE (metres from S along the beam)", o.plane);
+  if (o.plane.rfind("z=", 0) != 0)
+    ibl::fail(ibl::ErrorKind::Value, "--plane '{}': expected z=DISTANCE (metres from S along the beam)", o.plane);
   double z = 0;
   try {
     z = std::stod(o.plane.substr(2));
@@ -309,43 +350,51 @@ void run_irradiance(const IrrOpts& o) {
   std::string base = o.out.substr(0, o.out.size() - fs::path(o.out).extension().string().size());
   if (lum) {
     Image ex = nf::plane_irradiance_exact(*lum, pd);
-    auto ff = nf::far_field_spotlight([&](Vec3 w) { return lum->intensity(w); }, ds.distance, ds.m_max.x, ds.positive[0].width(), pl);
+    auto ff = nf::far_field_spotlight([&](Vec3 w) { return lum->intensity(w); }, ds.distance, ds.m_max.x,
+                                      ds.positive[0].width(), pl);
     Image fi = nf::plane_irradiance({ff}, pl, pd);
     j["near_field_error"] = stats_json(nf::compare(nfi, ex));
     j["far_field_error"] = stats_json(nf::compare(fi, ex));
     ibl::io::write_image(base + "_exact.exr", ex);
     auto tm = same_exposure({ex, nfi, fi});
-    ibl::io::write_image(base + "_compare.png", ibl::io::contact_sheet({{"exact", tm[0]}, {"near field", tm[1]}, {"far field", tm[2]}}, 3,
-                                                                       256, 256, fmt::format("{} at z = {} m", ds.name, z)));
+    ibl::io::write_image(base + "_compare.png",
+                         ibl::io::contact_sheet({{"exact", tm[0]}, {"near field", tm[1]}, {"far field", tm[2]}}, 3, 256,
+                                                256, fmt::format("{} at z = {} m", ds.name, z)));
     j["comparison"] = base + "_compare.png";
   }
   iblcli::emit(j, [&] {
-    fmt::print("irradiance of {} on the plane z = {} m (±{:.3f} m, {}²): mean ({:.4g}, {:.4g}, {:.4g}) W/m²\n  wrote {}\n", ds.name, z,
-               pd.half_extent, o.size, mean.x, mean.y, mean.z, o.out);
+    fmt::print(
+        "irradiance of {} on the plane z = {} m (±{:.3f} m, {}²): mean ({:.4g}, {:.4g}, {:.4g}) W/m²\n  wrote {}\n",
+        ds.name, z, pd.half_extent, o.size, mean.x, mean.y, mean.z, o.out);
     for (const char* k : {"near_field_error", "far_field_error"})
       if (j.contains(k))
-        fmt::print("  {:<16} vs exact: RMS {:.2f}%, max {:.2f}% of the max, power ×{:.4f}\n", k, 100 * j[k]["rel_rms"].get<double>(),
-                   100 * j[k]["rel_max"].get<double>(), j[k]["power_ratio"].get<double>());
+        fmt::print("  {:<16} vs exact: RMS {:.2f}%, max {:.2f}% of the max, power ×{:.4f}\n", k,
+                   100 * j[k]["rel_rms"].get<double>(), 100 * j[k]["rel_max"].get<double>(),
+                   j[k]["power_ratio"].get<double>());
     if (j.contains("comparison")) fmt::print("  side by side: {}\n", j["comparison"].get<std::string>());
   });
 }
 
 void setup(CLI::App& app) {
   app.require_subcommand(1);
-  app.footer("Examples:\n  iblkit nearfield simulate flashlight --grid 3x3 --resolution 16 --out nf/nf.json\n"
-             "  iblkit nearfield render nf/nf.json --out nf.png");
+  app.footer(
+      "Examples:\n  iblkit nearfield simulate flashlight --grid 3x3 --resolution 16 --out nf/nf.json\n"
+      "  iblkit nearfield render nf/nf.json --out nf.png");
   auto* so = iblcli::app_owned<SimOpts>();
-  auto* s = app.add_subcommand("simulate", "Simulate the acquisition of a lab luminaire: a dataset of filter positions (iblkit.nearfield/1)");
+  auto* s = app.add_subcommand(
+      "simulate", "Simulate the acquisition of a lab luminaire: a dataset of filter positions (iblkit.nearfield/1)");
   s->add_option("luminaire", so->luminaire, "flashlight or bikelight")->capture_default_str();
   s->add_option("--grid", so->grid, "filter positions NXxNY")->capture_default_str();
   s->add_option("--basis", so->basis, "bilinear or biquadratic (the filter is its dual)")->capture_default_str();
   s->add_option("--spacing", so->spacing, "filter spacing h on S (metres)")->capture_default_str();
   s->add_option("--distance", so->distance, "distance d between S and M (metres)")->capture_default_str();
   s->add_option("--resolution", so->resolution, "image size on M (pixels per side)")->capture_default_str();
-  s->add_option("--extent", so->extent, "half-extent of M (metres); 0 = what the luminaire's cut-off reaches")->capture_default_str();
+  s->add_option("--extent", so->extent, "half-extent of M (metres); 0 = what the luminaire's cut-off reaches")
+      ->capture_default_str();
   s->add_option("-o,--out", so->out, "manifest path STEM.json (images go to STEM_images/ beside it)")->required();
-  s->footer("Examples:\n  iblkit nearfield simulate bikelight --grid 9x7 --out bike/bike.json\n"
-            "  iblkit nearfield simulate flashlight --grid 5x5 --spacing 0.0075 --out mag5/mag5.json");
+  s->footer(
+      "Examples:\n  iblkit nearfield simulate bikelight --grid 9x7 --out bike/bike.json\n"
+      "  iblkit nearfield simulate flashlight --grid 5x5 --spacing 0.0075 --out mag5/mag5.json");
   s->callback([so] { run_simulate(*so); });
 
   auto* path = iblcli::app_owned<std::string>();
@@ -355,7 +404,8 @@ void setup(CLI::App& app) {
   i->callback([path] { run_info(*path); });
 
   auto* ro = iblcli::app_owned<RenderOpts>();
-  auto* r = app.add_subcommand("render", "Render a lab scene lit by the dataset's textured spotlights (CPU reference, shadow rays)");
+  auto* r = app.add_subcommand(
+      "render", "Render a lab scene lit by the dataset's textured spotlights (CPU reference, shadow rays)");
   r->add_option("dataset", ro->dataset, "iblkit.nearfield/1 manifest");
   r->add_option("--ies", ro->ies, "render an IES LM-63 file instead (one far-field spotlight)");
   r->add_option("--ies-scale", ro->ies_scale, "multiplies the IES candela values")->capture_default_str();
@@ -367,25 +417,31 @@ void setup(CLI::App& app) {
   r->add_option("--fov", ro->fov, "vertical field of view (degrees)")->capture_default_str();
   r->add_option("--at", ro->light.at, "luminaire position (centre of S) x,y,z")->capture_default_str();
   r->add_option("--aim", ro->light.aim, "point the luminaire shines at x,y,z")->capture_default_str();
-  r->add_option("--exact", ro->light.exact, "also render the lab luminaire exactly (NAME or auto) and the far field, with errors");
+  r->add_option("--exact", ro->light.exact,
+                "also render the lab luminaire exactly (NAME or auto) and the far field, with errors");
   r->add_flag("--no-far", ro->light.no_far, "with --exact: skip the far-field picture");
   r->add_flag("--no-shadows", ro->no_shadows, "no visibility tests");
-  r->add_flag("--srgbe", ro->srgbe, "also sum through the paper's sRGBE frame buffer (passes of 3) and report its error");
-  r->footer("Examples:\n  iblkit nearfield render bike/bike.json --scene crypt --out view.png\n"
-            "  iblkit nearfield render bike/bike.json --scene crypt --exact auto --size 200 --out view.png");
+  r->add_flag("--srgbe", ro->srgbe,
+              "also sum through the paper's sRGBE frame buffer (passes of 3) and report its error");
+  r->footer(
+      "Examples:\n  iblkit nearfield render bike/bike.json --scene crypt --out view.png\n"
+      "  iblkit nearfield render bike/bike.json --scene crypt --exact auto --size 200 --out view.png");
   r->callback([ro] {
-    if (ro->dataset.empty() == ro->ies.empty()) ibl::fail(ibl::ErrorKind::Value, "give a DATASET or --ies FILE (one of them)");
+    if (ro->dataset.empty() == ro->ies.empty())
+      ibl::fail(ibl::ErrorKind::Value, "give a DATASET or --ies FILE (one of them)");
     run_render(*ro);
   });
 
   auto* io = iblcli::app_owned<IrrOpts>();
-  auto* ir = app.add_subcommand("irradiance", "Irradiance on a receiver plane facing the luminaire (vs the exact answer for lab datasets)");
+  auto* ir = app.add_subcommand(
+      "irradiance", "Irradiance on a receiver plane facing the luminaire (vs the exact answer for lab datasets)");
   ir->add_option("dataset", io->dataset, "iblkit.nearfield/1 manifest")->required();
   ir->add_option("--plane", io->plane, "z=DISTANCE from S along the beam (metres)")->capture_default_str();
   ir->add_option("-o,--out", io->out, "irradiance image (.exr)")->required();
   ir->add_option("--size", io->size, "pixels per side")->capture_default_str();
   ir->add_option("--extent", io->extent, "half-extent of the plane (metres); 0 = the dataset's reach at that distance");
-  ir->add_option("--exact", io->exact, "compare with this lab luminaire (auto: the dataset's own; none)")->capture_default_str();
+  ir->add_option("--exact", io->exact, "compare with this lab luminaire (auto: the dataset's own; none)")
+      ->capture_default_str();
   ir->footer("Example:\n  iblkit nearfield irradiance bike/bike.json --plane z=0.25 --out irr.exr");
   ir->callback([io] { run_irradiance(*io); });
 
@@ -400,7 +456,8 @@ void setup(CLI::App& app) {
     double worst = 0;
     for (double t = 0; t < 1.5; t += 0.001) worst = std::max(worst, nf::shift_invariance_error(t, 0.04));
     iblcli::emit({{"out", *fo}, {"worst_error_s0.04", worst}}, [&] {
-      fmt::print("wrote {} and {}_2d.png; at s = 0.04 the 1-D error peaks at {:.2f}% (paper: below 8%)\n", *fo, base, 100 * worst);
+      fmt::print("wrote {} and {}_2d.png; at s = 0.04 the 1-D error peaks at {:.2f}% (paper: below 8%)\n", *fo, base,
+                 100 * worst);
     });
   });
 }
@@ -426,7 +483,8 @@ void nearfield_step(iblcli::DemoContext& ctx) {
     summary[name]["simulate_seconds"] = seconds_since(t0);
     auto ep = nf::incoming_radiance(ds);
     auto lights = nf::place_spotlights(ds, ep, origin, false);
-    auto ff = nf::far_field_spotlight([&](Vec3 w) { return lum.intensity(w); }, ds.distance, ds.m_max.x, 96, origin, false);
+    auto ff =
+        nf::far_field_spotlight([&](Vec3 w) { return lum.intensity(w); }, ds.distance, ds.m_max.x, 96, origin, false);
     std::vector<std::pair<std::string, Image>> cells;
     for (double z : {0.15, 0.3, 0.6, 1.2}) {
       nf::PlaneDesc pd;
@@ -434,7 +492,8 @@ void nearfield_step(iblcli::DemoContext& ctx) {
       pd.resolution = 64;
       // The flashlight's reflector beams stay within ~10° of the axis: look at that window.
       pd.half_extent = std::string(name) == "flashlight" ? 0.012 + 0.2 * z : lum.extent_at(z);
-      Image ex = nf::plane_irradiance_exact(lum, pd), ni = nf::plane_irradiance(lights, origin, pd), fi = nf::plane_irradiance({ff}, origin, pd);
+      Image ex = nf::plane_irradiance_exact(lum, pd), ni = nf::plane_irradiance(lights, origin, pd),
+            fi = nf::plane_irradiance({ff}, origin, pd);
       auto a = nf::compare(ni, ex), b = nf::compare(fi, ex);
       summary[name]["planes"].push_back({{"z", z}, {"near_field", stats_json(a)}, {"far_field", stats_json(b)}});
       auto tm = same_exposure({ex, ni, fi});
@@ -443,7 +502,9 @@ void nearfield_step(iblcli::DemoContext& ctx) {
       cells.push_back({fmt::format("far {:.0f}%", 100 * b.rel_rms), tm[2]});
     }
     std::string png = (dir / fmt::format("{}_planes.png", name)).string();
-    ibl::io::write_image(png, ibl::io::contact_sheet(cells, 3, 128, 128, fmt::format("{} {}x{}: exact | near field | far field (RMS error)", name, ds.nx, ds.ny)));
+    ibl::io::write_image(png, ibl::io::contact_sheet(cells, 3, 128, 128,
+                                                     fmt::format("{} {}x{}: exact | near field | far field (RMS error)",
+                                                                 name, ds.nx, ds.ny)));
     ctx.pictures.push_back({fmt::format("nearfield {} planes (exact|near|far)", name), png});
     if (std::string(name) == "bikelight") {
       auto scene = ibl::lab::load_scene("crypt");
@@ -460,7 +521,8 @@ void nearfield_step(iblcli::DemoContext& ctx) {
       Image ni = nf::render_spotlights(sv, sl, view, true);
       summary[name]["crypt_160_seconds"] = seconds_since(t0);
       Image ex = nf::render_exact(sv, lum, pl, view, true);
-      auto ffc = nf::far_field_spotlight([&](Vec3 w) { return lum.intensity(w); }, ds.distance, ds.m_max.x, 96, pl, true);
+      auto ffc =
+          nf::far_field_spotlight([&](Vec3 w) { return lum.intensity(w); }, ds.distance, ds.m_max.x, 96, pl, true);
       Image fi = nf::render_spotlights(sv, {ffc}, view, true);
       auto a = nf::compare(ni, ex), b = nf::compare(fi, ex);
       summary[name]["crypt"] = {{"near_field", stats_json(a)}, {"far_field", stats_json(b)}};
@@ -470,7 +532,9 @@ void nearfield_step(iblcli::DemoContext& ctx) {
         std::string p = (dir / fmt::format("crypt_{}.png", tags[k])).string();
         ibl::io::write_image(p, tm[static_cast<size_t>(k)]);
         double e = k == 1 ? a.rel_rms : b.rel_rms;
-        ctx.pictures.push_back({k == 0 ? std::string("nearfield crypt, exact bike light") : fmt::format("crypt {} field, RMS {:.0f}%", tags[k], 100 * e), p});
+        ctx.pictures.push_back({k == 0 ? std::string("nearfield crypt, exact bike light")
+                                       : fmt::format("crypt {} field, RMS {:.0f}%", tags[k], 100 * e),
+                                p});
       }
     }
   }

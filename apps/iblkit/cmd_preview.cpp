@@ -19,7 +19,9 @@ void setup(CLI::App& app) {
   app.add_option("output", o->out, "PNG (or JPEG) to write")->required();
   app.add_option("--exposure", o->exposure, "exposure in stops (added to auto exposure unless --fixed)");
   app.add_flag("--fixed", o->fixed, "no auto exposure: scale by 2^exposure only");
-  app.add_option("--curve", o->curve, "tone curve: aces, reinhard, clamp")->check(CLI::IsMember({"aces", "reinhard", "clamp"}))->capture_default_str();
+  app.add_option("--curve", o->curve, "tone curve: aces, reinhard, clamp")
+      ->check(CLI::IsMember({"aces", "reinhard", "clamp"}))
+      ->capture_default_str();
   app.add_flag("--sanitize", o->sanitize, "replace NaN/Inf/negative pixels by 0 instead of failing");
   app.footer("Example:\n  iblkit preview probe.exr probe.png --exposure -1 --curve reinhard");
   app.callback([o] {
@@ -28,7 +30,9 @@ void setup(CLI::App& app) {
     ibl::io::ToneMapDesc td;
     td.auto_exposure = !o->fixed;
     td.exposure_stops = o->exposure;
-    td.curve = o->curve == "aces" ? ibl::io::ToneCurve::Aces : o->curve == "reinhard" ? ibl::io::ToneCurve::Reinhard : ibl::io::ToneCurve::Clamp;
+    td.curve = o->curve == "aces"       ? ibl::io::ToneCurve::Aces
+               : o->curve == "reinhard" ? ibl::io::ToneCurve::Reinhard
+                                        : ibl::io::ToneCurve::Clamp;
     double scale = (td.auto_exposure ? ibl::io::auto_exposure_scale(img) : 1.0) * std::exp2(td.exposure_stops);
     ibl::io::write_image(o->out, ibl::io::tonemap(img, td));
     nlohmann::json j = {{"input", o->in}, {"output", o->out}, {"scale", scale}, {"curve", o->curve}};

@@ -2,22 +2,20 @@
 // OpenGL (real time, headless EGL). Prints per-frame GPU time and fps for the GL backend.
 #ifdef IBLKIT_HAVE_GEOMETRY
 #include <chrono>
-#include <optional>
 #include <filesystem>
-#include <map>
 #include <fstream>
+#include <map>
+#include <optional>
 
 #include <fmt/format.h>
 
 #include "cli.h"
-#include "render_setup.h"
-#include "render_truth.h"
 #include "iblkit/core/atomic_file.h"
-#include "iblkit/io/draw.h"
 #include "iblkit/core/error.h"
 #include "iblkit/geometry/mesh.h"
 #include "iblkit/geometry/mesh_io.h"
 #include "iblkit/ilf/shgrid.h"
+#include "iblkit/io/draw.h"
 #include "iblkit/io/envmap_io.h"
 #include "iblkit/io/image_io.h"
 #include "iblkit/io/tonemap.h"
@@ -27,6 +25,8 @@
 #include "iblkit/render/objects.h"
 #include "iblkit/render/prefilter.h"
 #include "iblkit/sh/project.h"
+#include "render_setup.h"
+#include "render_truth.h"
 #ifdef IBLKIT_HAVE_GL
 #include "iblkit/render/gl/context.h"
 #include "iblkit/render/gl/renderer.h"
@@ -40,9 +40,10 @@ using namespace ibl::render;
 
 struct Opts {
   std::vector<std::string> lights;
-  render::ObjectDesc object;             // scene, --object-size, --triangles (and --at)
-  render::LightingReadDesc lighting;     // --bands, --shadows (and the probe read options, --luminaire…)
-  std::string out = "frame.png", backend = "auto", size = "1024x768", eye, target, at = "0,0,0";  // eye, target empty: from --at
+  render::ObjectDesc object;          // scene, --object-size, --triangles (and --at)
+  render::LightingReadDesc lighting;  // --bands, --shadows (and the probe read options, --luminaire…)
+  std::string out = "frame.png", backend = "auto", size = "1024x768", eye, target,
+              at = "0,0,0";  // eye, target empty: from --at
   int frames = 1, sh_table = 0;
   iblcli::ShadowMapOptions shadow_maps;
   double gloss = 0, exponent = 20;
@@ -61,61 +62,85 @@ void add_options(CLI::App& app, Opts* o) {
                  "scaled to --object-size and placed at --at, on a floor")
       ->capture_default_str();
   app.add_option("-l,--light", o->lights,
-                 "lighting: a probe image, an SH grid (.shgrid, or an adaptive .shtree resampled to dense), iblkit.sh/1 or iblkit.lights/1 JSON; several render one "
+                 "lighting: a probe image, an SH grid (.shgrid, or an adaptive .shtree resampled to dense), "
+                 "iblkit.sh/1 or iblkit.lights/1 JSON; several render one "
                  "frame each (OUT_<name>.ext; NAME_<k> where two share a name)")
       ->required();
-  app.add_option("--at", o->at, "place the object's centre here, x,y,z (e.g. inside an SH grid's volume)")->capture_default_str();
-  app.add_option("--object-size", o->object.size, "object size in metres; 0 keeps a mesh file's own size and place (a room)")
+  app.add_option("--at", o->at, "place the object's centre here, x,y,z (e.g. inside an SH grid's volume)")
+      ->capture_default_str();
+  app.add_option("--object-size", o->object.size,
+                 "object size in metres; 0 keeps a mesh file's own size and place (a room)")
       ->check(CLI::Range(0.0, 1000.0))
       ->capture_default_str();
   app.add_option("-o,--out", o->out, "output .png (tone mapped) or .exr (linear)")->capture_default_str();
-  app.add_option("--backend", o->backend, "cpu, gl or auto (gl when available)")->check(CLI::IsMember({"cpu", "gl", "auto"}))->capture_default_str();
+  app.add_option("--backend", o->backend, "cpu, gl or auto (gl when available)")
+      ->check(CLI::IsMember({"cpu", "gl", "auto"}))
+      ->capture_default_str();
   app.add_option("--size", o->size, "frame size WxH")->capture_default_str();
-  app.add_option("--frames", o->frames, "GL: render this many frames and report the median GPU time")->check(CLI::Range(1, 10000));
+  app.add_option("--frames", o->frames, "GL: render this many frames and report the median GPU time")
+      ->check(CLI::Range(1, 10000));
   app.add_option("--shadows", o->lighting.shadows, "lights (in the file's priority order) that cast shadows")
       ->check(CLI::Range(0, 16))
       ->capture_default_str();
   iblcli::add_shadow_map_options(app, &o->shadow_maps);
-  app.add_option("--bands", o->lighting.bands, "SH bands when projecting a probe")->check(CLI::Range(1, 9))->capture_default_str();
-  app.add_option("--triangles", o->object.triangles, "triangles of the blob")->check(CLI::Range(100, 5000000))->capture_default_str();
+  app.add_option("--bands", o->lighting.bands, "SH bands when projecting a probe")
+      ->check(CLI::Range(1, 9))
+      ->capture_default_str();
+  app.add_option("--triangles", o->object.triangles, "triangles of the blob")
+      ->check(CLI::Range(100, 5000000))
+      ->capture_default_str();
   app.add_option("--gloss", o->gloss, "weight of the glossy Phong lobe (0..1)")->check(CLI::Range(0.0, 1.0));
   app.add_option("--exponent", o->exponent, "Phong exponent of the glossy lobe")->check(CLI::Range(1.0, 10000.0));
-  app.add_option("--lobe", o->lobe, "glossy lobe: phong, or blinn (Blinn-Phong for lights; SH and maps use Phong of exponent/4)")
+  app.add_option("--lobe", o->lobe,
+                 "glossy lobe: phong, or blinn (Blinn-Phong for lights; SH and maps use Phong of exponent/4)")
       ->check(CLI::IsMember({"phong", "blinn"}))
       ->capture_default_str();
   app.add_option("--albedo", o->albedo, "the object's diffuse reflectance r,g,b")->capture_default_str();
-  app.add_option("--texture", o->texture, "albedo texture of the object (sRGB PNG/JPG or linear EXR), at the mesh's UVs");
+  app.add_option("--texture", o->texture,
+                 "albedo texture of the object (sRGB PNG/JPG or linear EXR), at the mesh's UVs");
   app.add_option("--exposure", o->exposure, "stops added to the auto exposure of PNG output")->capture_default_str();
   app.add_option("--glossy", o->glossy,
                  "probe lighting with --gloss > 0: the glossy lobe from a prefiltered Phong map of the probe (map) "
                  "or from its --bands SH (sh, band-limited)")
       ->check(CLI::IsMember({"map", "sh"}))
       ->capture_default_str();
-  app.add_option("--sh-table", o->sh_table,
-                 "GL backend only: evaluate the SH basis from a precomputed table with faces of N×N texels (Löw et al.'s "
-                 "suggested variant; 64: |ΔY| about 2e-3) instead of its polynomials per fragment (0)")
+  app.add_option(
+         "--sh-table", o->sh_table,
+         "GL backend only: evaluate the SH basis from a precomputed table with faces of N×N texels (Löw et al.'s "
+         "suggested variant; 64: |ΔY| about 2e-3) instead of its polynomials per fragment (0)")
       ->check(CLI::Range(0, 1024))
       ->capture_default_str();
-  app.add_option("--floor-size", o->floor_size, "side of the square floor under the object, metres (a table top when small; 0: no floor)")
+  app.add_option("--floor-size", o->floor_size,
+                 "side of the square floor under the object, metres (a table top when small; 0: no floor)")
       ->check(CLI::Range(0.0, 1000.0))
       ->capture_default_str();
-  app.add_option("--truth", o->truth,
-                 "a lab scene (iblkit.scene/1, e.g. examples/low-scene2.json): also photograph the object and floor in it "
-                 "with its real emitters (lab path tracing) and report the frame's error against that photograph");
-  app.add_option("--truth-samples", o->truth_samples, "--truth: n×n rays per pixel")->check(CLI::Range(1, 64))->capture_default_str();
-  app.add_option("--truth-bounces", o->truth_bounces, "--truth: indirect bounces; one more than the capture's (lab capture --bounces, 0 by default): a probe "
-                 "sees the room's lit walls and floor, so their light must reach the photographed object too")
+  app.add_option(
+      "--truth", o->truth,
+      "a lab scene (iblkit.scene/1, e.g. examples/low-scene2.json): also photograph the object and floor in it "
+      "with its real emitters (lab path tracing) and report the frame's error against that photograph");
+  app.add_option("--truth-samples", o->truth_samples, "--truth: n×n rays per pixel")
+      ->check(CLI::Range(1, 64))
+      ->capture_default_str();
+  app.add_option(
+         "--truth-bounces", o->truth_bounces,
+         "--truth: indirect bounces; one more than the capture's (lab capture --bounces, 0 by default): a probe "
+         "sees the room's lit walls and floor, so their light must reach the photographed object too")
       ->check(CLI::Range(0, 16))
       ->capture_default_str();
   app.add_option("--luminaire", o->luminaire, "a near-field dataset's luminaire: centre of its sampling plane, x,y,z")
       ->capture_default_str();
-  app.add_option("--luminaire-dir", o->luminaire_dir, "the direction the luminaire shines, x,y,z")->capture_default_str();
+  app.add_option("--luminaire-dir", o->luminaire_dir, "the direction the luminaire shines, x,y,z")
+      ->capture_default_str();
   app.add_option("--eye", o->eye, "camera position x,y,z (default: --at + (0, 0.5, 1.6), looking at the object)");
-  app.add_option("--fov", o->fov, "vertical field of view, degrees")->check(CLI::Range(1.0, 170.0))->capture_default_str();
+  app.add_option("--fov", o->fov, "vertical field of view, degrees")
+      ->check(CLI::Range(1.0, 170.0))
+      ->capture_default_str();
   app.add_option("--target", o->target, "camera target x,y,z (default: --at)");
-  app.footer("Examples:\n  iblkit render blob --light probe.exr --out blob.png --backend cpu --size 400x300\n"
-             "  iblkit render blob --light lights.json --backend gl --frames 10 --size 320x240 --out blob.exr\n"
-             "  iblkit render blob --light grid.shgrid --at 0.5,0.3,0.5 --object-size 0.3 --eye 0.5,0.6,1.6 --target 0.5,0.3,0.5");
+  app.footer(
+      "Examples:\n  iblkit render blob --light probe.exr --out blob.png --backend cpu --size 400x300\n"
+      "  iblkit render blob --light lights.json --backend gl --frames 10 --size 320x240 --out blob.exr\n"
+      "  iblkit render blob --light grid.shgrid --at 0.5,0.3,0.5 --object-size 0.3 --eye 0.5,0.6,1.6 --target "
+      "0.5,0.3,0.5");
 }
 
 // What the frame shows: the object (and a floor under it) with its material; `d` points at them.
@@ -139,7 +164,8 @@ void make_scene(const Opts& o, Scene* s) {
   d.camera.target = o.target.empty() ? od.at : iblcli::parse_vec3(o.target, "--target");
   d.camera.eye = o.eye.empty() ? od.at + Vec3{0, 0.5, 1.6} : iblcli::parse_vec3(o.eye, "--eye");
   d.camera.fov_y_deg = o.fov;
-  if (!(od.size > 0) && (od.scene == "blob" || od.scene == "sphere")) fail(ErrorKind::Value, "--object-size must be > 0 for the {}", od.scene);
+  if (!(od.size > 0) && (od.scene == "blob" || od.scene == "sphere"))
+    fail(ErrorKind::Value, "--object-size must be > 0 for the {}", od.scene);
   s->object = render::make_object(od);
   Vec3 lo, hi;
   s->object.bounds(&lo, &hi);
@@ -154,9 +180,9 @@ void make_scene(const Opts& o, Scene* s) {
 
 // The backend that renders: "cpu", or "gl" with its context (current while this lives).
 struct Backend {
-  std::string name;                // "cpu" or "gl"
-  std::string gl_renderer;         // the GL context's renderer string
-  std::shared_ptr<void> context;   // the GL context
+  std::string name;               // "cpu" or "gl"
+  std::string gl_renderer;        // the GL context's renderer string
+  std::shared_ptr<void> context;  // the GL context
 };
 
 // --backend: cpu, gl, or auto (gl when a context opens, else the CPU).
@@ -170,7 +196,8 @@ Backend open_backend(const std::string& wanted) {
       b.context = ctx;
       b.name = "gl";
     } catch (const Error& e) {
-      if (b.name == "gl") fail(ErrorKind::Unsupported, "no OpenGL here ({}); --backend cpu or auto renders on the CPU", e.what());
+      if (b.name == "gl")
+        fail(ErrorKind::Unsupported, "no OpenGL here ({}); --backend cpu or auto renders on the CPU", e.what());
       iblcli::info(fmt::format("no OpenGL here ({}); rendering on the CPU", e.what()));
       b.name = "cpu";
     }
@@ -203,8 +230,9 @@ RenderResult render_frame(const Opts& o, const FrameDesc& d, const Backend& back
     }
     if (f.unshadowed_lights > 0) {
       j["unshadowed_lights"] = f.unshadowed_lights;
-      iblcli::info(fmt::format("{} shadow-casting lights got no shadow map (over {}, or point lights inside the object's bounds)",
-                               f.unshadowed_lights, gl::Renderer::kMaxShadowMaps));
+      iblcli::info(fmt::format(
+          "{} shadow-casting lights got no shadow map (over {}, or point lights inside the object's bounds)",
+          f.unshadowed_lights, gl::Renderer::kMaxShadowMaps));
     }
   }
 #endif
@@ -271,22 +299,26 @@ std::string write_truth_pictures(const Opts& o, const fs::path& stem, int w, int
   return pictures;
 }
 
-void print_renders(const Opts& o, const nlohmann::json& renders, const nlohmann::json& result, const std::string& backend) {
+void print_renders(const Opts& o, const nlohmann::json& renders, const nlohmann::json& result,
+                   const std::string& backend) {
   for (const auto& j : renders) {
-    fmt::print("rendered {} ({}, {} backend) lit by {}\n", j["output"].get<std::string>(), o.size, backend, j["lighting"].get<std::string>());
+    fmt::print("rendered {} ({}, {} backend) lit by {}\n", j["output"].get<std::string>(), o.size, backend,
+               j["lighting"].get<std::string>());
     if (j.contains("gpu_ms_median"))
-      fmt::print("GPU time {:.3f} ms/frame median of {} ({:.0f} fps) on {}\n", j["gpu_ms_median"].get<double>(), o.frames,
-                 j["fps_gpu"].get<double>(), j["gl_renderer"].get<std::string>());
+      fmt::print("GPU time {:.3f} ms/frame median of {} ({:.0f} fps) on {}\n", j["gpu_ms_median"].get<double>(),
+                 o.frames, j["fps_gpu"].get<double>(), j["gl_renderer"].get<std::string>());
     else if (j.contains("gl_renderer"))
-      fmt::print("{:.1f} ms/frame wall clock over {} frames on {} (a software renderer: its GPU timer queries mean nothing)\n",
-                 j["wall_ms_per_frame"].get<double>(), o.frames, j["gl_renderer"].get<std::string>());
+      fmt::print(
+          "{:.1f} ms/frame wall clock over {} frames on {} (a software renderer: its GPU timer queries mean nothing)\n",
+          j["wall_ms_per_frame"].get<double>(), o.frames, j["gl_renderer"].get<std::string>());
     if (j.contains("cpu_ms")) fmt::print("CPU time {:.0f} ms\n", j["cpu_ms"].get<double>());
     if (j.contains("truth"))
-      fmt::print("against the lab photograph in {}: object relative L1 {:.3f} (median pixel {:.3f}; mean luminance {:.4g} vs "
-                 "{:.4g}), object and floor {:.3f}\n",
-                 o.truth, j["truth"]["rel_l1_object"].get<double>(), j["truth"]["median_rel_object"].get<double>(),
-                 j["truth"]["mean_luminance_render"].get<double>(), j["truth"]["mean_luminance_truth"].get<double>(),
-                 j["truth"]["rel_l1_object_and_floor"].get<double>());
+      fmt::print(
+          "against the lab photograph in {}: object relative L1 {:.3f} (median pixel {:.3f}; mean luminance {:.4g} vs "
+          "{:.4g}), object and floor {:.3f}\n",
+          o.truth, j["truth"]["rel_l1_object"].get<double>(), j["truth"]["median_rel_object"].get<double>(),
+          j["truth"]["mean_luminance_render"].get<double>(), j["truth"]["mean_luminance_truth"].get<double>(),
+          j["truth"]["rel_l1_object_and_floor"].get<double>());
   }
   if (result.contains("truth_pictures")) fmt::print("pictures: {}\n", result["truth_pictures"].get<std::string>());
 }
@@ -332,8 +364,10 @@ void run(const Opts& o, const io::EnvReadDesc& rd) {
     RenderResult f = render_frame(o, d, backend, j);
     // One --light writes --out; several write OUT_<light name>.ext each.
     std::string out = o.lights.size() == 1 ? o.out : stem.string() + "_" + names[li] + ext;
-    if (ext == ".png" || ext == ".jpg") io::write_image(out, io::tonemap(f.color, truth.td));
-    else io::write_image(out, f.color);
+    if (ext == ".png" || ext == ".jpg")
+      io::write_image(out, io::tonemap(f.color, truth.td));
+    else
+      io::write_image(out, f.color);
     j["output"] = out;
     if (truth.photo) compare_with_truth(o, light, f, &truth, j);
     renders.push_back(j);
@@ -359,7 +393,8 @@ void demo_step(iblcli::DemoContext& ctx) {
   d.camera.height = 360;
   d.camera.eye = {0, 0.5, 1.6};
   geometry::TriMesh object = geometry::make_blob(60000, 0.8), floor = geometry::make_floor(6, -0.42);
-  d.objects = {{&object, Material{{0.75, 0.75, 0.75}, {0.15, 0.15, 0.15}, 20}}, {&floor, Material{{0.5, 0.5, 0.5}, {0, 0, 0}, 1}}};
+  d.objects = {{&object, Material{{0.75, 0.75, 0.75}, {0.15, 0.15, 0.15}, 20}},
+               {&floor, Material{{0.5, 0.5, 0.5}, {0, 0, 0}, 1}}};
   auto probe = io::read_envmap(ctx.probe);
   d.lighting.environment = sh::project(probe, 5);
   d.lighting.glossy_maps.push_back(prefilter_phong(probe, 20));  // the highlight without the SH band limit
@@ -411,11 +446,13 @@ void demo_step(iblcli::DemoContext& ctx) {
     f9.camera.height = 240;
     f9.camera.eye = {0, 1.45, 1.5};
     f9.camera.target = {0, 0.8, 0};
-    geometry::TriMesh small = render::make_object({.scene = "blob", .size = 0.35, .triangles = 30000, .at = {0, 0.85, 0}});
+    geometry::TriMesh small =
+        render::make_object({.scene = "blob", .size = 0.35, .triangles = 30000, .at = {0, 0.85, 0}});
     Vec3 lo, hi;
     small.bounds(&lo, &hi);
     geometry::TriMesh table = geometry::make_floor(0.8, lo.y - 1e-3);
-    f9.objects = {{&small, Material{{0.75, 0.75, 0.75}, {0, 0, 0}, 1}}, {&table, Material{{0.5, 0.5, 0.5}, {0, 0, 0}, 1}}};
+    f9.objects = {{&small, Material{{0.75, 0.75, 0.75}, {0, 0, 0}, 1}},
+                  {&table, Material{{0.5, 0.5, 0.5}, {0, 0, 0}, 1}}};
     iblcli::LabPhotograph photo = iblcli::photograph_frame("low-scene2", f9, 3, 1);  // one bounce more than the capture
     io::ToneMapDesc t9;
     t9.auto_exposure = false;

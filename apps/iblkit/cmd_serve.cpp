@@ -22,11 +22,15 @@ void setup(CLI::App& app) {
   };
   auto* o = iblcli::app_owned<Opts>();
   app.add_option("dir", o->d.root, "folder to serve (its index.html is the page)")->required();
-  app.add_option("--port", o->d.port, "TCP port (0: any free port)")->capture_default_str()->check(CLI::Range(0, 65535));
+  app.add_option("--port", o->d.port, "TCP port (0: any free port)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 65535));
   app.add_option("--host", o->d.host, "loopback address to listen on (127.0.0.0/8 or ::1)")->capture_default_str();
-  app.add_option("--seconds", o->seconds, "stop after this many seconds (0: until interrupted)")->check(CLI::Range(0.0, 1e7));
-  app.footer("Prints the page's address on its first line, then serves until Ctrl-C.\n"
-             "Example:\n  iblkit demo --out demo-out --only sh,lights,web && iblkit serve demo-out/web --port 8080");
+  app.add_option("--seconds", o->seconds, "stop after this many seconds (0: until interrupted)")
+      ->check(CLI::Range(0.0, 1e7));
+  app.footer(
+      "Prints the page's address on its first line, then serves until Ctrl-C.\n"
+      "Example:\n  iblkit demo --out demo-out --only sh,lights,web && iblkit serve demo-out/web --port 8080");
   app.callback([o] {
     std::signal(SIGINT, on_signal);
     std::signal(SIGTERM, on_signal);
@@ -34,7 +38,8 @@ void setup(CLI::App& app) {
     if (o->seconds > 0)
       timer = std::thread([s = o->seconds] {
         auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(s);
-        while (!g_stop && std::chrono::steady_clock::now() < end) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+        while (!g_stop && std::chrono::steady_clock::now() < end)
+          std::this_thread::sleep_for(std::chrono::milliseconds(50));
         g_stop = true;
       });
     try {

@@ -45,12 +45,15 @@ void setup(CLI::App& app) {
   app.add_option("-f,--format", o->format, "output layout: iblkit (iblkit.sh/1 JSON), threejs, filament (sh.txt), gltf")
       ->capture_default_str();
   app.add_option("-o,--out", o->out, "write the coefficients here (default: print them on stdout)");
-  app.add_option("--irradiance-map", o->irradiance_map, "also render the SH irradiance E(n) as a lat-long image (.exr …)");
-  app.add_option("--irradiance-size", o->irradiance_size, "height of the irradiance map (width is twice)")->capture_default_str();
-  app.add_option("--specular-images", o->specular_images,
-                 "--format gltf: the prefiltered cube's HDR faces as a pattern with {level} and {face} (px nx py ny pz nz), e.g. "
-                 "spec/m{level}_{face}.exr from `iblkit specular --faces spec`; levels 0, 1, … while all six exist. Each face is "
-                 "written beside --out as the extension's RGBD PNG (OUT-STEM_m<level>_<face>.png, flipped as it specifies)");
+  app.add_option("--irradiance-map", o->irradiance_map,
+                 "also render the SH irradiance E(n) as a lat-long image (.exr …)");
+  app.add_option("--irradiance-size", o->irradiance_size, "height of the irradiance map (width is twice)")
+      ->capture_default_str();
+  app.add_option(
+      "--specular-images", o->specular_images,
+      "--format gltf: the prefiltered cube's HDR faces as a pattern with {level} and {face} (px nx py ny pz nz), e.g. "
+      "spec/m{level}_{face}.exr from `iblkit specular --faces spec`; levels 0, 1, … while all six exist. Each face is "
+      "written beside --out as the extension's RGBD PNG (OUT-STEM_m<level>_<face>.png, flipped as it specifies)");
   auto& rd = iblcli::add_probe_read_options(app);
   app.footer(
       "Examples:\n"
@@ -68,7 +71,8 @@ void setup(CLI::App& app) {
     sh::WindowDesc wd;
     wd.kind = sh::parse_window(o->window);
     if (format != sh::ExportFormat::Iblkit && o->bands != 3)
-      fail(ErrorKind::Value, "--format {} stores 3 bands (9 coefficients); use --bands 3 (got {})", o->format, o->bands);
+      fail(ErrorKind::Value, "--format {} stores 3 bands (9 coefficients); use --bands 3 (got {})", o->format,
+           o->bands);
 
     io::ReadReport rep;
     sphere::EnvMap env = io::read_envmap(o->probe, rd, &rep);
@@ -85,7 +89,8 @@ void setup(CLI::App& app) {
     std::vector<std::string> specular_files;
     if (!o->specular_images.empty()) {
       if (format != sh::ExportFormat::Gltf) fail(ErrorKind::Value, "--specular-images goes with --format gltf");
-      if (o->out.empty()) fail(ErrorKind::Value, "--specular-images needs --out (the PNGs are written beside the glTF)");
+      if (o->out.empty())
+        fail(ErrorKind::Value, "--specular-images needs --out (the PNGs are written beside the glTF)");
       specular_files = engine::write_gltf_ibl(o->out, c, engine::read_cube_faces(o->specular_images));
       specular_files.pop_back();  // the document itself
     } else if (!o->out.empty()) {
@@ -115,14 +120,15 @@ void setup(CLI::App& app) {
         return;
       }
       fmt::print("{}: {} bands ({} coefficients) from {} {}x{} in {:.1f} ms, window {}\n", o->out, c.bands,
-                 sh::coeff_count(c.bands), sphere::mapping_name(env.mapping.kind()), env.image.width(), env.image.height(),
-                 ms, sh::window_name(wd.kind));
+                 sh::coeff_count(c.bands), sphere::mapping_name(env.mapping.kind()), env.image.width(),
+                 env.image.height(), ms, sh::window_name(wd.kind));
       Vec3 e = sh::irradiance_at(c, {0, 1, 0});
       fmt::print("E(+Y) = {:.6g} {:.6g} {:.6g}; min E / mean E = {:.4f} before window, {:.4f} after\n", e.x, e.y, e.z,
                  wr.min_irradiance_before, wr.min_irradiance_after);
       if (!o->irradiance_map.empty()) fmt::print("irradiance map: {}\n", o->irradiance_map);
       if (!specular_files.empty())
-        fmt::print("specular images: {} RGBD PNGs ({} levels) beside {}\n", specular_files.size(), specular_files.size() / 6, o->out);
+        fmt::print("specular images: {} RGBD PNGs ({} levels) beside {}\n", specular_files.size(),
+                   specular_files.size() / 6, o->out);
     });
   });
 }

@@ -29,29 +29,39 @@ void setup(CLI::App& app) {
   app.add_option("probe", o->probe, "HDR probe image (or a folder of six cube faces); not needed for --dfg alone");
   app.add_option("-o,--out", o->out, "write the prefiltered cube map, every level, as KTX2 (RGBA16F)");
   app.add_option("-s,--size", o->size, "face size of level 0 (power of two, 8..4096)")->capture_default_str();
-  app.add_option("-l,--levels", o->levels, "mip levels N (0: log2(size) − 3, down to 16², as cmgen)")->capture_default_str();
+  app.add_option("-l,--levels", o->levels, "mip levels N (0: log2(size) − 3, down to 16², as cmgen)")
+      ->capture_default_str();
   app.add_option("--roughness", o->lod,
-                 "level → perceptual roughness: linear (m/(N−1), glTF/three.js viewers) or filament (1 − √(1 − m/(N−1)), cmgen's levels)")
+                 "level → perceptual roughness: linear (m/(N−1), glTF/three.js viewers) or filament (1 − √(1 − "
+                 "m/(N−1)), cmgen's levels)")
       ->capture_default_str();
-  app.add_option("--frame", o->frame, "world frame of the maps: iblkit (= three.js, glTF) or filament (cmgen's frame of a lat-long)")
+  app.add_option("--frame", o->frame,
+                 "world frame of the maps: iblkit (= three.js, glTF) or filament (cmgen's frame of a lat-long)")
       ->capture_default_str();
-  app.add_option("--samples", o->samples, "importance samples per texel on the levels too large to convolve exactly")->capture_default_str();
+  app.add_option("--samples", o->samples, "importance samples per texel on the levels too large to convolve exactly")
+      ->capture_default_str();
   app.add_option("--faces", o->faces, "also write every level as EXR faces DIR/m<level>_<px|nx|py|ny|pz|nz>.exr");
   app.add_option("--latlong", o->latlong, "also write every level as a lat-long DIR/m<level>.exr");
-  app.add_option("--irradiance", o->irradiance, "also write the irradiance cube map E/π (.ktx2, or a folder of six EXR faces)");
-  app.add_option("--irradiance-size", o->irradiance_size, "face size of the irradiance cube map")->capture_default_str();
+  app.add_option("--irradiance", o->irradiance,
+                 "also write the irradiance cube map E/π (.ktx2, or a folder of six EXR faces)");
+  app.add_option("--irradiance-size", o->irradiance_size, "face size of the irradiance cube map")
+      ->capture_default_str();
   app.add_option("--dfg", o->dfg, "write the split-sum DFG table (scale, bias) as .png, .exr or .ktx2");
   app.add_option("--dfg-size", o->dfg_size, "size of the DFG table")->capture_default_str();
   auto& rd = iblcli::add_probe_read_options(app);
   app.footer(
       "Examples:\n"
-      "  iblkit specular /usr/share/blender/datafiles/studiolights/world/forest.exr --out forest_env.ktx2 --irradiance forest_irr.ktx2\n"
-      "  iblkit specular /usr/share/blender/datafiles/studiolights/world/forest.exr --size 64 --faces forest_faces --roughness filament --frame filament\n"
+      "  iblkit specular /usr/share/blender/datafiles/studiolights/world/forest.exr --out forest_env.ktx2 --irradiance "
+      "forest_irr.ktx2\n"
+      "  iblkit specular /usr/share/blender/datafiles/studiolights/world/forest.exr --size 64 --faces forest_faces "
+      "--roughness filament --frame filament\n"
       "  iblkit specular --dfg dfg.png");
   app.callback([o, &rd] {
     const bool wants_probe = !o->out.empty() || !o->faces.empty() || !o->latlong.empty() || !o->irradiance.empty();
-    if (!wants_probe && o->dfg.empty()) fail(ErrorKind::Value, "nothing to write: give --out, --faces, --latlong, --irradiance or --dfg");
-    if (wants_probe && o->probe.empty()) fail(ErrorKind::Value, "--out, --faces, --latlong and --irradiance need a PROBE");
+    if (!wants_probe && o->dfg.empty())
+      fail(ErrorKind::Value, "nothing to write: give --out, --faces, --latlong, --irradiance or --dfg");
+    if (wants_probe && o->probe.empty())
+      fail(ErrorKind::Value, "--out, --faces, --latlong and --irradiance need a PROBE");
     engine::SpecularDesc sd;
     sd.size = o->size;
     sd.levels = o->levels;
@@ -83,13 +93,19 @@ void setup(CLI::App& app) {
         nlohmann::json lv = nlohmann::json::array();
         for (size_t m = 0; m < cube.info.size(); ++m) {
           const auto& l = cube.info[m];
-          lv.push_back({{"level", m}, {"size", cube.cube.size(static_cast<int>(m))}, {"roughness", l.roughness}, {"alpha", l.alpha},
-                        {"method", engine::level_method_name(l.method)}, {"source_size", l.source_size}, {"seconds", l.seconds}});
+          lv.push_back({{"level", m},
+                        {"size", cube.cube.size(static_cast<int>(m))},
+                        {"roughness", l.roughness},
+                        {"alpha", l.alpha},
+                        {"method", engine::level_method_name(l.method)},
+                        {"source_size", l.source_size},
+                        {"seconds", l.seconds}});
         }
         j["levels"] = lv;
         if (!o->out.empty()) engine::write_ktx2(o->out, engine::cube_ktx2(cube.cube)), written.push_back(o->out);
         if (!o->faces.empty()) engine::write_cube_faces(o->faces, cube.cube), written.push_back(o->faces + "/");
-        if (!o->latlong.empty()) engine::write_cube_latlongs(o->latlong, cube.cube), written.push_back(o->latlong + "/");
+        if (!o->latlong.empty())
+          engine::write_cube_latlongs(o->latlong, cube.cube), written.push_back(o->latlong + "/");
       }
       if (!o->irradiance.empty()) {
         auto t0 = std::chrono::steady_clock::now();
@@ -109,8 +125,9 @@ void setup(CLI::App& app) {
     iblcli::emit(j, [&] {
       if (j.contains("levels"))
         for (const auto& l : j["levels"])
-          fmt::print("level {}  {:4}²  roughness {:.3f}  α {:.4f}  {:10}  {:.2f} s\n", l["level"].get<int>(), l["size"].get<int>(),
-                     l["roughness"].get<double>(), l["alpha"].get<double>(), l["method"].get<std::string>(), l["seconds"].get<double>());
+          fmt::print("level {}  {:4}²  roughness {:.3f}  α {:.4f}  {:10}  {:.2f} s\n", l["level"].get<int>(),
+                     l["size"].get<int>(), l["roughness"].get<double>(), l["alpha"].get<double>(),
+                     l["method"].get<std::string>(), l["seconds"].get<double>());
       for (const auto& w : written) fmt::print("wrote {}\n", w);
     });
   });

@@ -3,8 +3,8 @@
 // frame time. With --frames N it runs N frames on its own (orbiting) and exits: how the tests drive
 // it under Xvfb.
 #if defined(IBLKIT_HAVE_GL) && defined(IBLKIT_HAVE_GLFW)
-#include <epoxy/gl.h>
 #include <GLFW/glfw3.h>
+#include <epoxy/gl.h>
 
 #include <algorithm>
 #include <chrono>
@@ -15,7 +15,6 @@
 #include <fmt/format.h>
 
 #include "cli.h"
-#include "render_setup.h"
 #include "iblkit/augment/albedo.h"
 #include "iblkit/augment/composite.h"
 #include "iblkit/augment/gl/compositor.h"
@@ -31,6 +30,7 @@
 #include "iblkit/render/gl/renderer.h"
 #include "iblkit/render/lighting_io.h"
 #include "iblkit/render/objects.h"
+#include "render_setup.h"
 
 namespace {
 
@@ -58,21 +58,23 @@ struct Orbit {
   Vec3 target;
   double azimuth = 0, elevation = 0.35, distance = 2;
   Vec3 eye() const {
-    return target + Vec3{std::sin(azimuth) * std::cos(elevation), std::sin(elevation), std::cos(azimuth) * std::cos(elevation)} * distance;
+    return target +
+           Vec3{std::sin(azimuth) * std::cos(elevation), std::sin(elevation), std::cos(azimuth) * std::cos(elevation)} *
+               distance;
   }
 };
 
 struct State {
   Orbit orbit;
-  Vec3 offset;          // object displacement from --at
-  int lighting = 0;     // index into the loaded lightings
+  Vec3 offset;       // object displacement from --at
+  int lighting = 0;  // index into the loaded lightings
   bool glossy = true;
-  double exposure = 0;  // stops added to the auto exposure
+  double exposure = 0;   // stops added to the auto exposure
   bool remeter = false;  // measure the auto exposure again on the next frame
   bool dragging = false;
   double last_x = 0, last_y = 0;
-  double step = 0.05;   // metres per key press
-  int slice_axis = 1;   // --error-grid: the slice's normal axis (keys X, Y, Z); it passes through the object
+  double step = 0.05;  // metres per key press
+  int slice_axis = 1;  // --error-grid: the slice's normal axis (keys X, Y, Z); it passes through the object
 };
 
 // What the viewer shows, all read before a window opens (everything that can fail on input).
@@ -87,8 +89,8 @@ struct Inputs {
 
 Inputs read_inputs(const ViewOpts& o, const io::EnvReadDesc& rd) {
   Inputs in;
-  if (std::sscanf(o.size.c_str(), "%dx%d", &in.width, &in.height) != 2 || in.width < 16 || in.height < 16 || in.width > 8192 ||
-      in.height > 8192)
+  if (std::sscanf(o.size.c_str(), "%dx%d", &in.width, &in.height) != 2 || in.width < 16 || in.height < 16 ||
+      in.width > 8192 || in.height > 8192)
     fail(ErrorKind::Value, "--size '{}': expected WxH, e.g. 960x720", o.size);
   render::LightingReadDesc lopt = o.lighting;
   lopt.glossy_exponent = o.gloss > 0 ? o.exponent : 0.0;
@@ -107,7 +109,8 @@ Inputs read_inputs(const ViewOpts& o, const io::EnvReadDesc& rd) {
   if (!o.error_grid.empty()) {
     in.error = ilf::read_shgrid(o.error_grid, true);
     if (in.error.content() != "cv-error")
-      fail(ErrorKind::Value, "--error-grid {}: holds \"{}\", not a cross-validated error volume (write one with ilf build --error-grid)",
+      fail(ErrorKind::Value,
+           "--error-grid {}: holds \"{}\", not a cross-validated error volume (write one with ilf build --error-grid)",
            o.error_grid, in.error.content().empty() ? "radiance SH" : in.error.content());
   }
   return in;
@@ -136,21 +139,54 @@ void install_controls(GLFWwindow* win, State* st) {
     if (action == GLFW_RELEASE) return;
     auto& s = *static_cast<State*>(glfwGetWindowUserPointer(wnd));
     switch (key) {
-      case GLFW_KEY_ESCAPE: case GLFW_KEY_Q: glfwSetWindowShouldClose(wnd, GLFW_TRUE); break;
-      case GLFW_KEY_LEFT: s.offset.x -= s.step; break;
-      case GLFW_KEY_RIGHT: s.offset.x += s.step; break;
-      case GLFW_KEY_UP: s.offset.z -= s.step; break;
-      case GLFW_KEY_DOWN: s.offset.z += s.step; break;
-      case GLFW_KEY_PAGE_UP: s.offset.y += s.step; break;
-      case GLFW_KEY_PAGE_DOWN: s.offset.y -= s.step; break;
-      case GLFW_KEY_G: s.glossy = !s.glossy; break;
-      case GLFW_KEY_E: s.remeter = true; break;
-      case GLFW_KEY_EQUAL: case GLFW_KEY_KP_ADD: s.exposure += 0.5; break;
-      case GLFW_KEY_MINUS: case GLFW_KEY_KP_SUBTRACT: s.exposure -= 0.5; break;
-      case GLFW_KEY_TAB: ++s.lighting; break;
-      case GLFW_KEY_X: s.slice_axis = 0; break;
-      case GLFW_KEY_Y: s.slice_axis = 1; break;
-      case GLFW_KEY_Z: s.slice_axis = 2; break;
+      case GLFW_KEY_ESCAPE:
+      case GLFW_KEY_Q:
+        glfwSetWindowShouldClose(wnd, GLFW_TRUE);
+        break;
+      case GLFW_KEY_LEFT:
+        s.offset.x -= s.step;
+        break;
+      case GLFW_KEY_RIGHT:
+        s.offset.x += s.step;
+        break;
+      case GLFW_KEY_UP:
+        s.offset.z -= s.step;
+        break;
+      case GLFW_KEY_DOWN:
+        s.offset.z += s.step;
+        break;
+      case GLFW_KEY_PAGE_UP:
+        s.offset.y += s.step;
+        break;
+      case GLFW_KEY_PAGE_DOWN:
+        s.offset.y -= s.step;
+        break;
+      case GLFW_KEY_G:
+        s.glossy = !s.glossy;
+        break;
+      case GLFW_KEY_E:
+        s.remeter = true;
+        break;
+      case GLFW_KEY_EQUAL:
+      case GLFW_KEY_KP_ADD:
+        s.exposure += 0.5;
+        break;
+      case GLFW_KEY_MINUS:
+      case GLFW_KEY_KP_SUBTRACT:
+        s.exposure -= 0.5;
+        break;
+      case GLFW_KEY_TAB:
+        ++s.lighting;
+        break;
+      case GLFW_KEY_X:
+        s.slice_axis = 0;
+        break;
+      case GLFW_KEY_Y:
+        s.slice_axis = 1;
+        break;
+      case GLFW_KEY_Z:
+        s.slice_axis = 2;
+        break;
       default:
         if (key >= GLFW_KEY_1 && key <= GLFW_KEY_9) s.lighting = key - GLFW_KEY_1;
     }
@@ -184,7 +220,7 @@ Image capture(int fw, int fh) {
   for (int y = 0; y < fh; ++y)
     for (int x = 0; x < fw; ++x)
       for (int c = 0; c < 3; ++c) {
-        float v = px[(static_cast<size_t>(fh - 1 - y) * fw + x) * 3 + c];  // GL rows go up
+        float v = px[(static_cast<size_t>(fh - 1 - y) * fw + x) * 3 + c];                       // GL rows go up
         shot.at(x, y, c) = v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);  // back to linear
       }
   return shot;
@@ -199,7 +235,8 @@ struct ErrorSlice {
 };
 
 struct Viewer {
-  std::unique_ptr<gl::Renderer> renderer = std::make_unique<gl::Renderer>();  // released before the window's context goes
+  std::unique_ptr<gl::Renderer> renderer =
+      std::make_unique<gl::Renderer>();  // released before the window's context goes
   std::unique_ptr<gl::Presenter> present = std::make_unique<gl::Presenter>();
   ErrorSlice slice;
   Image last;  // the screenshot
@@ -298,11 +335,15 @@ void show_frame(const ViewOpts& o, Inputs& in, State& st, Viewer& v, GLFWwindow*
   v.ms_sum += ms;
   ++v.frame;
   bool software = v.renderer_name.find("llvmpipe") != std::string::npos;
-  glfwSetWindowTitle(win, fmt::format("iblkit view — {} — {} {:.2f} ms/frame ({}){}{}", std::filesystem::path(o.lights[li]).filename().string(),
-                                      software ? "wall" : "GPU", software ? ms : t.frame_ms[0], in.kinds[li],
-                                      st.glossy ? ", glossy" : "",
-                                      in.error.data().empty() ? std::string() : fmt::format(", error slice {} = {:.2f}: mean {:.3f}, max {:.3f} (red: {:g})",
-                                                                                     "xyz"[v.slice.axis], v.slice.value, v.slice.mean, v.slice.max, o.max_error)).c_str());
+  glfwSetWindowTitle(
+      win, fmt::format("iblkit view — {} — {} {:.2f} ms/frame ({}){}{}",
+                       std::filesystem::path(o.lights[li]).filename().string(), software ? "wall" : "GPU",
+                       software ? ms : t.frame_ms[0], in.kinds[li], st.glossy ? ", glossy" : "",
+                       in.error.data().empty()
+                           ? std::string()
+                           : fmt::format(", error slice {} = {:.2f}: mean {:.3f}, max {:.3f} (red: {:g})",
+                                         "xyz"[v.slice.axis], v.slice.value, v.slice.mean, v.slice.max, o.max_error))
+               .c_str());
 }
 
 // Composite mode: the object moved over the photograph (augment/gl/compositor.h), the camera the
@@ -311,7 +352,8 @@ void show_frame(const ViewOpts& o, Inputs& in, State& st, Viewer& v, GLFWwindow*
 void run_composite(const ViewOpts& o, const ibl::io::EnvReadDesc& rd) {
   Image photo = io::read_image(o.photo);
   const geometry::Camera cam = iblcli::photo_camera(o.scene, photo, o.photo, "--composite: ");
-  const augment::ObjectDesc od = iblcli::inserted_object(o.object.scene, o.object.size, o.object.triangles, o.at, o.albedo);
+  const augment::ObjectDesc od =
+      iblcli::inserted_object(o.object.scene, o.object.size, o.object.triangles, o.at, o.albedo);
   geometry::TriMesh object = augment::make_object(od);
   Vec3 lo, hi;
   object.bounds(&lo, &hi);
@@ -325,7 +367,9 @@ void run_composite(const ViewOpts& o, const ibl::io::EnvReadDesc& rd) {
   sd.lights = o.gl_lights;
   augment::SplitLight split = augment::split_light(L.light, L.proxy, sd);
   if (!glfwInit()) fail(ErrorKind::Unsupported, "no display: GLFW could not initialise (is DISPLAY set? try xvfb-run)");
-  struct Terminate { ~Terminate() { glfwTerminate(); } } terminate;
+  struct Terminate {
+    ~Terminate() { glfwTerminate(); }
+  } terminate;
   GLFWwindow* win = open_window(photo.width(), photo.height(), o.frames == 0);
   glfwSetWindowAttrib(win, GLFW_RESIZABLE, GLFW_FALSE);  // the frame is the photograph's
   State st;
@@ -364,26 +408,35 @@ void run_composite(const ViewOpts& o, const ibl::io::EnvReadDesc& rd) {
     auto t0 = std::chrono::steady_clock::now();
     comp->draw(offset, true, &t);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    present->draw(comp->color_texture(), std::min(fw, photo.width()), std::min(fh, photo.height()), meter * std::exp2(st.exposure));
-    if (!o.screenshot.empty() && (o.frames == 0 || frame + 1 == o.frames)) last = capture(std::min(fw, photo.width()), std::min(fh, photo.height()));
+    present->draw(comp->color_texture(), std::min(fw, photo.width()), std::min(fh, photo.height()),
+                  meter * std::exp2(st.exposure));
+    if (!o.screenshot.empty() && (o.frames == 0 || frame + 1 == o.frames))
+      last = capture(std::min(fw, photo.width()), std::min(fh, photo.height()));
     glfwSwapBuffers(win);
     double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     ms_sum += ms;
     ++frame;
     bool software = renderer_name.find("llvmpipe") != std::string::npos;
-    glfwSetWindowTitle(win, fmt::format("iblkit view — composite {} — {} {:.2f} ms/frame, {} hard lights", std::filesystem::path(o.photo).filename().string(),
-                                        software ? "wall" : "GPU", software ? ms : t.gpu_ms, split.hard.size()).c_str());
+    glfwSetWindowTitle(win, fmt::format("iblkit view — composite {} — {} {:.2f} ms/frame, {} hard lights",
+                                        std::filesystem::path(o.photo).filename().string(), software ? "wall" : "GPU",
+                                        software ? ms : t.gpu_ms, split.hard.size())
+                                .c_str());
     glfwPollEvents();
   }
   present.reset();  // before the window's context goes
   comp.reset();
   glfwDestroyWindow(win);
   if (!o.screenshot.empty() && !last.empty()) io::write_image(o.screenshot, last);
-  iblcli::emit({{"frames", frame}, {"ms_per_frame", frame ? ms_sum / frame : 0.0}, {"gl_renderer", renderer_name}, {"screenshot", o.screenshot},
-                {"mode", "composite"}, {"hard_lights", split.hard.size()}},
+  iblcli::emit({{"frames", frame},
+                {"ms_per_frame", frame ? ms_sum / frame : 0.0},
+                {"gl_renderer", renderer_name},
+                {"screenshot", o.screenshot},
+                {"mode", "composite"},
+                {"hard_lights", split.hard.size()}},
                [&] {
-                 fmt::print("{} composite frames, {:.1f} ms per frame (shadow maps, differential render, display) on {}\n", frame,
-                            frame ? ms_sum / frame : 0.0, renderer_name);
+                 fmt::print(
+                     "{} composite frames, {:.1f} ms per frame (shadow maps, differential render, display) on {}\n",
+                     frame, frame ? ms_sum / frame : 0.0, renderer_name);
                  if (!o.screenshot.empty()) fmt::print("screenshot {}\n", o.screenshot);
                });
 }
@@ -393,7 +446,9 @@ void run(const ViewOpts& o, const ibl::io::EnvReadDesc& rd) {
   if (o.lights.empty()) fail(ErrorKind::Value, "--light is required (or --composite PHOTO with its light)");
   Inputs in = read_inputs(o, rd);
   if (!glfwInit()) fail(ErrorKind::Unsupported, "no display: GLFW could not initialise (is DISPLAY set? try xvfb-run)");
-  struct Terminate { ~Terminate() { glfwTerminate(); } } terminate;
+  struct Terminate {
+    ~Terminate() { glfwTerminate(); }
+  } terminate;
   GLFWwindow* win = open_window(in.width, in.height, o.frames == 0);
   State st;
   st.orbit.target = in.at;
@@ -419,7 +474,8 @@ void run(const ViewOpts& o, const ibl::io::EnvReadDesc& rd) {
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     v->present->draw(v->renderer->color_texture(), v->shown_w, v->shown_h, v->shown_scale);
     if (!in.error.data().empty())
-      v->slice.overlay->draw(8, v->shown_h - 8 - v->slice.overlay->height(), v->slice.overlay->width(), v->slice.overlay->height());
+      v->slice.overlay->draw(8, v->shown_h - 8 - v->slice.overlay->height(), v->slice.overlay->width(),
+                             v->slice.overlay->height());
     v->last = capture(v->shown_w, v->shown_h);
   }
   const int frames = v->frame;
@@ -430,47 +486,73 @@ void run(const ViewOpts& o, const ibl::io::EnvReadDesc& rd) {
   v.reset();  // the renderer and presenter before the window's context
   glfwDestroyWindow(win);
   if (!o.screenshot.empty() && !last.empty()) io::write_image(o.screenshot, last);
-  nlohmann::json summary = {{"frames", frames}, {"ms_per_frame", frames ? ms_sum / frames : 0.0}, {"gl_renderer", renderer_name},
+  nlohmann::json summary = {{"frames", frames},
+                            {"ms_per_frame", frames ? ms_sum / frames : 0.0},
+                            {"gl_renderer", renderer_name},
                             {"screenshot", o.screenshot}};
   if (!in.error.data().empty() && slice_shown.axis >= 0)
-    summary["error_slice"] = {{"plane", fmt::format("{}={:.9g}", "xyz"[slice_shown.axis], slice_shown.value)}, {"width", slice_shown.width},
-                              {"mean_rel_error", slice_shown.mean}, {"max_rel_error", slice_shown.max}, {"max_error", o.max_error}};
-  iblcli::emit(summary,
-               [&] {
-                 fmt::print("{} frames, {:.1f} ms per frame (render + tone map + display) on {}\n", frames, frames ? ms_sum / frames : 0.0,
-                            renderer_name);
-                 if (!in.error.data().empty() && slice_shown.axis >= 0)
-                   fmt::print("error slice {}={:.3g} ({} px wide): cross-validated relative error mean {:.3f}, max {:.3f}\n", "xyz"[slice_shown.axis],
-                              slice_shown.value, slice_shown.width, slice_shown.mean, slice_shown.max);
-                 if (!o.screenshot.empty()) fmt::print("screenshot {}\n", o.screenshot);
-               });
+    summary["error_slice"] = {{"plane", fmt::format("{}={:.9g}", "xyz"[slice_shown.axis], slice_shown.value)},
+                              {"width", slice_shown.width},
+                              {"mean_rel_error", slice_shown.mean},
+                              {"max_rel_error", slice_shown.max},
+                              {"max_error", o.max_error}};
+  iblcli::emit(summary, [&] {
+    fmt::print("{} frames, {:.1f} ms per frame (render + tone map + display) on {}\n", frames,
+               frames ? ms_sum / frames : 0.0, renderer_name);
+    if (!in.error.data().empty() && slice_shown.axis >= 0)
+      fmt::print("error slice {}={:.3g} ({} px wide): cross-validated relative error mean {:.3f}, max {:.3f}\n",
+                 "xyz"[slice_shown.axis], slice_shown.value, slice_shown.width, slice_shown.mean, slice_shown.max);
+    if (!o.screenshot.empty()) fmt::print("screenshot {}\n", o.screenshot);
+  });
 }
 
 void setup(CLI::App& app) {
   auto* o = iblcli::app_owned<ViewOpts>();
-  app.add_option("scene", o->object.scene, "the object: blob, sphere, or a mesh file (OBJ, PLY, glTF)")->capture_default_str();
-  app.add_option("-l,--light", o->lights, "lightings to switch between (keys 1-9, Tab): probe, .shgrid (or .shtree), iblkit.sh/1, iblkit.lights/1; "
-                 "with --composite: an SH grid or a probe image (with --proxy)");
-  app.add_option("--composite", o->photo, "composite mode: this photograph behind, the object moving in it with its shadows");
+  app.add_option("scene", o->object.scene, "the object: blob, sphere, or a mesh file (OBJ, PLY, glTF)")
+      ->capture_default_str();
+  app.add_option(
+      "-l,--light", o->lights,
+      "lightings to switch between (keys 1-9, Tab): probe, .shgrid (or .shtree), iblkit.sh/1, iblkit.lights/1; "
+      "with --composite: an SH grid or a probe image (with --proxy)");
+  app.add_option("--composite", o->photo,
+                 "composite mode: this photograph behind, the object moving in it with its shadows");
   iblcli::add_photo_scene_options(app, &o->scene, "composite: ");
   app.add_option("--albedo", o->albedo, "composite: the object's Lambertian albedo r,g,b")->capture_default_str();
-  app.add_option("--gl-lights", o->gl_lights, "composite: most hard lights with shadow maps")->check(CLI::Range(0, 16))->capture_default_str();
-  app.add_option("--at", o->at, "the object's starting centre x,y,z (e.g. inside an SH grid's volume)")->capture_default_str();
-  app.add_option("--object-size", o->object.size, "object size in metres")->check(CLI::Range(0.001, 1000.0))->capture_default_str();
-  app.add_option("--floor-size", o->floor_size, "side of the floor square, metres")->check(CLI::Range(0.0, 1000.0))->capture_default_str();
+  app.add_option("--gl-lights", o->gl_lights, "composite: most hard lights with shadow maps")
+      ->check(CLI::Range(0, 16))
+      ->capture_default_str();
+  app.add_option("--at", o->at, "the object's starting centre x,y,z (e.g. inside an SH grid's volume)")
+      ->capture_default_str();
+  app.add_option("--object-size", o->object.size, "object size in metres")
+      ->check(CLI::Range(0.001, 1000.0))
+      ->capture_default_str();
+  app.add_option("--floor-size", o->floor_size, "side of the floor square, metres")
+      ->check(CLI::Range(0.0, 1000.0))
+      ->capture_default_str();
   app.add_option("--size", o->size, "window size WxH")->capture_default_str();
-  app.add_option("--gloss", o->gloss, "weight of the glossy Phong lobe (key G toggles it)")->check(CLI::Range(0.0, 1.0))->capture_default_str();
+  app.add_option("--gloss", o->gloss, "weight of the glossy Phong lobe (key G toggles it)")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
   app.add_option("--exponent", o->exponent, "Phong exponent")->check(CLI::Range(1.0, 10000.0))->capture_default_str();
   app.add_option("--exposure", o->exposure, "stops added to the auto exposure (keys + and -)")->capture_default_str();
-  app.add_option("--bands", o->lighting.bands, "SH bands when projecting a probe")->check(CLI::Range(1, 9))->capture_default_str();
-  app.add_option("--triangles", o->object.triangles, "triangles of the blob")->check(CLI::Range(100, 5000000))->capture_default_str();
-  app.add_option("--shadows", o->lighting.shadows, "lights of a light set that cast shadows")->check(CLI::Range(0, 16))->capture_default_str();
-  app.add_option("--frames", o->frames, "run this many frames (one orbit) and exit; 0: interactive")->check(CLI::Range(0, 100000));
+  app.add_option("--bands", o->lighting.bands, "SH bands when projecting a probe")
+      ->check(CLI::Range(1, 9))
+      ->capture_default_str();
+  app.add_option("--triangles", o->object.triangles, "triangles of the blob")
+      ->check(CLI::Range(100, 5000000))
+      ->capture_default_str();
+  app.add_option("--shadows", o->lighting.shadows, "lights of a light set that cast shadows")
+      ->check(CLI::Range(0, 16))
+      ->capture_default_str();
+  app.add_option("--frames", o->frames, "run this many frames (one orbit) and exit; 0: interactive")
+      ->check(CLI::Range(0, 100000));
   app.add_option("--screenshot", o->screenshot, "write the last frame here on exit (.png)");
-  app.add_option("--error-grid", o->error_grid, "an error volume (ilf build --error-grid): its false-colour slice through the object, top left "
+  app.add_option("--error-grid", o->error_grid,
+                 "an error volume (ilf build --error-grid): its false-colour slice through the object, top left "
                  "(keys X / Y / Z: the plane's normal)");
   app.add_option("--max-error", o->max_error, "--error-grid: the relative error shown red (as ilf slice)")
-      ->check(CLI::Range(1e-9, 1e9))->capture_default_str();
+      ->check(CLI::Range(1e-9, 1e9))
+      ->capture_default_str();
   iblcli::add_shadow_map_options(app, &o->shadow_maps);
   auto& rd = iblcli::add_probe_read_options(app);
   app.footer(
@@ -481,7 +563,8 @@ void setup(CLI::App& app) {
       "  iblkit view blob --light probe.exr --light lights.json\n"
       "  iblkit view blob --light grid.shgrid --error-grid err.shgrid --at 0,1,0 --object-size 0.3\n"
       "  xvfb-run -a iblkit view sphere --light probe.exr --frames 10 --screenshot view.png\n"
-      "  iblkit view blob --composite photo.exr --eye 0,1.3,2.2 --target 0,0.3,0 --fov 40 --probes probe/probes.json --at 0.1,0.2,0.1\n"
+      "  iblkit view blob --composite photo.exr --eye 0,1.3,2.2 --target 0,0.3,0 --fov 40 --probes probe/probes.json "
+      "--at 0.1,0.2,0.1\n"
       "Composite mode: drag or the arrows / PageUp / PageDown move the object, + / - exposure, Esc quits.");
   app.callback([o, &rd] { run(*o, rd); });
 }

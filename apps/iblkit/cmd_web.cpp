@@ -19,17 +19,24 @@ void setup(CLI::App& app) {
     std::string size = "800x600";
   };
   auto* o = iblcli::app_owned<Opts>();
-  app.add_option("-o,--out", o->d.out, "folder to write (index.html, viewer.js, three/, data/, iblkit-web.json)")->required();
+  app.add_option("-o,--out", o->d.out, "folder to write (index.html, viewer.js, three/, data/, iblkit-web.json)")
+      ->required();
   app.add_option("-p,--probe", o->d.probes, "HDR probe (any mapping): its SH and a lat-long background; repeatable");
-  app.add_option("--specular", o->d.specular, "specular KTX2 (iblkit specular) of the --probe of the same rank; repeatable");
+  app.add_option("--specular", o->d.specular,
+                 "specular KTX2 (iblkit specular) of the --probe of the same rank; repeatable");
   app.add_option("-l,--lights", o->d.lights, "light set: iblkit.lights/1 JSON or glTF (lights --gltf); repeatable");
   app.add_option("-g,--grid", o->d.grids, "SH grid (.shgrid, or .shtree resampled to dense); repeatable");
-  app.add_option("--probe-height", o->d.probe_height, "height of the background lat-long copy")->capture_default_str()->check(CLI::Range(8, 8192));
+  app.add_option("--probe-height", o->d.probe_height, "height of the background lat-long copy")
+      ->capture_default_str()
+      ->check(CLI::Range(8, 8192));
   app.add_option("--screenshot", o->screenshot, "also take a headless-Chromium screenshot of the page into this PNG");
-  app.add_option("--view", o->query, "viewer URL parameters for the screenshot (docs/web.md), e.g. mode=lights&shadows=4")->capture_default_str();
+  app.add_option("--view", o->query,
+                 "viewer URL parameters for the screenshot (docs/web.md), e.g. mode=lights&shadows=4")
+      ->capture_default_str();
   app.add_option("--size", o->size, "screenshot size WxH")->capture_default_str();
-  app.footer("Example:\n  iblkit web --out view --probe /usr/share/blender/datafiles/studiolights/world/forest.exr\n"
-             "  iblkit serve view");
+  app.footer(
+      "Example:\n  iblkit web --out view --probe /usr/share/blender/datafiles/studiolights/world/forest.exr\n"
+      "  iblkit serve view");
   app.callback([o] {
     if (o->d.probes.empty() && o->d.lights.empty() && o->d.grids.empty())
       ibl::fail(ibl::ErrorKind::Value, "nothing to show: give at least one --probe, --lights or --grid");
@@ -40,12 +47,13 @@ void setup(CLI::App& app) {
       if (std::sscanf(o->size.c_str(), "%dx%d", &w, &h) != 2 || w < 16 || h < 16 || w > 8192 || h > 8192)
         ibl::fail(ibl::ErrorKind::Value, "--size {}: expected WxH, 16..8192 each", o->size);
       int rc = iblcli::screenshot_page(o->d.out, o->query, o->screenshot, w, h);
-      if (rc != 0 || !fs::exists(o->screenshot)) ibl::fail(ibl::ErrorKind::Io, "Chromium could not take the screenshot (exit {})", rc);
+      if (rc != 0 || !fs::exists(o->screenshot))
+        ibl::fail(ibl::ErrorKind::Io, "Chromium could not take the screenshot (exit {})", rc);
       j["screenshot"] = o->screenshot;
     }
     iblcli::emit(j, [&] {
-      fmt::print("wrote the viewer into {}/ ({} probes, {} light sets, {} grids); open it with: iblkit serve {}\n", o->d.out,
-                 m["probes"].size(), m["lights"].size(), m["grids"].size(), o->d.out);
+      fmt::print("wrote the viewer into {}/ ({} probes, {} light sets, {} grids); open it with: iblkit serve {}\n",
+                 o->d.out, m["probes"].size(), m["lights"].size(), m["grids"].size(), o->d.out);
       if (!o->screenshot.empty()) fmt::print("screenshot: {}\n", o->screenshot);
     });
   });

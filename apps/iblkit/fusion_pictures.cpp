@@ -24,7 +24,8 @@ Image coverage_picture(const ibl::fusion::LocalMap& map, int probes) {
       PixelStatus s = map.status[static_cast<size_t>(y) * r.width() + x];
       Vec3 c;
       if (s == PixelStatus::Fused)
-        c = Vec3{0.1, 1.0, 0.25} * (0.3 + 0.7 * std::min(1.0, static_cast<double>(map.coverage.at(x, y, 0)) / std::max(1, probes)));
+        c = Vec3{0.1, 1.0, 0.25} *
+            (0.3 + 0.7 * std::min(1.0, static_cast<double>(map.coverage.at(x, y, 0)) / std::max(1, probes)));
       else if (s == PixelStatus::LeftProxy)
         c = {0.15, 0.35, 1.0};
       else if (s == PixelStatus::Unseen)
@@ -41,7 +42,8 @@ Image tone(const Image& img, double scale) {
   return ibl::io::tonemap(img, td).with_channels(3);
 }
 
-Image fused_sheet(const ibl::fusion::LocalMap& ll, int probes, const ibl::lights::LightSet* lights, const std::string& title) {
+Image fused_sheet(const ibl::fusion::LocalMap& ll, int probes, const ibl::lights::LightSet* lights,
+                  const std::string& title) {
   std::vector<std::pair<std::string, Image>> pics;
   pics.push_back({"fused map", ibl::io::tonemap(ll.radiance.image).with_channels(3)});
   pics.push_back({fmt::format("coverage: fused {:.1f}% / left {:.1f}% / unseen {:.1f}%", 100 * ll.stats.fused,

@@ -16,7 +16,8 @@ namespace {
 using ibl::Image;
 using ibl::Vec3;
 
-const Vec3 kPalette[] = {{0.95, 0.45, 0.15}, {0.25, 0.65, 0.95}, {0.35, 0.85, 0.35}, {0.9, 0.3, 0.8}, {0.95, 0.85, 0.2}};
+const Vec3 kPalette[] = {
+    {0.95, 0.45, 0.15}, {0.25, 0.65, 0.95}, {0.35, 0.85, 0.35}, {0.9, 0.3, 0.8}, {0.95, 0.85, 0.2}};
 
 void dashed_line(Image& img, double x0, double y0, double x1, double y1, Vec3 c, double dash = 6) {
   double len = std::hypot(x1 - x0, y1 - y0);
@@ -104,7 +105,8 @@ Image error_plot(const std::vector<ErrorCurve>& curves, const ErrorPlotDesc& des
   int pw = (desc.width - margin_l - margin_r - gap) / 2, ph = desc.height - top - bottom;
   if (!desc.title.empty()) ibl::io::draw_text(img, margin_l, 24, desc.title, 18, {1, 1, 1});
   panel(img, margin_l, top, pw, ph, curves, false, desc.reference_mean, "mean irradiance error", desc.reference_name);
-  panel(img, margin_l + pw + gap, top, pw, ph, curves, true, desc.reference_max, "max irradiance error", desc.reference_name);
+  panel(img, margin_l + pw + gap, top, pw, ph, curves, true, desc.reference_max, "max irradiance error",
+        desc.reference_name);
   return img;
 }
 
@@ -118,7 +120,8 @@ Image light_overlay(const ibl::sphere::EnvMap& env, const ibl::lights::LightSet&
     for (int y = 0; y < height; ++y)
       for (int x = 0; x < width; ++x) {
         int rx = x * reg.width / width, ry = y * reg.height / height;
-        int rx1 = std::min(reg.width - 1, (x + 1) * reg.width / width), ry1 = std::min(reg.height - 1, (y + 1) * reg.height / height);
+        int rx1 = std::min(reg.width - 1, (x + 1) * reg.width / width),
+            ry1 = std::min(reg.height - 1, (y + 1) * reg.height / height);
         if (reg.at(rx, ry) != reg.at(rx1, ry) || reg.at(rx, ry) != reg.at(rx, ry1))
           pic.set_rgb(x, y, pic.rgb(x, y) * 0.15 + Vec3{0.1, 1.0, 0.2} * 0.85);
       }

@@ -11,16 +11,16 @@
 namespace iblcli {
 
 struct ErrorCurve {
-  std::string name;           // legend text (a method)
-  std::vector<int> counts;    // N
-  std::vector<double> mean;   // mean relative error (fraction) at each N
-  std::vector<double> max;    // max relative error (fraction) at each N
+  std::string name;          // legend text (a method)
+  std::vector<int> counts;   // N
+  std::vector<double> mean;  // mean relative error (fraction) at each N
+  std::vector<double> max;   // max relative error (fraction) at each N
 };
 
 struct ErrorPlotDesc {
-  std::string title;          // drawn above both panels
-  double reference_mean = -1; // a horizontal reference line (3-band SH) on the mean panel; < 0: none
-  double reference_max = -1;  // the same on the max panel
+  std::string title;                         // drawn above both panels
+  double reference_mean = -1;                // a horizontal reference line (3-band SH) on the mean panel; < 0: none
+  double reference_max = -1;                 // the same on the max panel
   std::string reference_name = "3-band SH";  // legend text of the reference line
   int width = 1000, height = 420;            // size of the picture in pixels
 };

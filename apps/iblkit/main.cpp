@@ -10,8 +10,8 @@
 #include <cstring>
 #include <string_view>
 
-#include <CLI/CLI.hpp>
 #include <oneapi/tbb/global_control.h>
+#include <CLI/CLI.hpp>
 
 #include "cli.h"
 #include "iblkit/core/atomic_file.h"
@@ -35,7 +35,8 @@ constexpr Subcommand kSubcommands[] = {
     {"sh", "Project a probe onto spherical harmonics; export, window, render irradiance", nullptr},
     {"eval", "Irradiance error of light sets against the exact ground truth (Madsen & Laursen Fig. 4)", nullptr},
     {"ilf", "Incident light fields: probe sequences -> SH grids, queries, slices", nullptr},
-    {"specular", "Engine maps: GGX-prefiltered specular cube map (KTX2, all mips), irradiance cube, DFG table", nullptr},
+    {"specular", "Engine maps: GGX-prefiltered specular cube map (KTX2, all mips), irradiance cube, DFG table",
+     nullptr},
 #ifdef IBLKIT_HAVE_GEOMETRY
     {"lab", "Analytic lighting scenes: synthetic captures and exact ground truth", "geometry"},
     {"fuse", "Local environment maps anywhere from probes on a proxy mesh (Pedersen 2008)", "geometry"},
@@ -119,8 +120,10 @@ int main(int argc, char** argv) {
   }
   const auto& reg = iblcli::command_registry();
   for (const auto& c : reg)
-    if (std::none_of(std::begin(kSubcommands), std::end(kSubcommands), [&](const Subcommand& s) { return c.name == s.name; })) {
-      std::fprintf(stderr, "iblkit: internal error: subcommand '%s' is registered but not listed in main.cpp\n", c.name.c_str());
+    if (std::none_of(std::begin(kSubcommands), std::end(kSubcommands),
+                     [&](const Subcommand& s) { return c.name == s.name; })) {
+      std::fprintf(stderr, "iblkit: internal error: subcommand '%s' is registered but not listed in main.cpp\n",
+                   c.name.c_str());
       return 1;
     }
   for (const auto& s : kSubcommands) {
@@ -140,7 +143,8 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
     outputs.commit();
   } catch (const CLI::ParseError& e) {
-    const std::string unknown = e.get_exit_code() != 0 ? iblcli::unknown_subcommand(app, argc, argv) : "";  // not for --help
+    const std::string unknown =
+        e.get_exit_code() != 0 ? iblcli::unknown_subcommand(app, argc, argv) : "";  // not for --help
     if (!unknown.empty()) return std::fprintf(stderr, "iblkit: error: %s\n", unknown.c_str()), 1;
     return app.exit(e);
   } catch (const ibl::Error& e) {

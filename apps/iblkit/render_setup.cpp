@@ -30,10 +30,11 @@ std::string grid_bounds_warning(const ibl::render::Lighting& L, const ibl::geome
   ibl::Vec3 lo, hi;
   object.bounds(&lo, &hi);
   const ibl::Vec3 gmin = L.grid->grid().volume.min, gmax = L.grid->grid().volume.max;
-  return fmt::format("the object spans ({:.3g}, {:.3g}, {:.3g})..({:.3g}, {:.3g}, {:.3g}), outside the SH grid's volume "
-                     "({:.3g}, {:.3g}, {:.3g})..({:.3g}, {:.3g}, {:.3g}): lookups there clamp to the grid's faces "
-                     "(move it with --at, shrink it with --object-size)",
-                     lo.x, lo.y, lo.z, hi.x, hi.y, hi.z, gmin.x, gmin.y, gmin.z, gmax.x, gmax.y, gmax.z);
+  return fmt::format(
+      "the object spans ({:.3g}, {:.3g}, {:.3g})..({:.3g}, {:.3g}, {:.3g}), outside the SH grid's volume "
+      "({:.3g}, {:.3g}, {:.3g})..({:.3g}, {:.3g}, {:.3g}): lookups there clamp to the grid's faces "
+      "(move it with --at, shrink it with --object-size)",
+      lo.x, lo.y, lo.z, hi.x, hi.y, hi.z, gmin.x, gmin.y, gmin.z, gmax.x, gmax.y, gmax.z);
 }
 
 ibl::augment::ObjectDesc inserted_object(const std::string& kind, double size, int triangles, const std::string& at,
@@ -50,7 +51,8 @@ ibl::augment::ObjectDesc inserted_object(const std::string& kind, double size, i
 ibl::render::Material object_material(const std::string& albedo, double gloss, double exponent, const std::string& lobe,
                                       const std::string& texture) {
   using ibl::render::Lobe;
-  ibl::render::Material m{parse_vec3(albedo, "--albedo"), ibl::Vec3{1, 1, 1} * gloss, exponent, lobe == "blinn" ? Lobe::BlinnPhong : Lobe::Phong};
+  ibl::render::Material m{parse_vec3(albedo, "--albedo"), ibl::Vec3{1, 1, 1} * gloss, exponent,
+                          lobe == "blinn" ? Lobe::BlinnPhong : Lobe::Phong};
   if (!texture.empty()) {
     m.albedo = {1, 1, 1};
     m.texture = std::make_shared<ibl::Image>(ibl::io::read_image(texture).with_channels(3));
@@ -64,8 +66,12 @@ void add_photo_scene_options(CLI::App& app, PhotoSceneOptions* o, const std::str
   app.add_option("--up", o->up, prefix + "the world direction that appears upwards")->capture_default_str();
   app.add_option("--fov", o->fov, prefix + "vertical field of view, degrees")->capture_default_str();
   app.add_option("--camera", o->camera, prefix + "an iblkit.camera/1 file instead of --eye/--target/--up/--fov");
-  app.add_option("--probes", o->probes, prefix + "an iblkit.probes/1 set with its proxy (one probe: Debevec 1998; several: fused at the object)");
-  app.add_option("--proxy", o->proxy, prefix + "the local scene's mesh (OBJ, PLY, glTF) with --light: receives shadows, occludes the object");
+  app.add_option(
+      "--probes", o->probes,
+      prefix + "an iblkit.probes/1 set with its proxy (one probe: Debevec 1998; several: fused at the object)");
+  app.add_option(
+      "--proxy", o->proxy,
+      prefix + "the local scene's mesh (OBJ, PLY, glTF) with --light: receives shadows, occludes the object");
   app.add_option("--at-probe", o->at_probe, prefix + "where the --light probe was captured, x,y,z");
 }
 
@@ -73,14 +79,16 @@ ibl::geometry::Camera photo_camera(const PhotoSceneOptions& o, const ibl::Image&
                                    const std::string& who) {
   ibl::geometry::Camera cam;
   if (!o.camera.empty()) {
-    if (!o.eye.empty() || !o.target.empty()) ibl::fail(ibl::ErrorKind::Value, "give either --camera or --eye/--target, not both");
+    if (!o.eye.empty() || !o.target.empty())
+      ibl::fail(ibl::ErrorKind::Value, "give either --camera or --eye/--target, not both");
     cam = ibl::augment::read_camera(o.camera);
     if ((cam.width != 0 && cam.width != photo.width()) || (cam.height != 0 && cam.height != photo.height()))
-      ibl::fail(ibl::ErrorKind::Value, "{} is {}x{} but the photograph {} is {}x{}", o.camera, cam.width, cam.height, photo_path,
-                photo.width(), photo.height());
+      ibl::fail(ibl::ErrorKind::Value, "{} is {}x{} but the photograph {} is {}x{}", o.camera, cam.width, cam.height,
+                photo_path, photo.width(), photo.height());
   } else {
     if (o.eye.empty() || o.target.empty())
-      ibl::fail(ibl::ErrorKind::Value, "{}give the photograph's camera: --eye and --target (and --fov), or --camera", who);
+      ibl::fail(ibl::ErrorKind::Value, "{}give the photograph's camera: --eye and --target (and --fov), or --camera",
+                who);
     cam.eye = parse_vec3(o.eye, "--eye");
     cam.target = parse_vec3(o.target, "--target");
     cam.up = parse_vec3(o.up, "--up");

@@ -20,9 +20,10 @@ namespace iblcli {
 // The GL renderer's shadow maps (render and view share the options): --shadow-map,
 // --spot-shadow-map and --spot-shadow-share, their defaults FrameDesc's.
 struct ShadowMapOptions {
-  int size = ibl::render::FrameDesc{}.shadow_map_size;              // each directional or point light's (cube faces too)
-  int spot_size = ibl::render::FrameDesc{}.spot_shadow_map_size;    // each textured spotlight's
-  double spot_share = ibl::render::FrameDesc{}.spot_shadow_share;   // metres: spotlights this close share a map (0: one each)
+  int size = ibl::render::FrameDesc{}.shadow_map_size;            // each directional or point light's (cube faces too)
+  int spot_size = ibl::render::FrameDesc{}.spot_shadow_map_size;  // each textured spotlight's
+  double spot_share =
+      ibl::render::FrameDesc{}.spot_shadow_share;  // metres: spotlights this close share a map (0: one each)
   void apply(ibl::render::FrameDesc* d) const {
     d->shadow_map_size = size;
     d->spot_shadow_map_size = spot_size;

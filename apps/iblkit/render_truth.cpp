@@ -28,7 +28,12 @@ LabPhotograph photograph_frame(const std::string& scene_path, const render::Fram
   vd.render.bounces = bounces;
   const geometry::Camera cam = d.camera;
   lab::View v = lab::photograph(
-      scene, [&](double px, double py, Vec3* o, Vec3* dir) { *o = cam.eye; *dir = cam.ray_direction(px, py); }, vd, progress);
+      scene,
+      [&](double px, double py, Vec3* o, Vec3* dir) {
+        *o = cam.eye;
+        *dir = cam.ray_direction(px, py);
+      },
+      vd, progress);
   p.radiance = std::move(v.radiance);
   p.surface = std::move(v.surface);
   std::vector<double> lum;
@@ -36,7 +41,8 @@ LabPhotograph photograph_frame(const std::string& scene_path, const render::Fram
     for (int x = 0; x < vd.width; ++x)
       if (std::find(p.objects.begin(), p.objects.end(), static_cast<int>(p.surface.at(x, y, 0))) != p.objects.end())
         lum.push_back(luminance(p.radiance.rgb(x, y)));
-  if (lum.empty()) fail(ErrorKind::Value, "no pixel of the frame sees the objects in {}: check --at, --eye and --target", scene_path);
+  if (lum.empty())
+    fail(ErrorKind::Value, "no pixel of the frame sees the objects in {}: check --at, --eye and --target", scene_path);
   std::nth_element(lum.begin(), lum.begin() + lum.size() / 2, lum.end());
   p.median = lum[lum.size() / 2];
   return p;
@@ -45,7 +51,8 @@ LabPhotograph photograph_frame(const std::string& scene_path, const render::Fram
 TruthComparison compare(const LabPhotograph& photo, const render::RenderResult& rendered) {
   const int W = photo.radiance.width(), H = photo.radiance.height();
   if (rendered.color.width() != W || rendered.color.height() != H)
-    fail(ErrorKind::Value, "frame {}x{} and photograph {}x{} differ in size", rendered.color.width(), rendered.color.height(), W, H);
+    fail(ErrorKind::Value, "frame {}x{} and photograph {}x{} differ in size", rendered.color.width(),
+         rendered.color.height(), W, H);
   TruthComparison c;
   c.error = Image(W, H, 1, -1.0f);
   double sum_abs = 0, sum_ref = 0, first_abs = 0, first_ref = 0, first_render = 0;

@@ -27,11 +27,18 @@ using ibl::ErrorKind;
 using ibl::fail;
 
 std::string content_type(const std::string& path) {
-  static const std::pair<const char*, const char*> kTypes[] = {
-      {".html", "text/html; charset=utf-8"}, {".js", "text/javascript"},   {".mjs", "text/javascript"},
-      {".json", "application/json"},         {".css", "text/css"},         {".png", "image/png"},
-      {".jpg", "image/jpeg"},                {".gltf", "model/gltf+json"}, {".glb", "model/gltf-binary"},
-      {".ktx2", "image/ktx2"},               {".wasm", "application/wasm"}, {".svg", "image/svg+xml"}};
+  static const std::pair<const char*, const char*> kTypes[] = {{".html", "text/html; charset=utf-8"},
+                                                               {".js", "text/javascript"},
+                                                               {".mjs", "text/javascript"},
+                                                               {".json", "application/json"},
+                                                               {".css", "text/css"},
+                                                               {".png", "image/png"},
+                                                               {".jpg", "image/jpeg"},
+                                                               {".gltf", "model/gltf+json"},
+                                                               {".glb", "model/gltf-binary"},
+                                                               {".ktx2", "image/ktx2"},
+                                                               {".wasm", "application/wasm"},
+                                                               {".svg", "image/svg+xml"}};
   std::string ext = fs::path(path).extension().string();
   for (auto& [e, t] : kTypes)
     if (ext == e) return t;
@@ -48,7 +55,8 @@ std::string percent_decode(const std::string& s) {
       out += s[i];
       continue;
     }
-    if (i + 2 >= s.size() || !std::isxdigit(static_cast<unsigned char>(s[i + 1])) || !std::isxdigit(static_cast<unsigned char>(s[i + 2])))
+    if (i + 2 >= s.size() || !std::isxdigit(static_cast<unsigned char>(s[i + 1])) ||
+        !std::isxdigit(static_cast<unsigned char>(s[i + 2])))
       return "";
     out += static_cast<char>(std::stoi(s.substr(i + 1, 2), nullptr, 16));
     i += 2;
@@ -67,8 +75,10 @@ bool send_all(int fd, const char* p, size_t n) {
 }
 
 void respond(int fd, int code, const char* reason, const std::string& type, const std::string& body, bool head) {
-  std::string h = fmt::format("HTTP/1.1 {} {}\r\nContent-Type: {}\r\nContent-Length: {}\r\nCache-Control: no-store\r\nConnection: close\r\n\r\n",
-                              code, reason, type, body.size());
+  std::string h = fmt::format(
+      "HTTP/1.1 {} {}\r\nContent-Type: {}\r\nContent-Length: {}\r\nCache-Control: no-store\r\nConnection: "
+      "close\r\n\r\n",
+      code, reason, type, body.size());
   if (send_all(fd, h.data(), h.size()) && !head) send_all(fd, body.data(), body.size());
 }
 
@@ -91,7 +101,8 @@ void handle(int fd, const std::string& root, const std::atomic<bool>* stop) {
   if (sp2 == std::string::npos) return respond(fd, 400, "Bad Request", "text/plain", "bad request\n", false);
   std::string method = req.substr(0, sp1), target = req.substr(sp1 + 1, sp2 - sp1 - 1);
   bool head = method == "HEAD";
-  if (method != "GET" && !head) return respond(fd, 405, "Method Not Allowed", "text/plain", "GET or HEAD only\n", false);
+  if (method != "GET" && !head)
+    return respond(fd, 405, "Method Not Allowed", "text/plain", "GET or HEAD only\n", false);
   std::string file = resolve_request(root, target);
   if (file.empty()) return respond(fd, 404, "Not Found", "text/plain", "not found\n", head);
   std::ifstream in(file, std::ios::binary);
@@ -151,7 +162,9 @@ void serve_static(const StaticServerDesc& d, const std::atomic<bool>* stop, cons
                       : IN6_IS_ADDR_LOOPBACK(&reinterpret_cast<sockaddr_in6*>(ai->ai_addr)->sin6_addr);
   if (!loopback) {
     ::freeaddrinfo(ai);
-    fail(ErrorKind::Value, "serve: --host {} is not a loopback address (127.0.0.0/8 or ::1): the viewer is served to this machine only", d.host);
+    fail(ErrorKind::Value,
+         "serve: --host {} is not a loopback address (127.0.0.0/8 or ::1): the viewer is served to this machine only",
+         d.host);
   }
   int s = ::socket(ai->ai_family, SOCK_STREAM, 0);
   int one = 1;

@@ -24,6 +24,7 @@ std::string resolve_request(const std::string& root, const std::string& target);
 
 // Serves until *stop becomes true (checked every 100 ms). Calls on_ready(port) once listening.
 // Throws ibl::Error when the folder is missing, the host is not loopback or the port is taken.
-void serve_static(const StaticServerDesc& desc, const std::atomic<bool>* stop, const std::function<void(int)>& on_ready);
+void serve_static(const StaticServerDesc& desc, const std::atomic<bool>* stop,
+                  const std::function<void(int)>& on_ready);
 
 }  // namespace iblcli

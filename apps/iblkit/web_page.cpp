@@ -57,9 +57,10 @@ nlohmann::json write_web_page(const WebPageDesc& d) {
     fail(ErrorKind::Unsupported,
          "the web viewer was not built (it needs node and npm at build time: scripts/install-deps, then rebuild)");
   if (d.specular.size() > d.probes.size())
-    fail(ErrorKind::Value, "{} specular KTX2 files for {} probes: each --specular goes with the --probe of its rank", d.specular.size(),
-         d.probes.size());
-  if (d.probe_height < 8 || d.probe_height > 8192) fail(ErrorKind::Value, "probe height {} outside 8..8192", d.probe_height);
+    fail(ErrorKind::Value, "{} specular KTX2 files for {} probes: each --specular goes with the --probe of its rank",
+         d.specular.size(), d.probes.size());
+  if (d.probe_height < 8 || d.probe_height > 8192)
+    fail(ErrorKind::Value, "probe height {} outside 8..8192", d.probe_height);
   fs::path out = d.out, data = out / "data";
   std::error_code ec;
   fs::create_directories(data, ec);
@@ -67,7 +68,9 @@ nlohmann::json write_web_page(const WebPageDesc& d) {
   fs::copy(page, out, fs::copy_options::recursive | fs::copy_options::overwrite_existing, ec);
   if (ec) fail(ErrorKind::Io, "cannot copy the viewer from {} to {} ({})", page, out.string(), ec.message());
 
-  nlohmann::json m = {{"format", "iblkit.web/1"}, {"probes", nlohmann::json::array()}, {"lights", nlohmann::json::array()},
+  nlohmann::json m = {{"format", "iblkit.web/1"},
+                      {"probes", nlohmann::json::array()},
+                      {"lights", nlohmann::json::array()},
                       {"grids", nlohmann::json::array()}};
   for (size_t i = 0; i < d.probes.size(); ++i) {
     sphere::EnvMap env = io::read_envmap(d.probes[i]);
@@ -76,10 +79,14 @@ nlohmann::json write_web_page(const WebPageDesc& d) {
     sh::Coeffs c = sh::project(env, 3);
     write_file_atomically((data / (name + "_sh.json")).string(), sh::export_text(c, sh::ExportFormat::ThreeJs));
     sphere::Mapping ll(sphere::MappingKind::LatLong, 2 * d.probe_height, d.probe_height);
-    Image img = env.mapping.kind() == sphere::MappingKind::LatLong && env.image.height() == d.probe_height ? env.image
-                                                                                                          : sphere::resample(env, ll);
+    Image img = env.mapping.kind() == sphere::MappingKind::LatLong && env.image.height() == d.probe_height
+                    ? env.image
+                    : sphere::resample(env, ll);
     io::write_image((data / (name + ".exr")).string(), img);
-    nlohmann::json p = {{"name", stem(d.probes[i])}, {"source", d.probes[i]}, {"image", "data/" + name + ".exr"}, {"sh", "data/" + name + "_sh.json"}};
+    nlohmann::json p = {{"name", stem(d.probes[i])},
+                        {"source", d.probes[i]},
+                        {"image", "data/" + name + ".exr"},
+                        {"sh", "data/" + name + "_sh.json"}};
     if (i < d.specular.size()) {
       copy_into(d.specular[i], data / (name + ".ktx2"));
       p["specular"] = "data/" + name + ".ktx2";
@@ -88,8 +95,10 @@ nlohmann::json write_web_page(const WebPageDesc& d) {
   }
   for (size_t i = 0; i < d.lights.size(); ++i) {
     std::string file = fmt::format("lights{}.gltf", i);
-    if (fs::path(d.lights[i]).extension() == ".gltf") copy_into(d.lights[i], data / file);
-    else lights::write_gltf((data / file).string(), lights::read_lights(d.lights[i]));
+    if (fs::path(d.lights[i]).extension() == ".gltf")
+      copy_into(d.lights[i], data / file);
+    else
+      lights::write_gltf((data / file).string(), lights::read_lights(d.lights[i]));
     m["lights"].push_back({{"name", stem(d.lights[i])}, {"source", d.lights[i]}, {"gltf", "data/" + file}});
   }
   for (size_t i = 0; i < d.grids.size(); ++i) {
@@ -128,7 +137,8 @@ std::string shell_quote(const std::string& s) {
 
 int screenshot_page(const std::string& dir, const std::string& query, const std::string& png, int width, int height) {
   std::string chromium = find_chromium();
-  if (chromium.empty()) fail(ErrorKind::Unsupported, "no Chromium found (scripts/install-deps installs Debian's chromium)");
+  if (chromium.empty())
+    fail(ErrorKind::Unsupported, "no Chromium found (scripts/install-deps installs Debian's chromium)");
   std::atomic<bool> stop{false};
   std::promise<int> ready;
   auto port_future = ready.get_future();
@@ -146,7 +156,8 @@ int screenshot_page(const std::string& dir, const std::string& query, const std:
     // and the first frame finish before Chromium takes the picture.
     std::string url = fmt::format("http://127.0.0.1:{}/index.html?ui=0&size={}x{}&{}", port, width, height, query);
     std::string cmd = fmt::format(
-        "{} --headless --no-sandbox --disable-gpu-sandbox --use-angle=swiftshader --enable-unsafe-swiftshader --hide-scrollbars "
+        "{} --headless --no-sandbox --disable-gpu-sandbox --use-angle=swiftshader --enable-unsafe-swiftshader "
+        "--hide-scrollbars "
         "--window-size={},{} --virtual-time-budget=20000 --screenshot={} {} >/dev/null 2>&1",
         shell_quote(chromium), width, height, shell_quote(fs::absolute(png).string()), shell_quote(url));
     int rc = std::system(cmd.c_str());

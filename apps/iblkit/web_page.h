@@ -10,12 +10,12 @@
 namespace iblcli {
 
 struct WebPageDesc {
-  std::string out;                      // the folder to write
-  std::vector<std::string> probes;      // HDR probes (any mapping): lat-long EXR + three.js SH each
-  std::vector<std::string> specular;    // specular KTX2 (iblkit specular), paired with probes in order
-  std::vector<std::string> lights;      // light sets: iblkit.lights/1 JSON or glTF (KHR_lights_punctual)
-  std::vector<std::string> grids;       // SH grids (.shgrid) -> three.js LightProbeGridWebGL atlases
-  int probe_height = 512;               // the lat-long copy's height (width twice): the page's background
+  std::string out;                    // the folder to write
+  std::vector<std::string> probes;    // HDR probes (any mapping): lat-long EXR + three.js SH each
+  std::vector<std::string> specular;  // specular KTX2 (iblkit specular), paired with probes in order
+  std::vector<std::string> lights;    // light sets: iblkit.lights/1 JSON or glTF (KHR_lights_punctual)
+  std::vector<std::string> grids;     // SH grids (.shgrid) -> three.js LightProbeGridWebGL atlases
+  int probe_height = 512;             // the lat-long copy's height (width twice): the page's background
 };
 
 // The folder the build assembled (IBLKIT_WEB_PAGE_DIR), or "" when it was not built (no npm).

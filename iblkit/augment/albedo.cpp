@@ -11,7 +11,7 @@ namespace ibl::augment {
 
 namespace {
 constexpr double kRayEpsilon = 1e-4, kShadowShorten = 1e-3, kUnlit = 1e-9;  // as composite.cpp
-uint64_t mix(uint64_t z) {  // SplitMix64 (Steele, Lea & Flood 2014)
+uint64_t mix(uint64_t z) {                                                  // SplitMix64 (Steele, Lea & Flood 2014)
   z += 0x9e3779b97f4a7c15ull;
   z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
   z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
@@ -21,9 +21,11 @@ uint64_t mix(uint64_t z) {  // SplitMix64 (Steele, Lea & Flood 2014)
 
 AlbedoEstimate estimate_albedo(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy,
                                const LocalLight& light, int samples, uint64_t seed) {
-  if (photo.channels() < 3) fail(ErrorKind::Value, "the photograph has {} channels; an RGB image is needed", photo.channels());
+  if (photo.channels() < 3)
+    fail(ErrorKind::Value, "the photograph has {} channels; an RGB image is needed", photo.channels());
   if (photo.width() != cam.width || photo.height() != cam.height)
-    fail(ErrorKind::Value, "the photograph is {}x{} but the camera's frame is {}x{}", photo.width(), photo.height(), cam.width, cam.height);
+    fail(ErrorKind::Value, "the photograph is {}x{} but the camera's frame is {}x{}", photo.width(), photo.height(),
+         cam.width, cam.height);
   if (samples < 1 || samples > 65536) fail(ErrorKind::Value, "albedo samples {} must lie in 1..65536", samples);
   if (proxy.triangle_count() == 0) fail(ErrorKind::Value, "the proxy has no triangles");
   geometry::RayTracer rt;
@@ -50,7 +52,8 @@ AlbedoEstimate estimate_albedo(const Image& photo, const geometry::Camera& cam, 
         double u = (k + static_cast<double>(mix(s) >> 11) * 0x1.0p-53) / samples, pmf, dist;
         size_t i = field.sample(u, &pmf, table);
         Vec3 w, c = field.contribution(i, p, n, &w, &dist);
-        double tfar = std::isinf(dist) ? std::numeric_limits<double>::infinity() : dist * (1 - kShadowShorten) - kRayEpsilon;
+        double tfar =
+            std::isinf(dist) ? std::numeric_limits<double>::infinity() : dist * (1 - kShadowShorten) - kRayEpsilon;
         if (max_component(c) <= 0 || rt.occluded(p, w, kRayEpsilon, tfar)) continue;
         e += c / pmf;
       }

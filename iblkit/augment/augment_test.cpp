@@ -8,12 +8,12 @@
 #include <random>
 #include <vector>
 
-#include "iblkit/augment/testing.h"
 #include "iblkit/augment/camera_io.h"
 #include "iblkit/augment/composite.h"
 #include "iblkit/augment/light.h"
 #include "iblkit/augment/measure.h"
 #include "iblkit/augment/object.h"
+#include "iblkit/augment/testing.h"
 #include "iblkit/core/error.h"
 
 namespace ibl::augment {
@@ -60,7 +60,8 @@ using testing::sphere_at;
 TEST(AugmentComposite, WhiteFurnaceFloorGivesItsAlbedoAndAHiddenObjectChangesNothing) {
   // Photo: ρ L on a floor under a constant sky L = 1. The object sits below the floor: no ray meets it.
   Image photo = constant_photo(kFloorAlbedo);
-  auto r = composite(photo, top_camera(), floor_mesh(), constant_sky({1, 1, 1}, {0, 0.5, 0}), sphere_at({0, -1, 0}, 0.4), {0.7, 0.7, 0.7});
+  auto r = composite(photo, top_camera(), floor_mesh(), constant_sky({1, 1, 1}, {0, 0.5, 0}),
+                     sphere_at({0, -1, 0}, 0.4), {0.7, 0.7, 0.7});
   constexpr double kMeanAlbedoTol = 0.01;  // 64 stratified patch samples per pixel, averaged over 3072 pixels
   double sum = 0;
   for (int y = 0; y < kH; ++y)
@@ -82,7 +83,8 @@ TEST(AugmentComposite, DifferenceIsExactlyZeroWhereAWallHidesTheObject) {
   Image photo = constant_photo(kFloorAlbedo);
   geometry::Camera cam = top_camera();  // above the far side of the wall, so that it sees the floor there
   cam.eye.x = cam.target.x = 1.2;
-  auto r = composite(photo, cam, proxy, constant_sky({1, 1, 1}, {-0.5, 0.5, 0}), sphere_at({-0.5, 0.25, 0}, 0.4), {0.7, 0.7, 0.7});
+  auto r = composite(photo, cam, proxy, constant_sky({1, 1, 1}, {-0.5, 0.5, 0}), sphere_at({-0.5, 0.25, 0}, 0.4),
+                     {0.7, 0.7, 0.7});
   int changed_left = 0;
   for (int y = 0; y < kH; ++y)
     for (int x = 0; x < kW; ++x) {
@@ -94,7 +96,8 @@ TEST(AugmentComposite, DifferenceIsExactlyZeroWhereAWallHidesTheObject) {
       if (fx < 0.3 && r.difference.rgb(x, y).y != 0) ++changed_left;
     }
   EXPECT_EQ(changed_left, 0);  // the wall's back, seen from this side, does not see the object either
-  auto r2 = composite(photo, top_camera(), proxy, constant_sky({1, 1, 1}, {-0.5, 0.5, 0}), sphere_at({-0.5, 0.25, 0}, 0.4), {0.7, 0.7, 0.7});
+  auto r2 = composite(photo, top_camera(), proxy, constant_sky({1, 1, 1}, {-0.5, 0.5, 0}),
+                      sphere_at({-0.5, 0.25, 0}, 0.4), {0.7, 0.7, 0.7});
   EXPECT_GT(r2.stats.changed_pixels, 0);  // from above the object: its floor and the wall's front do change
 }
 
@@ -137,10 +140,11 @@ TEST(AugmentLight, AFloorsTableLeavesOutWhatItCannotSeeAndStaysUnbiased) {
   for (int k = 0; k < 20000; ++k) {
     const double u = (k + 0.5) / 20000;
     double pmf;
-    const size_t want = std::min<size_t>(field.size() - 1, static_cast<size_t>(std::upper_bound(cdf.begin(), cdf.end(), u) - cdf.begin()));
+    const size_t want = std::min<size_t>(
+        field.size() - 1, static_cast<size_t>(std::upper_bound(cdf.begin(), cdf.end(), u) - cdf.begin()));
     ASSERT_EQ(field.sample(u, &pmf, table), want) << "u = " << u;
   }
-  constexpr double kPlainShare = 0.3;  // the plain table's share of a conditioned one
+  constexpr double kPlainShare = 0.3;   // the plain table's share of a conditioned one
   EXPECT_LE(floor_share, kPlainShare);  // the floor's patches are what the plain part gives them
   std::mt19937_64 gen(7);
   std::uniform_real_distribution<double> uni(0, 1);
@@ -167,7 +171,9 @@ TEST(AugmentLight, AFloorsTableLeavesOutWhatItCannotSeeAndStaysUnbiased) {
   const double se_table = spread(table, &mean_table), se_plain = spread(-1, &mean_plain);
   EXPECT_NEAR(mean_table, exact, 4 * se_table);
   EXPECT_NEAR(mean_plain, exact, 4 * se_plain);
-  EXPECT_LT(se_table, 0.9 * se_plain);  // 0.87 measured: stratified, the plain table spends its floor samples in strata of their own
+  EXPECT_LT(
+      se_table,
+      0.9 * se_plain);  // 0.87 measured: stratified, the plain table spends its floor samples in strata of their own
 }
 
 TEST(AugmentComposite, SunCastsAFullShadowAndLeavesTheSunlitFloorAlone) {
@@ -186,7 +192,7 @@ TEST(AugmentComposite, SunCastsAFullShadowAndLeavesTheSunlitFloorAlone) {
   auto r = composite(photo, top_camera(), floor_mesh(), sun, sphere_at(c, 0.4), {0.7, 0.7, 0.7}, desc);
   auto [ux, uy] = pixel_of(umbra.x, umbra.z);
   ASSERT_EQ(r.mask.at(ux, uy, 0), 0.0f);  // the shadow is not hidden behind the object
-  constexpr double kUmbraTol = 1e-9;  // every sample is the sun's texel, blocked
+  constexpr double kUmbraTol = 1e-9;      // every sample is the sun's texel, blocked
   EXPECT_NEAR(r.composite.rgb(ux, uy).y, 0.0, kUmbraTol);
   auto [fx, fy] = pixel_of(-1.5, 1.2);  // far from the shadow, in the sun
   EXPECT_EQ(r.composite.rgb(fx, fy).y, photo.rgb(fx, fy).y);
@@ -195,8 +201,8 @@ TEST(AugmentComposite, SunCastsAFullShadowAndLeavesTheSunlitFloorAlone) {
 TEST(AugmentComposite, ObjectUnderTheWhiteFurnaceHasRadianceAlbedoTimesL) {
   constexpr double kL = 2.0, kRho = 0.6;
   Image photo = constant_photo(kFloorAlbedo * kL);
-  auto r = composite(photo, top_camera(), floor_mesh(), constant_sky({kL, kL, kL}, {0, 0.5, 0}), sphere_at({0, 0.5, 0}, 0.6),
-                     {kRho, kRho, kRho});
+  auto r = composite(photo, top_camera(), floor_mesh(), constant_sky({kL, kL, kL}, {0, 0.5, 0}),
+                     sphere_at({0, 0.5, 0}, 0.6), {kRho, kRho, kRho});
   double sum = 0;
   int n = 0;
   for (int y = 0; y < kH; ++y)
@@ -236,7 +242,8 @@ TEST(AugmentComposite, TextureMultipliesTheAlbedoAtTheObjectsUVs) {
   m.texture = std::make_shared<Image>(tex);
   auto r = composite(photo, top_camera(), floor_mesh(), sky, sphere_at({0, 0.5, 0}, 0.6), m);
   constexpr double kObjectTol = 0.02;  // as the white furnace above
-  for (int c = 0; c < 3; ++c) EXPECT_NEAR(object_mean(r, c).first, 0.8 * tex.rgb(0, 0)[c] * kL, kObjectTol * 0.8 * kL) << c;
+  for (int c = 0; c < 3; ++c)
+    EXPECT_NEAR(object_mean(r, c).first, 0.8 * tex.rgb(0, 0)[c] * kL, kObjectTol * 0.8 * kL) << c;
   // Half black, half white around the sphere (u from +X): the sphere's −Z and +Z sides (u = ¼ and ¾,
   // the two texel columns' centres) are black and white.
   Image half(2, 1, 3);
@@ -261,7 +268,8 @@ TEST(AugmentComposite, GlossyLobeUnderTheWhiteFurnaceReflectsItsWeightTimesL) {
   render::Material m{{0, 0, 0}, {kGloss, kGloss, kGloss}, 8.0};
   CompositeDesc d;
   d.object_samples = 4096;
-  auto r = composite(photo, top_camera(), floor_mesh(), constant_sky({kL, kL, kL}, {0, 0.5, 0}), sphere_at({0, 0.5, 0}, 0.6), m, d);
+  auto r = composite(photo, top_camera(), floor_mesh(), constant_sky({kL, kL, kL}, {0, 0.5, 0}),
+                     sphere_at({0, 0.5, 0}, 0.6), m, d);
   // Pixels within 0.1 m of the sphere's top (normals within 20° of the view: the lobe stays in the hemisphere).
   double sum = 0;
   int n = 0;
@@ -274,8 +282,8 @@ TEST(AugmentComposite, GlossyLobeUnderTheWhiteFurnaceReflectsItsWeightTimesL) {
   constexpr double kGlossTol = 0.06;  // power sampling of a constant sky puts few samples into an exponent-8 lobe
   EXPECT_NEAR(sum / n, kGloss * kL, kGlossTol * kGloss * kL);
   // A Lambertian object of the same weight is as bright at the top: the lobe neither gains nor loses light.
-  auto lam = composite(photo, top_camera(), floor_mesh(), constant_sky({kL, kL, kL}, {0, 0.5, 0}), sphere_at({0, 0.5, 0}, 0.6),
-                       Vec3{kGloss, kGloss, kGloss}, d);
+  auto lam = composite(photo, top_camera(), floor_mesh(), constant_sky({kL, kL, kL}, {0, 0.5, 0}),
+                       sphere_at({0, 0.5, 0}, 0.6), Vec3{kGloss, kGloss, kGloss}, d);
   EXPECT_NEAR(object_mean(lam).first, kGloss * kL, kGlossTol * kGloss * kL);
 }
 
@@ -307,7 +315,7 @@ TEST(AugmentComposite, WhiteObjectInTheWhiteFurnaceSendsBackWhatItBlocks) {
   ASSERT_GT(n, 8);
   dw /= n;
   dn /= n;
-  EXPECT_LT(dn, -0.1 * kL);                 // the shadow alone: more than a tenth of the light gone
+  EXPECT_LT(dn, -0.1 * kL);                     // the shadow alone: more than a tenth of the light gone
   EXPECT_LT(std::abs(dw), 0.3 * std::abs(dn));  // the bounce gives most of it back
 }
 
@@ -320,7 +328,8 @@ TEST(AugmentComposite, BadInputFailsWithAClearMessage) {
     composite(photo, cam, floor_mesh(), sky, sphere_at({0, 0.5, 0}, 0.4), {0.5, 0.5, 0.5});
     FAIL();
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("the photograph is 64x48 but the camera's frame is 32x48"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("the photograph is 64x48 but the camera's frame is 32x48"), std::string::npos)
+        << e.what();
   }
   try {
     composite(photo, top_camera(), floor_mesh(), sky, sphere_at({0, 0.1, 0}, 0.4), {0.5, 0.5, 0.5});
@@ -329,7 +338,8 @@ TEST(AugmentComposite, BadInputFailsWithAClearMessage) {
     EXPECT_NE(std::string(e.what()).find("the object intersects the proxy"), std::string::npos) << e.what();
   }
   try {  // the camera inside a closed box whose faces point outwards
-    composite(photo, top_camera(), geometry::make_box({-4, -1, -4}, {4, 5, 4}), sky, sphere_at({0, 0.5, 0}, 0.4), {0.5, 0.5, 0.5});
+    composite(photo, top_camera(), geometry::make_box({-4, -1, -4}, {4, 5, 4}), sky, sphere_at({0, 0.5, 0}, 0.4),
+              {0.5, 0.5, 0.5});
     FAIL();
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("is inside the proxy"), std::string::npos) << e.what();

@@ -30,21 +30,30 @@ bool finite_point(Vec3 p) {
 }  // namespace
 
 void validate_camera(const geometry::Camera& c, const std::string& what) {
-  if (!finite_point(c.eye)) fail(ErrorKind::Value, "{}: eye ({}, {}, {}) is not a finite point within 1e6 m", what, c.eye.x, c.eye.y, c.eye.z);
+  if (!finite_point(c.eye))
+    fail(ErrorKind::Value, "{}: eye ({}, {}, {}) is not a finite point within 1e6 m", what, c.eye.x, c.eye.y, c.eye.z);
   if (!finite_point(c.target))
-    fail(ErrorKind::Value, "{}: target ({}, {}, {}) is not a finite point within 1e6 m", what, c.target.x, c.target.y, c.target.z);
-  if (!finite_point(c.up) || length(c.up) == 0) fail(ErrorKind::Value, "{}: up ({}, {}, {}) has no direction", what, c.up.x, c.up.y, c.up.z);
+    fail(ErrorKind::Value, "{}: target ({}, {}, {}) is not a finite point within 1e6 m", what, c.target.x, c.target.y,
+         c.target.z);
+  if (!finite_point(c.up) || length(c.up) == 0)
+    fail(ErrorKind::Value, "{}: up ({}, {}, {}) has no direction", what, c.up.x, c.up.y, c.up.z);
   Vec3 f = c.target - c.eye;
   if (length(f) == 0) fail(ErrorKind::Value, "{}: eye and target are the same point", what);
-  if (length(cross(normalize(f), normalize(c.up))) < 1e-6) fail(ErrorKind::Value, "{}: up is parallel to the view direction", what);
-  if (!(c.fov_y_deg > 0 && c.fov_y_deg < 179)) fail(ErrorKind::Value, "{}: fov_y_deg {} must lie in (0, 179)", what, c.fov_y_deg);
+  if (length(cross(normalize(f), normalize(c.up))) < 1e-6)
+    fail(ErrorKind::Value, "{}: up is parallel to the view direction", what);
+  if (!(c.fov_y_deg > 0 && c.fov_y_deg < 179))
+    fail(ErrorKind::Value, "{}: fov_y_deg {} must lie in (0, 179)", what, c.fov_y_deg);
   if (c.width < 1 || c.height < 1 || c.width > 16384 || c.height > 16384)
     fail(ErrorKind::Value, "{}: frame size {}x{} must lie in 1..16384", what, c.width, c.height);
 }
 
 nlohmann::json camera_to_json(const geometry::Camera& c, bool with_size) {
   auto v = [](Vec3 p) { return nlohmann::json::array({p.x, p.y, p.z}); };
-  nlohmann::json j = {{"format", "iblkit.camera/1"}, {"eye", v(c.eye)}, {"target", v(c.target)}, {"up", v(c.up)}, {"fov_y_deg", c.fov_y_deg}};
+  nlohmann::json j = {{"format", "iblkit.camera/1"},
+                      {"eye", v(c.eye)},
+                      {"target", v(c.target)},
+                      {"up", v(c.up)},
+                      {"fov_y_deg", c.fov_y_deg}};
   if (with_size) {
     j["width"] = c.width;
     j["height"] = c.height;
@@ -58,11 +67,13 @@ geometry::Camera camera_from_json(const nlohmann::json& j, const std::string& wh
   c.eye = vec3_field(j, "eye", what);
   c.target = vec3_field(j, "target", what);
   c.up = j.contains("up") ? vec3_field(j, "up", what) : Vec3{0, 1, 0};
-  if (!j.contains("fov_y_deg") || !j["fov_y_deg"].is_number()) fail(ErrorKind::Format, "{}: \"fov_y_deg\" (a number) is missing", what);
+  if (!j.contains("fov_y_deg") || !j["fov_y_deg"].is_number())
+    fail(ErrorKind::Format, "{}: \"fov_y_deg\" (a number) is missing", what);
   c.fov_y_deg = j["fov_y_deg"].get<double>();
   c.width = c.height = 0;
   for (const char* key : {"width", "height"})
-    if (j.contains(key) && !j[key].is_number_integer()) fail(ErrorKind::Format, "{}: \"{}\" must be an integer", what, key);
+    if (j.contains(key) && !j[key].is_number_integer())
+      fail(ErrorKind::Format, "{}: \"{}\" must be an integer", what, key);
   if (j.contains("width")) c.width = j["width"].get<int>();
   if (j.contains("height")) c.height = j["height"].get<int>();
   geometry::Camera check = c;

@@ -64,7 +64,8 @@ double patch_tfar(double dist) {
 
 // E at x (normal n) from `count` stratified patch samples, visibility against `rt`; `shadowed`: the proxy's
 // patches darkened by the object's shadow on them (the light an object point receives).
-Vec3 irradiance(const Scene& s, const geometry::RayTracer& rt, Vec3 x, Vec3 n, int count, Rng& rng, bool shadowed = false) {
+Vec3 irradiance(const Scene& s, const geometry::RayTracer& rt, Vec3 x, Vec3 n, int count, Rng& rng,
+                bool shadowed = false) {
   Vec3 e;
   for (int k = 0; k < count; ++k) {
     double pmf;
@@ -94,7 +95,8 @@ Vec3 object_radiance(const Scene& s, Vec3 z, Vec3 n, Vec3 v, Vec3 rho, const ren
     if (max_component(c) <= 0 || s.both_rt.occluded(z, w, kRayEpsilon, patch_tfar(dist))) continue;
     c = c / pmf;
     e += c;
-    if (glossy) g += c * (render::glossy_lobe(m, n, v, r, w) / dot(n, w));  // c / cos: the irradiance at normal incidence
+    if (glossy)
+      g += c * (render::glossy_lobe(m, n, v, r, w) / dot(n, w));  // c / cos: the irradiance at normal incidence
   }
   return (rho * e / kPi + m.specular * g) / count;
 }
@@ -138,8 +140,8 @@ struct Cone {
 // object (good where the object covers a small share of a broad sky: a far pixel's faint soft shadow); lamps
 // (free emitters) come from patch samples alone. The cone samples also give the object's light on y. Only
 // samples that meet the object add to `blocked` and `bounce`.
-void proxy_terms(const Scene& s, const std::vector<Vec3>* tri_radiance, Vec3 y, Vec3 n, int count, int cone_count, Rng& rng,
-                 Vec3* e0, Vec3* blocked, Vec3* bounce) {
+void proxy_terms(const Scene& s, const std::vector<Vec3>* tri_radiance, Vec3 y, Vec3 n, int count, int cone_count,
+                 Rng& rng, Vec3* e0, Vec3* blocked, Vec3* bounce) {
   const LightField& L = *s.light;
   const Cone cone(s.bound, y, n);
   const double n1 = count, n2 = cone_count, pc = cone_count > 0 ? 1 / cone.solid_angle : 0;
@@ -153,7 +155,8 @@ void proxy_terms(const Scene& s, const std::vector<Vec3>* tri_radiance, Vec3 y, 
   for (int k = 0; k < count; ++k) {
     if (k % kBatch == 0)
       for (int j = 0; j < kBatch && k + j < count; ++j) {
-        drawn[static_cast<size_t>(j)] = L.sample((k + j + rng.uniform()) / count, &drawn_pmf[static_cast<size_t>(j)], table);
+        drawn[static_cast<size_t>(j)] =
+            L.sample((k + j + rng.uniform()) / count, &drawn_pmf[static_cast<size_t>(j)], table);
         L.prefetch(drawn[static_cast<size_t>(j)]);
       }
     const size_t i = drawn[static_cast<size_t>(k % kBatch)];
@@ -211,15 +214,19 @@ void shadow_patches(const Scene& s, LightField& field, int count, int cone_count
   for (size_t i = 0; i < field.size(); ++i)
     if (field.local(i) && length(field.point(i) - s.bound.c) < kShadowReach * s.bound.r) near.push_back(i);
   std::vector<Vec3> factor(near.size(), Vec3{1, 1, 1});
-  parallel_for(0, static_cast<int64_t>(near.size()), [&](int64_t k) {
-    size_t i = near[static_cast<size_t>(k)];
-    Vec3 n = field.normal(i), e0, blocked;
-    Rng rng(seed, 0x706174 /* "pat" */, i);
-    Vec3 unused;
-    proxy_terms(s, nullptr, field.point(i) + n * kRayEpsilon, n, count, cone_count, rng, &e0, &blocked, &unused);
-    for (int c = 0; c < 3; ++c)
-      if (e0[c] > kUnlitIrradiance) factor[static_cast<size_t>(k)][c] = std::clamp(1 - blocked[c] / e0[c], 0.0, 1.0);
-  }, 64);
+  parallel_for(
+      0, static_cast<int64_t>(near.size()),
+      [&](int64_t k) {
+        size_t i = near[static_cast<size_t>(k)];
+        Vec3 n = field.normal(i), e0, blocked;
+        Rng rng(seed, 0x706174 /* "pat" */, i);
+        Vec3 unused;
+        proxy_terms(s, nullptr, field.point(i) + n * kRayEpsilon, n, count, cone_count, rng, &e0, &blocked, &unused);
+        for (int c = 0; c < 3; ++c)
+          if (e0[c] > kUnlitIrradiance)
+            factor[static_cast<size_t>(k)][c] = std::clamp(1 - blocked[c] / e0[c], 0.0, 1.0);
+      },
+      64);
   for (size_t k = 0; k < near.size(); ++k) field.set_shadow(near[k], factor[k]);
 }
 
@@ -265,7 +272,8 @@ void check_geometry(const Scene& s, const geometry::Camera& cam) {
       if (len > 0 && s.proxy_rt.occluded(a, (b - a) / len, 0, len)) ++crossing;
     }
   if (crossing > 0)
-    fail(ErrorKind::Value, "the object intersects the proxy ({} of its edges cross it): move it (at) or make it smaller (size)",
+    fail(ErrorKind::Value,
+         "the object intersects the proxy ({} of its edges cross it): move it (at) or make it smaller (size)",
          crossing);
 }
 
@@ -276,7 +284,8 @@ CompositeResult composite(const Image& photo, const geometry::Camera& cam, const
                           const CompositeDesc& desc) {
   auto t0 = std::chrono::steady_clock::now();
   const int W = photo.width(), H = photo.height(), n = desc.pixel_samples;
-  if (photo.channels() < 3) fail(ErrorKind::Value, "the photograph has {} channels; an RGB image is needed", photo.channels());
+  if (photo.channels() < 3)
+    fail(ErrorKind::Value, "the photograph has {} channels; an RGB image is needed", photo.channels());
   if (W != cam.width || H != cam.height)
     fail(ErrorKind::Value, "the photograph is {}x{} but the camera's frame is {}x{}", W, H, cam.width, cam.height);
   if (n < 1 || n > 8) fail(ErrorKind::Value, "pixel_samples {} must lie in 1..8", n);
@@ -288,7 +297,8 @@ CompositeResult composite(const Image& photo, const geometry::Camera& cam, const
     if (!(material.albedo[c] >= 0 && material.albedo[c] <= 1 && material.specular[c] >= 0 && material.specular[c] <= 1))
       fail(ErrorKind::Value, "object albedo ({}, {}, {}) and gloss ({}, {}, {}) must lie in [0, 1]", material.albedo.x,
            material.albedo.y, material.albedo.z, material.specular.x, material.specular.y, material.specular.z);
-  if (!(material.exponent >= 1 && material.exponent <= 1e4)) fail(ErrorKind::Value, "glossy exponent {} must lie in 1..10000", material.exponent);
+  if (!(material.exponent >= 1 && material.exponent <= 1e4))
+    fail(ErrorKind::Value, "glossy exponent {} must lie in 1..10000", material.exponent);
   if (material.texture && (material.texture->empty() || material.texture->channels() < 3))
     fail(ErrorKind::Value, "the object's texture must be an RGB image");
   Scene s{proxy, object, {}, {}, {}, {}, nullptr};
@@ -301,13 +311,18 @@ CompositeResult composite(const Image& photo, const geometry::Camera& cam, const
   // The object's radiance per triangle (for its light on the proxy).
   std::vector<Vec3> tri_radiance(object.triangle_count());
   if (desc.bounce_samples > 0)
-    parallel_for(0, static_cast<int64_t>(object.triangle_count()), [&](int64_t ti) {
-      const auto& t = object.triangles[static_cast<size_t>(ti)];
-      Vec3 nn = object.normal(static_cast<size_t>(ti));
-      Vec3 c = (object.positions[t[0]] + object.positions[t[1]] + object.positions[t[2]]) / 3.0;
-      Rng rng(desc.seed, 0x747269 /* "tri" */, static_cast<uint64_t>(ti));
-      tri_radiance[static_cast<size_t>(ti)] = object_albedo(object, material, static_cast<uint32_t>(ti), 1.0 / 3, 1.0 / 3) * irradiance(s, s.both_rt, c + nn * kRayEpsilon, nn, desc.triangle_samples, rng, true) / kPi;
-    }, 256);
+    parallel_for(
+        0, static_cast<int64_t>(object.triangle_count()),
+        [&](int64_t ti) {
+          const auto& t = object.triangles[static_cast<size_t>(ti)];
+          Vec3 nn = object.normal(static_cast<size_t>(ti));
+          Vec3 c = (object.positions[t[0]] + object.positions[t[1]] + object.positions[t[2]]) / 3.0;
+          Rng rng(desc.seed, 0x747269 /* "tri" */, static_cast<uint64_t>(ti));
+          tri_radiance[static_cast<size_t>(ti)] =
+              object_albedo(object, material, static_cast<uint32_t>(ti), 1.0 / 3, 1.0 / 3) *
+              irradiance(s, s.both_rt, c + nn * kRayEpsilon, nn, desc.triangle_samples, rng, true) / kPi;
+        },
+        256);
   report(desc.progress, "object", 1.0);
 
   CompositeResult r;
@@ -339,8 +354,9 @@ CompositeResult composite(const Image& photo, const geometry::Camera& cam, const
           if (dot(nn, d) > 0) nn = -nn;
           Vec3 z = cam.eye + d * h.t;
           Rng rng(desc.seed, 0x6f626a /* "obj" */, pixel * 64 + static_cast<uint64_t>(kk));
-          obj_sum += object_radiance(s, z + nn * kRayEpsilon, nn, -d, object_albedo(object, material, h.triangle, h.b1, h.b2), material,
-                                     obj_per_ray, rng);
+          obj_sum +=
+              object_radiance(s, z + nn * kRayEpsilon, nn, -d, object_albedo(object, material, h.triangle, h.b1, h.b2),
+                              material, obj_per_ray, rng);
           ++obj_hits;
         } else if (!have_proxy) {
           have_proxy = true;
@@ -364,7 +380,8 @@ CompositeResult composite(const Image& photo, const geometry::Camera& cam, const
         for (int c = 0; c < 3; ++c) {
           if (e0[c] > kUnlitIrradiance) {
             rho[c] = kPi * ph[c] / e0[c];
-            comp[c] = std::max(0.0, ph[c] + std::min(rho[c], 1.0) * dE[c] / kPi);  // a reflectance > 1 changes no more than 1 would
+            comp[c] = std::max(
+                0.0, ph[c] + std::min(rho[c], 1.0) * dE[c] / kPi);  // a reflectance > 1 changes no more than 1 would
             bad = bad || rho[c] > 1;
           } else {
             lit = false;
@@ -393,27 +410,34 @@ CompositeResult composite(const Image& photo, const geometry::Camera& cam, const
     }
     report(desc.progress, "composite", static_cast<double>(++rows) / H);
   });
-  r.stats = {proxy_px, object_px, changed, over, unlit, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()};
+  r.stats = {proxy_px, object_px, changed,
+             over,     unlit,     std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()};
   if (r.stats.albedo_over_one > 0)
-    r.warnings.push_back(fmt::format("{} proxy pixels ({:.1f} %) have an estimated albedo > 1: the captured light is weaker there than "
-                                     "the photograph says (a light the probe misses, or a wrong proxy); kept as photographed",
-                                     r.stats.albedo_over_one, 100.0 * r.stats.albedo_over_one / std::max<int64_t>(1, proxy_px)));
+    r.warnings.push_back(
+        fmt::format("{} proxy pixels ({:.1f} %) have an estimated albedo > 1: the captured light is weaker there than "
+                    "the photograph says (a light the probe misses, or a wrong proxy); kept as photographed",
+                    r.stats.albedo_over_one, 100.0 * r.stats.albedo_over_one / std::max<int64_t>(1, proxy_px)));
   if (r.stats.unlit > 0)
-    r.warnings.push_back(fmt::format("{} proxy pixels receive no captured light in some channel: their albedo is unknown and they "
-                                     "keep the photograph's value",
-                                     r.stats.unlit));
-  if (r.stats.object_pixels == 0) r.warnings.push_back("no pixel of the photograph sees the object: check at, the eye and the target");
+    r.warnings.push_back(
+        fmt::format("{} proxy pixels receive no captured light in some channel: their albedo is unknown and they "
+                    "keep the photograph's value",
+                    r.stats.unlit));
+  if (r.stats.object_pixels == 0)
+    r.warnings.push_back("no pixel of the photograph sees the object: check at, the eye and the target");
   return r;
 }
 
 constexpr double kMaxSoftFactor = 16;  // composite.h: soft_visibility's f
 constexpr int kMaxPoolRings = 3;
 
-std::vector<Vec3> soft_visibility(const LocalLight& light, const geometry::TriMesh& proxy, const geometry::TriMesh& object,
-                                  const SoftVisibilityDesc& desc) {
-  if (desc.samples < 1 || desc.samples > 65536) fail(ErrorKind::Value, "soft visibility samples {} must lie in 1..65536", desc.samples);
-  if (desc.shadow_samples < 1 || desc.shadow_cone < 0) fail(ErrorKind::Value, "shadow samples must be ≥ 1 (cone samples ≥ 0)");
-  if (!(desc.threshold >= 0) || !std::isfinite(desc.threshold)) fail(ErrorKind::Value, "soft threshold {} must be ≥ 0", desc.threshold);
+std::vector<Vec3> soft_visibility(const LocalLight& light, const geometry::TriMesh& proxy,
+                                  const geometry::TriMesh& object, const SoftVisibilityDesc& desc) {
+  if (desc.samples < 1 || desc.samples > 65536)
+    fail(ErrorKind::Value, "soft visibility samples {} must lie in 1..65536", desc.samples);
+  if (desc.shadow_samples < 1 || desc.shadow_cone < 0)
+    fail(ErrorKind::Value, "shadow samples must be ≥ 1 (cone samples ≥ 0)");
+  if (!(desc.threshold >= 0) || !std::isfinite(desc.threshold))
+    fail(ErrorKind::Value, "soft threshold {} must be ≥ 0", desc.threshold);
   if (proxy.triangle_count() == 0) fail(ErrorKind::Value, "the proxy has no triangles");
   if (object.triangle_count() == 0) fail(ErrorKind::Value, "the object has no triangles");
   Scene s{proxy, object, {}, {}, {}, {}, nullptr};
@@ -421,33 +445,39 @@ std::vector<Vec3> soft_visibility(const LocalLight& light, const geometry::TriMe
   LightField field(light, proxy, s.proxy_rt);
   s.light = &field;
   if (desc.proxy) shadow_patches(s, field, desc.shadow_samples, desc.shadow_cone, desc.seed);
-  const double limit = desc.threshold > 0 ? desc.threshold * field.total_power() / (4 * kPi) : std::numeric_limits<double>::infinity();
+  const double limit =
+      desc.threshold > 0 ? desc.threshold * field.total_power() / (4 * kPi) : std::numeric_limits<double>::infinity();
   const geometry::RayTracer& rt = desc.proxy ? s.both_rt : s.object_rt;
   const int count = desc.samples;
   const size_t T = object.triangle_count();
   std::vector<Vec3> nums(T), dens(T);
-  parallel_for(0, static_cast<int64_t>(T), [&](int64_t ti) {
-    const auto& t = object.triangles[static_cast<size_t>(ti)];
-    const Vec3 n = object.normal(static_cast<size_t>(ti));
-    const Vec3 z = (object.positions[t[0]] + object.positions[t[1]] + object.positions[t[2]]) / 3.0 + n * kRayEpsilon;
-    Rng rng(desc.seed, 0x766973 /* "vis" */, static_cast<uint64_t>(ti));
-    Vec3 num, den;
-    for (int k = 0; k < count; ++k) {
-      double pmf;
-      size_t i = field.sample((k + rng.uniform()) / count, &pmf);
-      if (split_measure(field.radiance(i)) > limit) continue;  // a hard light's texel: the shadow maps' part
-      Vec3 w;
-      double dist;
-      if (desc.proxy) den += field.contribution(i, light.centre, n, &w, &dist) / pmf;  // E_c(n), what the shader has
-      Vec3 c = field.contribution(i, z, n, &w, &dist);
-      if (max_component(c) <= 0) continue;
-      if (!desc.proxy) den += c / pmf;
-      if (rt.occluded(z, w, kRayEpsilon, patch_tfar(dist))) continue;
-      num += (desc.proxy ? field.contribution(i, z, n, &w, &dist, true) : c) / pmf;
-    }
-    nums[static_cast<size_t>(ti)] = num;
-    dens[static_cast<size_t>(ti)] = den;
-  }, 256);
+  parallel_for(
+      0, static_cast<int64_t>(T),
+      [&](int64_t ti) {
+        const auto& t = object.triangles[static_cast<size_t>(ti)];
+        const Vec3 n = object.normal(static_cast<size_t>(ti));
+        const Vec3 z =
+            (object.positions[t[0]] + object.positions[t[1]] + object.positions[t[2]]) / 3.0 + n * kRayEpsilon;
+        Rng rng(desc.seed, 0x766973 /* "vis" */, static_cast<uint64_t>(ti));
+        Vec3 num, den;
+        for (int k = 0; k < count; ++k) {
+          double pmf;
+          size_t i = field.sample((k + rng.uniform()) / count, &pmf);
+          if (split_measure(field.radiance(i)) > limit) continue;  // a hard light's texel: the shadow maps' part
+          Vec3 w;
+          double dist;
+          if (desc.proxy)
+            den += field.contribution(i, light.centre, n, &w, &dist) / pmf;  // E_c(n), what the shader has
+          Vec3 c = field.contribution(i, z, n, &w, &dist);
+          if (max_component(c) <= 0) continue;
+          if (!desc.proxy) den += c / pmf;
+          if (rt.occluded(z, w, kRayEpsilon, patch_tfar(dist))) continue;
+          num += (desc.proxy ? field.contribution(i, z, n, &w, &dist, true) : c) / pmf;
+        }
+        nums[static_cast<size_t>(ti)] = num;
+        dens[static_cast<size_t>(ti)] = den;
+      },
+      256);
   // Each triangle's factor pools the sums of the triangles around it (rings of shared vertices, at most
   // kMaxPoolRings) until they hold desc.pool_rays rays: the rasterised object shows one triangle's factor per
   // sample, so its grain depends on the rays per triangle, and a dense mesh's neighbours see nearly what it sees.
@@ -463,28 +493,31 @@ std::vector<Vec3> soft_visibility(const LocalLight& light, const geometry::TriMe
   }
   const size_t want = static_cast<size_t>(std::max(desc.pool_rays, count)) / static_cast<size_t>(count);  // triangles
   std::vector<Vec3> f(T, Vec3{1, 1, 1});
-  parallel_for(0, static_cast<int64_t>(T), [&](int64_t ti) {
-    std::vector<uint32_t> pool{static_cast<uint32_t>(ti)}, verts(object.triangles[static_cast<size_t>(ti)].begin(),
-                                                                  object.triangles[static_cast<size_t>(ti)].end());
-    for (int ring = 0; ring < kMaxPoolRings && pool.size() < want; ++ring) {
-      std::vector<uint32_t> next;
-      for (uint32_t v : verts)
-        for (uint32_t k = first[v]; k < first[v + 1]; ++k) {
-          const uint32_t u = incident[k];
-          if (std::find(pool.begin(), pool.end(), u) != pool.end()) continue;
-          pool.push_back(u);
-          for (uint32_t w : object.triangles[u]) next.push_back(w);
+  parallel_for(
+      0, static_cast<int64_t>(T),
+      [&](int64_t ti) {
+        std::vector<uint32_t> pool{static_cast<uint32_t>(ti)},
+            verts(object.triangles[static_cast<size_t>(ti)].begin(), object.triangles[static_cast<size_t>(ti)].end());
+        for (int ring = 0; ring < kMaxPoolRings && pool.size() < want; ++ring) {
+          std::vector<uint32_t> next;
+          for (uint32_t v : verts)
+            for (uint32_t k = first[v]; k < first[v + 1]; ++k) {
+              const uint32_t u = incident[k];
+              if (std::find(pool.begin(), pool.end(), u) != pool.end()) continue;
+              pool.push_back(u);
+              for (uint32_t w : object.triangles[u]) next.push_back(w);
+            }
+          verts.swap(next);
         }
-      verts.swap(next);
-    }
-    Vec3 num, den;
-    for (uint32_t u : pool) {
-      num += nums[u];
-      den += dens[u];
-    }
-    for (int c = 0; c < 3; ++c)
-      if (den[c] > 0) f[static_cast<size_t>(ti)][c] = std::clamp(num[c] / den[c], 0.0, kMaxSoftFactor);
-  }, 256);
+        Vec3 num, den;
+        for (uint32_t u : pool) {
+          num += nums[u];
+          den += dens[u];
+        }
+        for (int c = 0; c < 3; ++c)
+          if (den[c] > 0) f[static_cast<size_t>(ti)][c] = std::clamp(num[c] / den[c], 0.0, kMaxSoftFactor);
+      },
+      256);
   return f;
 }
 

@@ -42,7 +42,8 @@ namespace ibl::augment {
 struct CompositeDesc {
   int light_samples = 96;      // patch samples per proxy pixel (albedo and shadow; 64 until 2026-12-02)
   int object_samples = 1024;   // patch samples per object pixel (split over its camera rays)
-  int bounce_samples = 64;     // cone samples per proxy pixel: the object's light on it (0: no bounce) and its shadow (MIS); a square is stratified
+  int bounce_samples = 64;     // cone samples per proxy pixel: the object's light on it (0: no bounce) and its shadow
+                               // (MIS); a square is stratified
   int triangle_samples = 64;   // patch samples per object triangle (its radiance for the bounce)
   int pixel_samples = 2;       // n: n×n camera rays per pixel (object coverage at its edges)
   uint64_t seed = 1;           // random streams (same seed, same bytes)
@@ -52,12 +53,12 @@ struct CompositeDesc {
 };
 
 struct CompositeStats {
-  int64_t proxy_pixels = 0;    // pixels whose camera ray hits the proxy
-  int64_t object_pixels = 0;   // pixels some camera ray of which hits the object
-  int64_t changed_pixels = 0;  // proxy pixels with ΔE ≠ 0 (shadowed or lit by the object)
-  int64_t albedo_over_one = 0; // proxy pixels whose estimated albedo exceeds 1 in some channel
-  int64_t unlit = 0;           // proxy pixels with no captured light (albedo unknown; left as photographed)
-  double seconds = 0;          // wall time of composite()
+  int64_t proxy_pixels = 0;     // pixels whose camera ray hits the proxy
+  int64_t object_pixels = 0;    // pixels some camera ray of which hits the object
+  int64_t changed_pixels = 0;   // proxy pixels with ΔE ≠ 0 (shadowed or lit by the object)
+  int64_t albedo_over_one = 0;  // proxy pixels whose estimated albedo exceeds 1 in some channel
+  int64_t unlit = 0;            // proxy pixels with no captured light (albedo unknown; left as photographed)
+  double seconds = 0;           // wall time of composite()
 };
 
 struct CompositeResult {
@@ -84,7 +85,8 @@ CompositeResult composite(const Image& photo, const geometry::Camera& cam, const
                           const CompositeDesc& desc = {});
 // A Lambertian object of albedo `albedo`.
 inline CompositeResult composite(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy,
-                                 const LocalLight& light, const geometry::TriMesh& object, Vec3 albedo, const CompositeDesc& desc = {}) {
+                                 const LocalLight& light, const geometry::TriMesh& object, Vec3 albedo,
+                                 const CompositeDesc& desc = {}) {
   return composite(photo, cam, proxy, light, object, render::Material{albedo, {0, 0, 0}}, desc);
 }
 
@@ -105,16 +107,16 @@ inline CompositeResult composite(const Image& photo, const geometry::Camera& cam
 // nothing is hidden, f is exactly 1. proxy = false: the object's own occlusion alone (V past the object, s = 1,
 // both sums at z), which stays right while the object moves (iblkit view).
 struct SoftVisibilityDesc {
-  int samples = 64;          // patch samples per triangle
-  int pool_rays = 1536;      // each triangle's f pools the sums of the triangles around it (up to 3 rings of
-                             // shared vertices) until they hold this many rays (≤ samples: none pooled)
-  double threshold = 8;      // as SplitDesc::threshold
-  bool proxy = true;         // the proxy occludes and carries the object's shadow (as composite())
-  int shadow_samples = 64;   // as CompositeDesc::light_samples, for the shadow on the proxy's patches
-  int shadow_cone = 64;      // as CompositeDesc::bounce_samples
+  int samples = 64;         // patch samples per triangle
+  int pool_rays = 1536;     // each triangle's f pools the sums of the triangles around it (up to 3 rings of
+                            // shared vertices) until they hold this many rays (≤ samples: none pooled)
+  double threshold = 8;     // as SplitDesc::threshold
+  bool proxy = true;        // the proxy occludes and carries the object's shadow (as composite())
+  int shadow_samples = 64;  // as CompositeDesc::light_samples, for the shadow on the proxy's patches
+  int shadow_cone = 64;     // as CompositeDesc::bounce_samples
   uint64_t seed = 1;
 };
-std::vector<Vec3> soft_visibility(const LocalLight& light, const geometry::TriMesh& proxy, const geometry::TriMesh& object,
-                                  const SoftVisibilityDesc& desc = {});
+std::vector<Vec3> soft_visibility(const LocalLight& light, const geometry::TriMesh& proxy,
+                                  const geometry::TriMesh& object, const SoftVisibilityDesc& desc = {});
 
 }  // namespace ibl::augment

@@ -63,7 +63,8 @@ LocalLight light_from_grid(const ilf::SHGrid& grid, Vec3 at, int size) {
   for (int k = 0; k < 3; ++k) scale[k] = clamped[k] > 0 && power[k] > 0 ? power[k] / clamped[k] : 1.0;
   for (int y = 0; y < size; ++y)
     for (int x = 0; x < 2 * size; ++x) l.map.image.set_rgb(x, y, l.map.image.rgb(x, y) * scale);
-  l.source = fmt::format("SH grid (Hanning-windowed, rings clamped: power x{:.2f}, scaled back)", luminance(clamped) / std::max(luminance(power), 1e-300));
+  l.source = fmt::format("SH grid (Hanning-windowed, rings clamped: power x{:.2f}, scaled back)",
+                         luminance(clamped) / std::max(luminance(power), 1e-300));
   return l;
 }
 
@@ -79,7 +80,8 @@ LocalLight light_from_probes(const fusion::ProbeSet& set, Vec3 at, int size) {
 }
 
 LocalLight as_median_cut(const LocalLight& light, int count) {
-  if (light.map.mapping.kind() != sphere::MappingKind::LatLong) fail(ErrorKind::Value, "median-cut baseline: the {} map is not lat-long", light.source);
+  if (light.map.mapping.kind() != sphere::MappingKind::LatLong)
+    fail(ErrorKind::Value, "median-cut baseline: the {} map is not lat-long", light.source);
   lights::CutDesc cd;
   cd.count = count;
   lights::LightSet set = lights::median_cut(light.map, cd);
@@ -99,13 +101,15 @@ LocalLight as_median_cut(const LocalLight& light, int count) {
   return out;
 }
 
-LightField::LightField(const LocalLight& light, const geometry::TriMesh& proxy, const geometry::RayTracer& proxy_tracer) {
+LightField::LightField(const LocalLight& light, const geometry::TriMesh& proxy,
+                       const geometry::RayTracer& proxy_tracer) {
   const Image& img = light.map.image;
   const sphere::Mapping& mp = light.map.mapping;
   const int W = img.width(), H = img.height();
   const bool have_depth = !light.depth.empty();
   if (have_depth && (light.depth.width() != W || light.depth.height() != H))
-    fail(ErrorKind::Value, "light depth map {}x{} and radiance map {}x{} differ in size", light.depth.width(), light.depth.height(), W, H);
+    fail(ErrorKind::Value, "light depth map {}x{} and radiance map {}x{} differ in size", light.depth.width(),
+         light.depth.height(), W, H);
   std::vector<std::vector<Patch>> rows(H);
   parallel_for(0, H, [&](int64_t yy) {
     const int y = static_cast<int>(yy);
@@ -155,7 +159,8 @@ LightField::LightField(const LocalLight& light, const geometry::TriMesh& proxy, 
   }
   total_ = power;
   if (!(power > 0)) fail(ErrorKind::Value, "the {} light has no positive radiance", light.source);
-  if (patches_.size() > std::numeric_limits<uint32_t>::max() / 2) fail(ErrorKind::Value, "the {} light has too many texels", light.source);
+  if (patches_.size() > std::numeric_limits<uint32_t>::max() / 2)
+    fail(ErrorKind::Value, "the {} light has too many texels", light.source);
   std::vector<double>& cdf = cdf_.cdf;
   cdf.resize(patches_.size());
   double acc = 0;
@@ -216,7 +221,8 @@ void LightField::build_tables(const geometry::TriMesh& proxy) {
       cdf[i] = acc;
     }
     const double cond = acc > 0 ? kConditionedShare / acc : 0, plain = acc > 0 ? 1 - kConditionedShare : 1;
-    for (size_t i = 0; i < patches_.size(); ++i) cdf[i] = std::min(1.0, cond * cdf[i] + plain * cdf_.cdf[i]);  // rounding stays ≤ 1
+    for (size_t i = 0; i < patches_.size(); ++i)
+      cdf[i] = std::min(1.0, cond * cdf[i] + plain * cdf_.cdf[i]);  // rounding stays ≤ 1
     cdf.back() = 1.0;
     tables_[static_cast<size_t>(kk)].build_guide();
   });
@@ -251,8 +257,10 @@ size_t LightField::Cdf::find(double u) const {
   const size_t G = guide.size() - 1;
   size_t j = static_cast<size_t>(u * static_cast<double>(G));
   j = std::min(j, G - 1);
-  auto lo = cdf.begin() + guide[j], hi = cdf.begin() + std::min<size_t>(cdf.size(), static_cast<size_t>(guide[j + 1]) + 1);
-  if (!(u >= static_cast<double>(j) / static_cast<double>(G))) lo = cdf.begin();  // rounding at a cell's edge: search it all
+  auto lo = cdf.begin() + guide[j],
+       hi = cdf.begin() + std::min<size_t>(cdf.size(), static_cast<size_t>(guide[j + 1]) + 1);
+  if (!(u >= static_cast<double>(j) / static_cast<double>(G)))
+    lo = cdf.begin();  // rounding at a cell's edge: search it all
   if (!(u < static_cast<double>(j + 1) / static_cast<double>(G))) hi = cdf.end();
   return static_cast<size_t>(std::upper_bound(lo, hi, u) - cdf.begin());
 }
@@ -293,7 +301,8 @@ long LightField::patch_along(Vec3 x, Vec3 w, const geometry::Hit& h) const {
   }
   double px, py;
   if (!mapping_.to_pixel(d, &px, &py)) return -1;
-  int tx = std::clamp(static_cast<int>(px), 0, mapping_.width() - 1), ty = std::clamp(static_cast<int>(py), 0, mapping_.height() - 1);
+  int tx = std::clamp(static_cast<int>(px), 0, mapping_.width() - 1),
+      ty = std::clamp(static_cast<int>(py), 0, mapping_.height() - 1);
   long i = texel_patch_[static_cast<size_t>(ty) * mapping_.width() + tx];
   if (i < 0) return -1;
   const Patch& p = patches_[static_cast<size_t>(i)];

@@ -25,8 +25,9 @@
 namespace ibl::augment {
 
 struct LocalLight {
-  sphere::EnvMap map{Image(2, 1, 3), sphere::Mapping(sphere::MappingKind::LatLong, 2, 1)};  // radiance arriving at centre
-  Vec3 centre;         // where the map was taken, world metres
+  sphere::EnvMap map{Image(2, 1, 3),
+                     sphere::Mapping(sphere::MappingKind::LatLong, 2, 1)};  // radiance arriving at centre
+  Vec3 centre;                                                              // where the map was taken, world metres
   Image depth;         // optional, 1 channel, the map's size: metres from centre to what each texel sees (0: none)
   std::string source;  // "probe", "SH grid", "fused probes": for messages
 };
@@ -96,11 +97,11 @@ class LightField {
 
  private:
   struct Patch {
-    Vec3 point;       // world point on the proxy, or the unit direction of a distant patch
-    Vec3 normal;      // facing the centre (local patches)
-    Vec3 radiance;    // W/(sr·m²)
-    double area = 0;  // local: m²; distant: solid angle, sr
-    double omega = 0; // solid angle seen from the centre, sr
+    Vec3 point;        // world point on the proxy, or the unit direction of a distant patch
+    Vec3 normal;       // facing the centre (local patches)
+    Vec3 radiance;     // W/(sr·m²)
+    double area = 0;   // local: m²; distant: solid angle, sr
+    double omega = 0;  // solid angle seen from the centre, sr
     bool distant = false;
     bool lamp = false;     // placed by the depth map in front of the proxy
     long texel = 0;        // its texel, row-major

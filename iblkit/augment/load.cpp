@@ -14,7 +14,9 @@ namespace {
 
 constexpr double kOutsideShare = 0.5;  // a point whose rays meet back faces more often than this is outside
 
-bool ends_with(const std::string& s, const std::string& e) { return s.size() >= e.size() && s.compare(s.size() - e.size(), e.size(), e) == 0; }
+bool ends_with(const std::string& s, const std::string& e) {
+  return s.size() >= e.size() && s.compare(s.size() - e.size(), e.size(), e) == 0;
+}
 
 // Share of rays from x whose first proxy hit is a back face (among those that hit).
 double backface_share(const geometry::TriMesh& proxy, Vec3 x) {
@@ -53,7 +55,8 @@ void require_inside(const geometry::TriMesh& proxy, Vec3 centre, const std::stri
   double back = backface_share(proxy, centre);
   if (back > kOutsideShare)
     fail(ErrorKind::Value,
-         "the object's centre ({:.3g}, {:.3g}, {:.3g}) lies outside the proxy of {} ({:.0f} % of its rays meet back faces): the "
+         "the object's centre ({:.3g}, {:.3g}, {:.3g}) lies outside the proxy of {} ({:.0f} % of its rays meet back "
+         "faces): the "
          "captured light says nothing about it there; move it (at)",
          centre.x, centre.y, centre.z, what, 100 * back);
 }
@@ -61,9 +64,10 @@ void require_inside(const geometry::TriMesh& proxy, Vec3 centre, const std::stri
 std::string probe_outside(const geometry::TriMesh& proxy, Vec3 p) {
   double back = backface_share(proxy, p);
   if (back <= kOutsideShare) return {};
-  return fmt::format("the probe at ({:.3g}, {:.3g}, {:.3g}) lies outside the proxy ({:.0f} % of its rays meet back "
-                     "faces): its light is projected onto the proxy from there all the same",
-                     p.x, p.y, p.z, 100 * back);
+  return fmt::format(
+      "the probe at ({:.3g}, {:.3g}, {:.3g}) lies outside the proxy ({:.0f} % of its rays meet back "
+      "faces): its light is projected onto the proxy from there all the same",
+      p.x, p.y, p.z, 100 * back);
 }
 
 }  // namespace
@@ -71,9 +75,11 @@ std::string probe_outside(const geometry::TriMesh& proxy, Vec3 p) {
 LoadedLight load_light(const LightInput& in, Vec3 lo, Vec3 hi) {
   LoadedLight out;
   const Vec3 centre = (lo + hi) * 0.5;
-  if (in.probes.empty() == in.light.empty()) fail(ErrorKind::Value, "give the light as either a probe set or a light file (not both)");
+  if (in.probes.empty() == in.light.empty())
+    fail(ErrorKind::Value, "give the light as either a probe set or a light file (not both)");
   if (!in.probes.empty()) {
-    if (!in.proxy.empty()) fail(ErrorKind::Value, "{}: a probe set names its own proxy; leave the proxy out", in.probes);
+    if (!in.proxy.empty())
+      fail(ErrorKind::Value, "{}: a probe set names its own proxy; leave the proxy out", in.probes);
     fusion::ProbeSet set = fusion::load_probe_set(in.probes);
     out.warnings = set.warnings;
     out.proxy = set.proxy;
@@ -87,7 +93,9 @@ LoadedLight load_light(const LightInput& in, Vec3 lo, Vec3 hi) {
     } else {
       fusion::PointCheck pc = fusion::check_point(set, centre);
       if (pc.backface > kOutsideShare)
-        fail(ErrorKind::Value, "the object's centre ({:.3g}, {:.3g}, {:.3g}) lies outside the proxy of {} ({:.0f} % of its rays meet back faces)",
+        fail(ErrorKind::Value,
+             "the object's centre ({:.3g}, {:.3g}, {:.3g}) lies outside the proxy of {} ({:.0f} % of its rays meet "
+             "back faces)",
              centre.x, centre.y, centre.z, in.probes, 100 * pc.backface);
       out.light = light_from_probes(set, centre, in.fused_map_size);
     }
@@ -104,7 +112,9 @@ LoadedLight load_light(const LightInput& in, Vec3 lo, Vec3 hi) {
     constexpr double kSlack = 1e-6;  // metres: on the volume's faces is inside
     for (int a = 0; a < 3; ++a) {
       if (centre[a] < gmin[a] - kSlack || centre[a] > gmax[a] + kSlack)
-        fail(ErrorKind::Value, "the object's centre ({:.3g}, {:.3g}, {:.3g}) lies outside the SH grid's volume ({:.3g}, {:.3g}, {:.3g})..({:.3g}, {:.3g}, {:.3g})",
+        fail(ErrorKind::Value,
+             "the object's centre ({:.3g}, {:.3g}, {:.3g}) lies outside the SH grid's volume ({:.3g}, {:.3g}, "
+             "{:.3g})..({:.3g}, {:.3g}, {:.3g})",
              centre.x, centre.y, centre.z, gmin.x, gmin.y, gmin.z, gmax.x, gmax.y, gmax.z);
       if (lo[a] < gmin[a] - kSlack || hi[a] > gmax[a] + kSlack) {
         out.warnings.push_back("the object reaches outside the SH grid's volume; it is lit by the grid at its centre");
@@ -121,8 +131,8 @@ LoadedLight load_light(const LightInput& in, Vec3 lo, Vec3 hi) {
   if (!in.probe_depth.empty()) {
     Image d = io::read_image(in.probe_depth);
     if (d.width() != out.light.map.image.width() || d.height() != out.light.map.image.height())
-      fail(ErrorKind::Value, "{}: depth map {}x{} and probe {}x{} differ in size", in.probe_depth, d.width(), d.height(),
-           out.light.map.image.width(), out.light.map.image.height());
+      fail(ErrorKind::Value, "{}: depth map {}x{} and probe {}x{} differ in size", in.probe_depth, d.width(),
+           d.height(), out.light.map.image.width(), out.light.map.image.height());
     Image one(d.width(), d.height(), 1);
     for (int y = 0; y < d.height(); ++y)
       for (int x = 0; x < d.width(); ++x) one.at(x, y, 0) = d.at(x, y, 0);

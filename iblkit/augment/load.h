@@ -15,14 +15,14 @@
 namespace ibl::augment {
 
 struct LightInput {
-  std::string probes;              // iblkit.probes/1 manifest (exclusive with `light`)
-  std::string light;               // .shgrid or a probe image
-  std::string proxy;               // mesh file: the local scene (with `light`)
-  std::optional<Vec3> at_probe;    // a probe image's position (required for a probe image)
-  std::string probe_depth;         // optional depth map of a probe image (metres, 1 channel, its size)
-  io::EnvReadDesc read;            // how a probe image is read
-  int grid_map_size = 64;          // lat-long height of the grid's map at the object
-  int fused_map_size = 128;        // lat-long height of the fused map
+  std::string probes;            // iblkit.probes/1 manifest (exclusive with `light`)
+  std::string light;             // .shgrid or a probe image
+  std::string proxy;             // mesh file: the local scene (with `light`)
+  std::optional<Vec3> at_probe;  // a probe image's position (required for a probe image)
+  std::string probe_depth;       // optional depth map of a probe image (metres, 1 channel, its size)
+  io::EnvReadDesc read;          // how a probe image is read
+  int grid_map_size = 64;        // lat-long height of the grid's map at the object
+  int fused_map_size = 128;      // lat-long height of the fused map
 };
 
 struct LoadedLight {

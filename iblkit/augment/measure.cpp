@@ -84,16 +84,19 @@ Image error_picture(const Image& comp, const Image& truth) {
   return out;
 }
 
-TruthErrors measure_against(const Image& photo, const Image& comp, const std::vector<Image>& truths, const Image& mask, double tau) {
+TruthErrors measure_against(const Image& photo, const Image& comp, const std::vector<Image>& truths, const Image& mask,
+                            double tau) {
   if (truths.empty()) fail(ErrorKind::Value, "measure: no truth");
   const Image& t1 = truths.front();
   TruthErrors r;
   r.mean = Image(t1.width(), t1.height(), 3);
   for (const Image& t : truths) {
     if (t.width() != t1.width() || t.height() != t1.height() || t.channels() < 3)
-      fail(ErrorKind::Value, "measure: truths of {}x{} and {}x{} (RGB) differ", t1.width(), t1.height(), t.width(), t.height());
+      fail(ErrorKind::Value, "measure: truths of {}x{} and {}x{} (RGB) differ", t1.width(), t1.height(), t.width(),
+           t.height());
     for (int y = 0; y < t1.height(); ++y)
-      for (int x = 0; x < t1.width(); ++x) r.mean.set_rgb(x, y, r.mean.rgb(x, y) + t.rgb(x, y) / static_cast<double>(truths.size()));
+      for (int x = 0; x < t1.width(); ++x)
+        r.mean.set_rgb(x, y, r.mean.rgb(x, y) + t.rgb(x, y) / static_cast<double>(truths.size()));
   }
   r.errors = measure(photo, comp, r.mean, mask, tau);
   if (truths.size() > 1) {

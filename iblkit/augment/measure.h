@@ -21,7 +21,8 @@ struct CompositeErrors {
 };
 
 // All four images of one size (mask: 1 channel, the object's coverage). τ = threshold.
-CompositeErrors measure(const Image& photo, const Image& composite, const Image& truth, const Image& mask, double threshold = 0.02);
+CompositeErrors measure(const Image& photo, const Image& composite, const Image& truth, const Image& mask,
+                        double threshold = 0.02);
 
 // A Monte Carlo truth is noisy; K ≥ 2 truths of different seeds measure how much. The composite is measured
 // against their mean T̄, and the mean's own noise is estimated on the same pixels as
@@ -38,7 +39,7 @@ struct TruthErrors {
 // ((c − t)/t per pixel; 1 = 100 %).
 Image error_picture(const Image& composite, const Image& truth);
 
-TruthErrors measure_against(const Image& photo, const Image& composite, const std::vector<Image>& truths, const Image& mask,
-                            double threshold = 0.02);
+TruthErrors measure_against(const Image& photo, const Image& composite, const std::vector<Image>& truths,
+                            const Image& mask, double threshold = 0.02);
 
 }  // namespace ibl::augment

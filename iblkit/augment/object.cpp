@@ -13,7 +13,8 @@ geometry::TriMesh make_object(const ObjectDesc& d) {
     if (!(d.albedo[c] >= 0 && d.albedo[c] <= 1))
       fail(ErrorKind::Value, "object albedo ({}, {}, {}) must lie in [0, 1]", d.albedo.x, d.albedo.y, d.albedo.z);
   for (int c = 0; c < 3; ++c)
-    if (!std::isfinite(d.at[c]) || std::abs(d.at[c]) > 1e6) fail(ErrorKind::Value, "object position is not a finite point within 1e6 m");
+    if (!std::isfinite(d.at[c]) || std::abs(d.at[c]) > 1e6)
+      fail(ErrorKind::Value, "object position is not a finite point within 1e6 m");
   const bool procedural = d.kind == "blob" || d.kind == "sphere";
   if (!(d.size >= 0 && d.size <= 1e4) || (procedural && d.size == 0))
     fail(ErrorKind::Value, "object size {} must be > 0 (and ≤ 1e4 m) for the {}", d.size, d.kind);

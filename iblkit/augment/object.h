@@ -10,11 +10,11 @@
 namespace ibl::augment {
 
 struct ObjectDesc {
-  std::string kind = "blob";  // "blob" (geometry::make_blob), "sphere", or a mesh file (OBJ, PLY, glTF)
-  double size = 0.3;          // largest extent, metres (0: a mesh file keeps its own size and place)
-  int triangles = 20000;      // triangles of the blob
-  Vec3 at{0, 0, 0};           // where the object's centre goes, metres
-  Vec3 albedo{0.7, 0.7, 0.7}; // Lambertian reflectance in [0, 1]
+  std::string kind = "blob";   // "blob" (geometry::make_blob), "sphere", or a mesh file (OBJ, PLY, glTF)
+  double size = 0.3;           // largest extent, metres (0: a mesh file keeps its own size and place)
+  int triangles = 20000;       // triangles of the blob
+  Vec3 at{0, 0, 0};            // where the object's centre goes, metres
+  Vec3 albedo{0.7, 0.7, 0.7};  // Lambertian reflectance in [0, 1]
 };
 
 // The object's triangles in world space. Throws ibl::Error on a bad size, albedo or file.

@@ -17,7 +17,9 @@ OccluderSphere equivalent_sphere(const geometry::TriMesh& object) {
   for (const Vec3& p : object.positions) s.bound_radius = std::max(s.bound_radius, length(p - s.centre));
   double volume = 0;
   for (const auto& t : object.triangles)
-    volume += dot(object.positions[t[0]] - s.centre, cross(object.positions[t[1]] - s.centre, object.positions[t[2]] - s.centre)) / 6;
+    volume += dot(object.positions[t[0]] - s.centre,
+                  cross(object.positions[t[1]] - s.centre, object.positions[t[2]] - s.centre)) /
+              6;
   // A closed mesh has every edge twice, once each way; an open one (a plane, a shell) falls back to the area rule.
   std::vector<std::pair<uint64_t, int>> edges;
   edges.reserve(object.triangle_count() * 3);
@@ -43,19 +45,22 @@ OccluderSphere equivalent_sphere(const geometry::TriMesh& object) {
 double cap_cosine_integral(double cos_beta, double sin2_alpha) {
   const double s2 = std::clamp(sin2_alpha, 0.0, 1 - 1e-9), c = std::clamp(cos_beta, -1.0, 1.0);
   if (c * c > s2) return c > 0 ? kPi * s2 * c : 0.0;  // wholly above (or below) the horizon
-  const double st = std::sqrt(std::max(0.0, 1 - c * c)), x = std::sqrt(1 / s2 - 1), y = std::clamp(-x * c / st, -1.0, 1.0);
+  const double st = std::sqrt(std::max(0.0, 1 - c * c)), x = std::sqrt(1 / s2 - 1),
+               y = std::clamp(-x * c / st, -1.0, 1.0);
   const double sy = st * std::sqrt(std::max(0.0, 1 - y * y));
   return std::max(0.0, (c * std::acos(y) - x * sy) * s2 + std::atan(sy / x));
 }
 
-Image facing_irradiance(const geometry::TriMesh& object, const std::vector<Vec3>* factor, const Image& soft_irradiance, int height) {
+Image facing_irradiance(const geometry::TriMesh& object, const std::vector<Vec3>* factor, const Image& soft_irradiance,
+                        int height) {
   if (height < 2 || height > 1024) fail(ErrorKind::Value, "facing irradiance height {} must lie in 2..1024", height);
   if (factor && factor->size() != object.triangle_count())
     fail(ErrorKind::Value, "{} soft factors for an object of {} triangles", factor->size(), object.triangle_count());
   if (soft_irradiance.width() != 2 * soft_irradiance.height() || soft_irradiance.channels() < 3)
-    fail(ErrorKind::Value, "the soft irradiance is {}x{}x{}, not a lat-long RGB map", soft_irradiance.width(), soft_irradiance.height(),
-         soft_irradiance.channels());
-  const sphere::EnvMap irr(soft_irradiance, sphere::Mapping(sphere::MappingKind::LatLong, soft_irradiance.width(), soft_irradiance.height()));
+    fail(ErrorKind::Value, "the soft irradiance is {}x{}x{}, not a lat-long RGB map", soft_irradiance.width(),
+         soft_irradiance.height(), soft_irradiance.channels());
+  const sphere::EnvMap irr(soft_irradiance, sphere::Mapping(sphere::MappingKind::LatLong, soft_irradiance.width(),
+                                                            soft_irradiance.height()));
   // The triangles gathered by normal into cells of a 2H × H lat-long grid of normals: Σ A, Σ A·n, Σ A·f·E_c(n).
   const sphere::Mapping cells(sphere::MappingKind::LatLong, 2 * height, height);
   const size_t C = static_cast<size_t>(2 * height) * height;
@@ -66,7 +71,8 @@ Image facing_irradiance(const geometry::TriMesh& object, const std::vector<Vec3>
     const double a = object.area(t);
     double px, py;
     if (!(a > 0) || !(dot(n, n) > 0.5) || !cells.to_pixel(n, &px, &py)) continue;
-    const int x = std::clamp(static_cast<int>(px), 0, 2 * height - 1), y = std::clamp(static_cast<int>(py), 0, height - 1);
+    const int x = std::clamp(static_cast<int>(px), 0, 2 * height - 1),
+              y = std::clamp(static_cast<int>(py), 0, height - 1);
     const size_t c = static_cast<size_t>(y) * 2 * height + x;
     const Vec3 f = factor ? (*factor)[t] : Vec3{1, 1, 1};
     area[c] += a;

@@ -34,6 +34,7 @@ double cap_cosine_integral(double cos_beta, double sin2_alpha);
 // the map centre's) times its factor (`factor`: soft_visibility, per triangle; 1 where null). With the factor,
 // the floor under the object lights its underside only as far as the object's shadow leaves it lit. Lat-long,
 // 2·height × height; 0 in a direction no triangle faces.
-Image facing_irradiance(const geometry::TriMesh& object, const std::vector<Vec3>* factor, const Image& soft_irradiance, int height = 16);
+Image facing_irradiance(const geometry::TriMesh& object, const std::vector<Vec3>* factor, const Image& soft_irradiance,
+                        int height = 16);
 
 }  // namespace ibl::augment

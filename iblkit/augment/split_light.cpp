@@ -4,9 +4,9 @@
 #include <cmath>
 
 #include "iblkit/core/error.h"
+#include "iblkit/core/parallel.h"
 #include "iblkit/geometry/raytracer.h"
 #include "iblkit/lights/cut.h"
-#include "iblkit/core/parallel.h"
 
 namespace ibl::augment {
 
@@ -54,13 +54,16 @@ Vec3 HardLight::at(Vec3 centre, Vec3 x, Vec3 n) const {
 
 SplitLight split_light(const LocalLight& light, const geometry::TriMesh& proxy, const SplitDesc& desc) {
   if (desc.lights < 0 || desc.lights > 256) fail(ErrorKind::Value, "hard lights {} must lie in 0..256", desc.lights);
-  if (!(desc.threshold >= 0) || !std::isfinite(desc.threshold)) fail(ErrorKind::Value, "hard-light threshold {} must be ≥ 0", desc.threshold);
-  if (desc.irradiance_size < 4 || desc.irradiance_size > 1024) fail(ErrorKind::Value, "irradiance map size {} must lie in 4..1024", desc.irradiance_size);
+  if (!(desc.threshold >= 0) || !std::isfinite(desc.threshold))
+    fail(ErrorKind::Value, "hard-light threshold {} must be ≥ 0", desc.threshold);
+  if (desc.irradiance_size < 4 || desc.irradiance_size > 1024)
+    fail(ErrorKind::Value, "irradiance map size {} must lie in 4..1024", desc.irradiance_size);
   lights::LatLongGrid grid = lights::to_latlong_grid(light.map);
   const int W = grid.width, H = grid.height;
   double total = 0;
   for (int y = 0; y < H; ++y)
-    for (int x = 0; x < W; ++x) total += split_measure(grid.rgb[static_cast<size_t>(y) * W + x]) * grid.row_solid_angle[y];
+    for (int x = 0; x < W; ++x)
+      total += split_measure(grid.rgb[static_cast<size_t>(y) * W + x]) * grid.row_solid_angle[y];
   if (!(total > 0)) fail(ErrorKind::Value, "the {} light has no positive radiance", light.source);
   const double limit = desc.threshold * total / (4 * kPi);
   SplitLight s;
@@ -101,7 +104,8 @@ SplitLight split_light(const LocalLight& light, const geometry::TriMesh& proxy, 
       if (!light.depth.empty()) {
         double px, py;
         if (light.map.mapping.to_pixel(h.direction, &px, &py)) {
-          int ix = std::clamp(static_cast<int>(px), 0, light.depth.width() - 1), iy = std::clamp(static_cast<int>(py), 0, light.depth.height() - 1);
+          int ix = std::clamp(static_cast<int>(px), 0, light.depth.width() - 1),
+              iy = std::clamp(static_cast<int>(py), 0, light.depth.height() - 1);
           double d = light.depth.at(ix, iy, 0);
           if (d > 0 && std::isfinite(d) && d < kDepthInFront * dist) dist = d;
         }

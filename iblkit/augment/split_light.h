@@ -16,11 +16,11 @@
 namespace ibl::augment {
 
 struct HardLight {
-  Vec3 direction;         // unit, from the map's centre towards the light
-  Vec3 irradiance;        // RGB W/m² at the centre, normal incidence (Σ L dω of its region)
-  double solid_angle = 0; // sr of its region, seen from the centre
-  bool distant = true;    // false: a point light at `position`
-  Vec3 position;          // world metres (local lights); intensity irradiance · |position − centre|² W/sr
+  Vec3 direction;          // unit, from the map's centre towards the light
+  Vec3 irradiance;         // RGB W/m² at the centre, normal incidence (Σ L dω of its region)
+  double solid_angle = 0;  // sr of its region, seen from the centre
+  bool distant = true;     // false: a point light at `position`
+  Vec3 position;           // world metres (local lights); intensity irradiance · |position − centre|² W/sr
   // Irradiance on a surface at x with unit normal n (no visibility): inverse square from a local light.
   Vec3 at(Vec3 centre, Vec3 x, Vec3 n) const;
 };
@@ -29,18 +29,18 @@ struct HardLight {
 inline double split_measure(Vec3 L) { return (std::max(0.0, L.x) + std::max(0.0, L.y) + std::max(0.0, L.z)) / 3; }
 
 struct SplitDesc {
-  int lights = 16;         // most hard lights (fewer when fewer texels are bright)
-  double threshold = 8;    // a texel is hard when its mean RGB radiance exceeds this × the map's mean (0: none hard)
+  int lights = 16;           // most hard lights (fewer when fewer texels are bright)
+  double threshold = 8;      // a texel is hard when its mean RGB radiance exceeds this × the map's mean (0: none hard)
   int irradiance_size = 32;  // lat-long height of the soft irradiance map (and of the soft map it is summed over)
 };
 
 struct SplitLight {
-  Vec3 centre;                   // the map's centre, world metres
-  std::vector<HardLight> hard;   // the concentrated light
-  Image soft;                    // lat-long radiance (RGB, 2H × H): the map less the hard texels
-  Image soft_irradiance;         // lat-long (RGB, 2·irradiance_size × irradiance_size): E_soft(n) = ∫ L_soft max(0, n·ω) dω, summed
-                                 // over the soft map (render::prefilter_phong, exponent 1, times π)
-  double hard_share = 0;         // share of the map's ∫ mean(RGB) dω in the hard lights
+  Vec3 centre;                  // the map's centre, world metres
+  std::vector<HardLight> hard;  // the concentrated light
+  Image soft;                   // lat-long radiance (RGB, 2H × H): the map less the hard texels
+  Image soft_irradiance;  // lat-long (RGB, 2·irradiance_size × irradiance_size): E_soft(n) = ∫ L_soft max(0, n·ω) dω,
+                          // summed over the soft map (render::prefilter_phong, exponent 1, times π)
+  double hard_share = 0;  // share of the map's ∫ mean(RGB) dω in the hard lights
 };
 
 // `proxy` places the lights (the map's own depth map, where it has one, places lamps in front of it).

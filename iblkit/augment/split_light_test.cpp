@@ -50,7 +50,8 @@ TEST(AugmentSphereOcclusion, EquivalentSphereOfASphereAndOfAnOpenSquare) {
   EXPECT_NEAR(s.radius, 0.2, 0.004);  // the tessellated sphere's volume is a little smaller
   EXPECT_NEAR(s.bound_radius, 0.2, 1e-3);
   EXPECT_NEAR(length(s.centre - Vec3{1, 2, 3}), 0, 1e-6);
-  OccluderSphere q = equivalent_sphere(geometry::make_quad({0, 0, 0}, {0, 1, 0}, {0, 0, -1}, 1, 1));  // open: S/4 = π r²
+  OccluderSphere q =
+      equivalent_sphere(geometry::make_quad({0, 0, 0}, {0, 1, 0}, {0, 0, -1}, 1, 1));  // open: S/4 = π r²
   EXPECT_NEAR(q.radius, std::sqrt(1.0 / (4 * kPi)), 1e-9);
 }
 
@@ -83,7 +84,7 @@ TEST(AugmentSphereOcclusion, FacingIrradianceOfASphereIsTheCosineMeanOfItsHemisp
   for (size_t t = 0; t < lit.size(); ++t) lit[t] = sphere.normal(t).y < 0 ? Vec3{} : Vec3{1, 1, 1};
   const Image g = facing_irradiance(sphere, &lit, irr);
   EXPECT_NEAR(g.rgb(0, g.height() - 1).y, 0.0, kTol);  // the bottom row faces (almost) straight down
-  EXPECT_NEAR(g.rgb(0, 0).y, f.rgb(0, 0).y, kTol);      // the top row: all of its side is lit
+  EXPECT_NEAR(g.rgb(0, 0).y, f.rgb(0, 0).y, kTol);     // the top row: all of its side is lit
   EXPECT_THROW(facing_irradiance(sphere, &lit, Image(10, 10, 3)), Error);
 }
 
@@ -121,7 +122,8 @@ TEST(AugmentSplit, HardLightsAndSoftMapHoldAllOfTheMapsPowerAndSitWhereTheProxyI
   const Image& irr = s.soft_irradiance;
   const double c = std::cos(kPi / (2 * irr.height()));
   Vec3 up;
-  ASSERT_TRUE(sphere::Mapping(sphere::MappingKind::LatLong, irr.width(), irr.height()).to_direction(irr.width() / 2 + 0.5, 0.5, &up));
+  ASSERT_TRUE(sphere::Mapping(sphere::MappingKind::LatLong, irr.width(), irr.height())
+                  .to_direction(irr.width() / 2 + 0.5, 0.5, &up));
   double sun_sky = 0;
   for (int x : {20, 21}) {
     Vec3 w;

@@ -115,7 +115,7 @@ struct OutputTransaction::State {
   TxChunk* tail = &head;
   char folders[kTxFolders][kSlotPath];  // created by make_output_folders, in order
   std::atomic<int> folder_count{0};
-  std::mutex mutex;                     // writers on several threads
+  std::mutex mutex;  // writers on several threads
   std::unordered_set<std::string> targets;
   size_t files = 0;
   ~State() {
@@ -138,8 +138,10 @@ void roll_back(OutputTransaction::State& st) noexcept {
     int n = c->used.load(std::memory_order_acquire);
     for (int i = 0; i < n; ++i) {
       const TxEntry& e = c->e[i];
-      if (e.backup[0]) ::rename(e.backup, e.target);
-      else if (!e.existed) ::unlink(e.target);
+      if (e.backup[0])
+        ::rename(e.backup, e.target);
+      else if (!e.existed)
+        ::unlink(e.target);
     }
   }
   for (int i = st.folder_count.load(std::memory_order_acquire) - 1; i >= 0; --i) ::rmdir(st.folders[i]);
@@ -270,8 +272,8 @@ AtomicFile::AtomicFile(const std::string& path) : path_(path), target_(path) {
       fail(ErrorKind::Io, "{}: cannot write ({})", path_, e.what());
     }
   }
-  std::string name = p.stem().string() + ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(g_counter.fetch_add(1)) +
-                     p.extension().string();
+  std::string name = p.stem().string() + ".tmp-" + std::to_string(::getpid()) + "-" +
+                     std::to_string(g_counter.fetch_add(1)) + p.extension().string();
   temp_ = (p.parent_path() / name).string();
   slot_ = register_temp(temp_);
 }
@@ -295,7 +297,6 @@ void AtomicFile::commit() {
   }
   committed_ = true;
 }
-
 
 void write_file_atomically(const std::string& path, std::string_view bytes) {
   AtomicFile f(path);

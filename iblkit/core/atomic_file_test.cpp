@@ -131,8 +131,7 @@ TEST(AtomicFileDeathTest, SignalRemovesLiveTempFiles) {
     ::raise(SIGTERM);
     std::exit(0);  // not reached
   };
-  EXPECT_EXIT(killed_while_writing(),
-      testing::KilledBySignal(SIGTERM), "");
+  EXPECT_EXIT(killed_while_writing(), testing::KilledBySignal(SIGTERM), "");
   EXPECT_EQ(listing(d), std::vector<std::string>{"grid.shgrid"});
   EXPECT_EQ(slurp(out), "previous");
   fs::remove_all(d);
@@ -148,7 +147,7 @@ TEST(OutputTransaction, FailurePutsBackReplacedFilesAndRemovesNewOnes) {
     make_output_folders((d / "frames" / "deep").string());
     write_file_atomically((d / "frames" / "deep" / "f0.exr").string(), "frame");
     write_file_atomically((d / "made" / "x.gltf").string(), "gltf");  // AtomicFile makes the folder
-    EXPECT_EQ(slurp(d / "l.json"), "newer lights");  // in place at once: readable by the command
+    EXPECT_EQ(slurp(d / "l.json"), "newer lights");                   // in place at once: readable by the command
     EXPECT_EQ(tx.files(), 3u);
     // ... the command throws here: no commit
   }

@@ -26,14 +26,15 @@ inline bool in_range(Vec3 v, double bound = kMaxCoordinate) {
 inline void require_point(std::string_view what, Vec3 p) {
   if (!is_finite(p)) fail(ErrorKind::Value, "{} ({}, {}, {}) is not finite", what, p.x, p.y, p.z);
   if (!in_range(p))
-    fail(ErrorKind::Value, "{} ({}, {}, {}) lies outside ±{:g} m, the supported range of coordinates", what, p.x, p.y, p.z,
-         kMaxCoordinate);
+    fail(ErrorKind::Value, "{} ({}, {}, {}) lies outside ±{:g} m, the supported range of coordinates", what, p.x, p.y,
+         p.z, kMaxCoordinate);
 }
 
 // Fails unless d is finite, within ±kMaxCoordinate and not (0, 0, 0); returns d normalised.
 inline Vec3 require_direction(std::string_view what, Vec3 d) {
   if (!is_finite(d)) fail(ErrorKind::Value, "{} ({}, {}, {}) is not finite", what, d.x, d.y, d.z);
-  if (!in_range(d)) fail(ErrorKind::Value, "{} ({}, {}, {}) has components beyond ±{:g}", what, d.x, d.y, d.z, kMaxCoordinate);
+  if (!in_range(d))
+    fail(ErrorKind::Value, "{} ({}, {}, {}) has components beyond ±{:g}", what, d.x, d.y, d.z, kMaxCoordinate);
   double l = length(d);
   if (!(l > 1e-12)) fail(ErrorKind::Value, "{} ({}, {}, {}) has no direction (zero length)", what, d.x, d.y, d.z);
   return d / l;
@@ -45,8 +46,8 @@ inline void require_box(std::string_view what, Vec3 lo, Vec3 hi, bool strict = f
   require_point(fmt::format("{} corner", what), hi);
   for (int a = 0; a < 3; ++a)
     if (strict ? !(hi[a] > lo[a]) : !(hi[a] >= lo[a]))
-      fail(ErrorKind::Value, "{} ({}, {}, {})–({}, {}, {}): max must {} min on axis {}", what, lo.x, lo.y, lo.z, hi.x, hi.y, hi.z,
-           strict ? "exceed" : "be at least", "xyz"[a]);
+      fail(ErrorKind::Value, "{} ({}, {}, {})–({}, {}, {}): max must {} min on axis {}", what, lo.x, lo.y, lo.z, hi.x,
+           hi.y, hi.z, strict ? "exceed" : "be at least", "xyz"[a]);
 }
 
 // Fails unless v is a finite number in [lo, hi].
@@ -72,7 +73,8 @@ inline void require_allocation(std::string_view what, double count, double bytes
                                double limit = physical_memory()) {
   double b = count * bytes_each;
   if (!(b <= limit))
-    fail(ErrorKind::Value, "{} would allocate {:.3g} GB (more than the {:.3g} GB allowed); {}", what, b / 1e9, limit / 1e9, hint);
+    fail(ErrorKind::Value, "{} would allocate {:.3g} GB (more than the {:.3g} GB allowed); {}", what, b / 1e9,
+         limit / 1e9, hint);
 }
 
 }  // namespace ibl

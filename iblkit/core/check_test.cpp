@@ -27,7 +27,9 @@ std::string message_of(const std::function<void()>& f) {
 TEST(CoreCheck, PointsMustBeFiniteAndWithinRange) {
   EXPECT_NO_THROW(require_point("p", {0, 1, -2}));
   EXPECT_NO_THROW(require_point("p", {kMaxCoordinate, -kMaxCoordinate, 0}));
-  EXPECT_NE(message_of([] { require_point("capture position", {kNaN, 1, 0}); }).find("capture position (nan, 1, 0) is not finite"),
+  EXPECT_NE(message_of([] {
+              require_point("capture position", {kNaN, 1, 0});
+            }).find("capture position (nan, 1, 0) is not finite"),
             std::string::npos);
   EXPECT_NE(message_of([] { require_point("p", {0, kInf, 0}); }).find("not finite"), std::string::npos);
   EXPECT_NE(message_of([] { require_point("p", {1e30, 0, 0}); }).find("outside ±1e+06 m"), std::string::npos);
@@ -53,8 +55,10 @@ TEST(CoreCheck, BoxesNumbersAndAllocations) {
             std::string::npos);
   EXPECT_THROW(require_number("x", -1, 0, 3), Error);
   EXPECT_NO_THROW(require_allocation("a", 1000, 4, "hint"));
-  std::string m = message_of([] { require_allocation("a 16384² cube", 6.0 * 16384 * 16384 * 16, 12, "choose a smaller size", 8e9); });
-  EXPECT_NE(m.find("would allocate 309 GB (more than the 8 GB allowed); choose a smaller size"), std::string::npos) << m;
+  std::string m = message_of(
+      [] { require_allocation("a 16384² cube", 6.0 * 16384 * 16384 * 16, 12, "choose a smaller size", 8e9); });
+  EXPECT_NE(m.find("would allocate 309 GB (more than the 8 GB allowed); choose a smaller size"), std::string::npos)
+      << m;
   EXPECT_GT(physical_memory(), 1e8);
 }
 

@@ -11,7 +11,8 @@ constexpr EnumName<Fruit> kFruitNames[] = {
 
 TEST(EnumNames, NamesAliasesAndRoundTrip) {
   static_assert(name_of(kFruitNames, Fruit::Pear)[0] == 'p');  // usable at compile time
-  for (Fruit f : {Fruit::Apple, Fruit::Pear, Fruit::Plum}) EXPECT_EQ(parse_enum(kFruitNames, name_of(kFruitNames, f), "fruit"), f);
+  for (Fruit f : {Fruit::Apple, Fruit::Pear, Fruit::Plum})
+    EXPECT_EQ(parse_enum(kFruitNames, name_of(kFruitNames, f), "fruit"), f);
   EXPECT_STREQ(name_of(kFruitNames, Fruit::Apple), "apple");  // the first entry, not the alias
   EXPECT_EQ(find_enum(kFruitNames, "malus"), Fruit::Apple);
   EXPECT_EQ(find_enum(kFruitNames, "Apple"), std::nullopt);  // exact: callers fold case themselves

@@ -9,11 +9,11 @@
 namespace ibl {
 
 enum class ErrorKind {
-  Io,        // a file is missing, unreadable or unwritable
-  Format,    // a file parses but is not what it claims (corrupt, truncated, unknown format)
-  Value,     // a value is out of range: NaN/Inf/negative pixel, N = 0, wrong size
+  Io,           // a file is missing, unreadable or unwritable
+  Format,       // a file parses but is not what it claims (corrupt, truncated, unknown format)
+  Value,        // a value is out of range: NaN/Inf/negative pixel, N = 0, wrong size
   Unsupported,  // a valid request this build cannot serve (optional part not built)
-  Internal,  // a bug: an invariant failed
+  Internal,     // a bug: an invariant failed
 };
 
 class Error : public std::runtime_error {

@@ -8,12 +8,11 @@
 
 namespace ibl {
 
-Image::Image(int width, int height, int channels, float fill)
-    : width_(width), height_(height), channels_(channels) {
+Image::Image(int width, int height, int channels, float fill) : width_(width), height_(height), channels_(channels) {
   if (width < 0 || height < 0 || channels < 1 || channels > 64)
     fail(ErrorKind::Value, "image size {}x{}x{} is invalid", width, height, channels);
-  require_allocation(fmt::format("an image of {}x{} pixels, {} channels,", width, height, channels), double(width) * height * channels,
-                     sizeof(float), "choose a smaller image size");
+  require_allocation(fmt::format("an image of {}x{} pixels, {} channels,", width, height, channels),
+                     double(width) * height * channels, sizeof(float), "choose a smaller image size");
   data_.assign(static_cast<size_t>(width) * height * channels, fill);
 }
 
@@ -25,7 +24,9 @@ Vec3 Image::rgb(int x, int y) const {
 void Image::set_rgb(int x, int y, Vec3 v) {
   float* p = pixel(x, y);
   if (channels_ >= 3) {
-    p[0] = static_cast<float>(v.x); p[1] = static_cast<float>(v.y); p[2] = static_cast<float>(v.z);
+    p[0] = static_cast<float>(v.x);
+    p[1] = static_cast<float>(v.y);
+    p[2] = static_cast<float>(v.z);
   } else {
     p[0] = static_cast<float>(luminance(v));
   }
@@ -39,8 +40,7 @@ Image Image::crop(int x0, int y0, int w, int h) const {
   if (x0 < 0 || y0 < 0 || w < 0 || h < 0 || x0 + w > width_ || y0 + h > height_)
     fail(ErrorKind::Value, "crop {}x{}+{}+{} is outside the {}x{} image", w, h, x0, y0, width_, height_);
   Image out(w, h, channels_);
-  for (int y = 0; y < h; ++y)
-    std::copy_n(pixel(x0, y0 + y), static_cast<size_t>(w) * channels_, out.pixel(0, y));
+  for (int y = 0; y < h; ++y) std::copy_n(pixel(x0, y0 + y), static_cast<size_t>(w) * channels_, out.pixel(0, y));
   return out;
 }
 
@@ -50,9 +50,12 @@ Image Image::with_channels(int channels) const {
     const float* s = data_.data() + i * channels_;
     float* d = out.data() + i * channels;
     for (int c = 0; c < channels; ++c) {
-      if (channels_ == 1 && c < 3) d[c] = s[0];
-      else if (c < channels_) d[c] = s[c];
-      else d[c] = (c == 3) ? 1.0f : 0.0f;
+      if (channels_ == 1 && c < 3)
+        d[c] = s[0];
+      else if (c < channels_)
+        d[c] = s[c];
+      else
+        d[c] = (c == 3) ? 1.0f : 0.0f;
     }
   }
   return out;
@@ -93,7 +96,10 @@ void ImageView::bilinear(double px, double py, Wrap wrap, float* out) const {
     const float* p = pixel(x, y);
     for (int c = 0; c < channels_; ++c) out[c] += w * p[c];
   };
-  add(xa, ya, w00); add(xb, ya, w10); add(xa, yb, w01); add(xb, yb, w11);
+  add(xa, ya, w00);
+  add(xb, ya, w10);
+  add(xa, yb, w01);
+  add(xb, yb, w11);
 }
 
 Vec3 ImageView::sample_rgb_uv(double u, double v, Wrap wrap) const {

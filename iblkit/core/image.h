@@ -35,9 +35,7 @@ class Image {
   float* data() { return data_.data(); }
   const float* data() const { return data_.data(); }
   float* pixel(int x, int y) { return data_.data() + (static_cast<size_t>(y) * width_ + x) * channels_; }
-  const float* pixel(int x, int y) const {
-    return data_.data() + (static_cast<size_t>(y) * width_ + x) * channels_;
-  }
+  const float* pixel(int x, int y) const { return data_.data() + (static_cast<size_t>(y) * width_ + x) * channels_; }
   float& at(int x, int y, int c) { return pixel(x, y)[c]; }
   float at(int x, int y, int c) const { return pixel(x, y)[c]; }
   // RGB of a pixel (grey images repeat channel 0; extra channels ignored).
@@ -65,18 +63,14 @@ class ImageView {
   int height() const { return height_; }
   int channels() const { return channels_; }
   const float* pixel(int x, int y) const { return data_ + y * stride_ + static_cast<ptrdiff_t>(x) * channels_; }
-  ImageView sub(int x0, int y0, int w, int h) const {
-    return {pixel(x0, y0), w, h, channels_, stride_};
-  }
+  ImageView sub(int x0, int y0, int w, int h) const { return {pixel(x0, y0), w, h, channels_, stride_}; }
   Vec3 rgb(int x, int y) const;
 
   // Bilinear sample at continuous pixel coordinates (px, py) in [0,width) x [0,height), pixel centres
   // at half-integers. out receives `channels()` floats.
   void bilinear(double px, double py, Wrap wrap, float* out) const;
   // Bilinear sample at normalised coordinates (u,v) in [0,1]^2.
-  void sample_uv(double u, double v, Wrap wrap, float* out) const {
-    bilinear(u * width_, v * height_, wrap, out);
-  }
+  void sample_uv(double u, double v, Wrap wrap, float* out) const { bilinear(u * width_, v * height_, wrap, out); }
   Vec3 sample_rgb_uv(double u, double v, Wrap wrap) const;
 
  private:

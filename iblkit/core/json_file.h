@@ -42,17 +42,25 @@ inline std::string json_error_text(const nlohmann::json::exception& e) {
 namespace detail {
 template <typename T>
 constexpr const char* json_kind() {
-  if constexpr (std::is_same_v<T, bool>) return "true or false";
-  else if constexpr (std::is_same_v<T, std::string>) return "a string";
-  else if constexpr (std::is_integral_v<T>) return "a whole number";
-  else return "a number";
+  if constexpr (std::is_same_v<T, bool>)
+    return "true or false";
+  else if constexpr (std::is_same_v<T, std::string>)
+    return "a string";
+  else if constexpr (std::is_integral_v<T>)
+    return "a whole number";
+  else
+    return "a number";
 }
 template <typename T>
 bool json_is(const nlohmann::json& v) {
-  if constexpr (std::is_same_v<T, bool>) return v.is_boolean();
-  else if constexpr (std::is_same_v<T, std::string>) return v.is_string();
-  else if constexpr (std::is_integral_v<T>) return v.is_number_integer();
-  else return v.is_number();
+  if constexpr (std::is_same_v<T, bool>)
+    return v.is_boolean();
+  else if constexpr (std::is_same_v<T, std::string>)
+    return v.is_string();
+  else if constexpr (std::is_integral_v<T>)
+    return v.is_number_integer();
+  else
+    return v.is_number();
 }
 }  // namespace detail
 
@@ -64,7 +72,8 @@ T opt_field(const nlohmann::json& j, const std::string& where, const char* key, 
   if (!j.is_object()) fail(ErrorKind::Format, "{}: expected a JSON object, got {}", where, j.type_name());
   auto it = j.find(key);
   if (it == j.end()) return def;
-  if (!detail::json_is<T>(*it)) fail(ErrorKind::Format, "{}: field \"{}\" must be {}, got {}", where, key, detail::json_kind<T>(), it->dump());
+  if (!detail::json_is<T>(*it))
+    fail(ErrorKind::Format, "{}: field \"{}\" must be {}, got {}", where, key, detail::json_kind<T>(), it->dump());
   return it->template get<T>();
 }
 inline std::string opt_field(const nlohmann::json& j, const std::string& where, const char* key, const char* def) {

@@ -1,7 +1,7 @@
 // Parallel loops on oneTBB. Bodies must be safe to run concurrently on disjoint ranges.
 #pragma once
-#include <cstdint>
 #include <algorithm>
+#include <cstdint>
 #include <functional>
 #include <vector>
 

@@ -35,7 +35,8 @@ void load(const std::string& name) {
   std::string path = path_of(name);
   std::error_code ec;
   if (!fs::exists(path, ec))
-    fail(ErrorKind::Unsupported, "{}: plugin not found (it is built beside the iblkit executable; rebuild iblkit)", path);
+    fail(ErrorKind::Unsupported, "{}: plugin not found (it is built beside the iblkit executable; rebuild iblkit)",
+         path);
   // RTLD_NOW: a plugin that does not match this executable fails here, not half-way through a command.
   // The handle is kept for the process's life: its registrars filled slots that point into it.
   void* h = ::dlopen(path.c_str(), RTLD_NOW | RTLD_GLOBAL);

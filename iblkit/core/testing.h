@@ -20,7 +20,8 @@ void expect_error(F&& f, std::initializer_list<std::string> fragments, std::opti
     if (kind) {
       EXPECT_EQ(static_cast<int>(e.kind()), static_cast<int>(*kind)) << e.what();
     }
-    for (const auto& frag : fragments) EXPECT_NE(std::string(e.what()).find(frag), std::string::npos) << e.what() << " lacks " << frag;
+    for (const auto& frag : fragments)
+      EXPECT_NE(std::string(e.what()).find(frag), std::string::npos) << e.what() << " lacks " << frag;
   }
 }
 template <typename F>

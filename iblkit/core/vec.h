@@ -31,15 +31,28 @@ struct Vec3 {
   constexpr Vec3 operator*(double s) const { return {x * s, y * s, z * s}; }
   constexpr Vec3 operator/(double s) const { return {x / s, y / s, z / s}; }
   constexpr Vec3 operator*(Vec3 o) const { return {x * o.x, y * o.y, z * o.z}; }
-  Vec3& operator+=(Vec3 o) { x += o.x; y += o.y; z += o.z; return *this; }
-  Vec3& operator-=(Vec3 o) { x -= o.x; y -= o.y; z -= o.z; return *this; }
-  Vec3& operator*=(double s) { x *= s; y *= s; z *= s; return *this; }
+  Vec3& operator+=(Vec3 o) {
+    x += o.x;
+    y += o.y;
+    z += o.z;
+    return *this;
+  }
+  Vec3& operator-=(Vec3 o) {
+    x -= o.x;
+    y -= o.y;
+    z -= o.z;
+    return *this;
+  }
+  Vec3& operator*=(double s) {
+    x *= s;
+    y *= s;
+    z *= s;
+    return *this;
+  }
 };
 constexpr Vec3 operator*(double s, Vec3 v) { return v * s; }
 constexpr double dot(Vec3 a, Vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-constexpr Vec3 cross(Vec3 a, Vec3 b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
+constexpr Vec3 cross(Vec3 a, Vec3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
 inline double length(Vec3 a) { return std::sqrt(dot(a, a)); }
 inline Vec3 normalize(Vec3 a) {
   double l = length(a);
@@ -58,7 +71,11 @@ struct Mat3 {
   static Mat3 identity() { return {}; }
   static Mat3 rows(Vec3 a, Vec3 b, Vec3 c) {
     Mat3 r;
-    for (int j = 0; j < 3; ++j) { r.m[0][j] = a[j]; r.m[1][j] = b[j]; r.m[2][j] = c[j]; }
+    for (int j = 0; j < 3; ++j) {
+      r.m[0][j] = a[j];
+      r.m[1][j] = b[j];
+      r.m[2][j] = c[j];
+    }
     return r;
   }
   // Rotation by `angle` radians about unit `axis` (right-hand rule).
@@ -66,9 +83,15 @@ struct Mat3 {
     Vec3 a = normalize(axis);
     double c = std::cos(angle), s = std::sin(angle), t = 1 - c;
     Mat3 r;
-    r.m[0][0] = t * a.x * a.x + c;       r.m[0][1] = t * a.x * a.y - s * a.z; r.m[0][2] = t * a.x * a.z + s * a.y;
-    r.m[1][0] = t * a.x * a.y + s * a.z; r.m[1][1] = t * a.y * a.y + c;       r.m[1][2] = t * a.y * a.z - s * a.x;
-    r.m[2][0] = t * a.x * a.z - s * a.y; r.m[2][1] = t * a.y * a.z + s * a.x; r.m[2][2] = t * a.z * a.z + c;
+    r.m[0][0] = t * a.x * a.x + c;
+    r.m[0][1] = t * a.x * a.y - s * a.z;
+    r.m[0][2] = t * a.x * a.z + s * a.y;
+    r.m[1][0] = t * a.x * a.y + s * a.z;
+    r.m[1][1] = t * a.y * a.y + c;
+    r.m[1][2] = t * a.y * a.z - s * a.x;
+    r.m[2][0] = t * a.x * a.z - s * a.y;
+    r.m[2][1] = t * a.y * a.z + s * a.x;
+    r.m[2][2] = t * a.z * a.z + c;
     return r;
   }
   Vec3 operator*(Vec3 v) const {

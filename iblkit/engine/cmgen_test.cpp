@@ -80,7 +80,7 @@ std::vector<Vec3> parse_sh(const std::string& text) {
   return out;
 }
 
-#define REQUIRE_PEER()                                                     \
+#define REQUIRE_PEER()                                                   \
   if (!have_cmgen()) GTEST_SKIP() << "cmgen (libfilament-tools) absent"; \
   if (!fs::exists(kWorld + "forest.exr")) GTEST_SKIP() << "blender-data probes absent"
 
@@ -91,10 +91,11 @@ std::vector<Vec3> parse_sh(const std::string& text) {
 // nearest-pixel lookups (CubemapUtils::equirectangularToCubemap: x = (atan2(x, z)/π + 1)/2 · (W − 1),
 // truncated), which moves probes with small bright sources by up to a few per cent of L00;
 // iblkit integrates the lat-long exactly. Measured: bench/RESULTS.md.
-constexpr double kShCubeTol = 0.01;     // the 1 %
-constexpr double kShLatLongTol = 0.15;  // a frame check only: cmgen's nearest-pixel equirect → cube conversion moves
-                                        // its SH by up to 9.7 % (interior.exr, 2026-12-01); a wrong frame misses by ≫ 50 %.
-                                        // The layouts' equality is the cube-input case (kShCubeTol; measured 1e-5).
+constexpr double kShCubeTol = 0.01;  // the 1 %
+constexpr double kShLatLongTol =
+    0.15;  // a frame check only: cmgen's nearest-pixel equirect → cube conversion moves
+           // its SH by up to 9.7 % (interior.exr, 2026-12-01); a wrong frame misses by ≫ 50 %.
+           // The layouts' equality is the cube-input case (kShCubeTol; measured 1e-5).
 TEST(Cmgen, ShMatchesFilamentLayout) {
   REQUIRE_PEER();
   const fs::path dir = scratch("sh");
@@ -108,7 +109,8 @@ TEST(Cmgen, ShMatchesFilamentLayout) {
       double worst = 0;
       for (int i = 0; i < 9; ++i)
         for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(ours.c[i][c] - peer[i][c]) / std::abs(peer[0][c]));
-      std::printf("cmgen --sh=3 --sh-shader %-9s %-8s: max |Δ| / L00 = %.5f\n", name, face ? "cross" : "latlong", worst);
+      std::printf("cmgen --sh=3 --sh-shader %-9s %-8s: max |Δ| / L00 = %.5f\n", name, face ? "cross" : "latlong",
+                  worst);
       EXPECT_LT(worst, face ? kShCubeTol : kShLatLongTol) << probe;
     }
   fs::remove_all(dir);
@@ -139,7 +141,8 @@ Faces our_faces(const CubeChain& c, int m) {
   out.size = c.size(m);
   for (int f = 0; f < 6; ++f)
     for (int y = 0; y < out.size; ++y)
-      for (int x = 0; x < out.size; ++x) out.lum.push_back(luminance(c.levels[static_cast<size_t>(m)].rgb(f * out.size + x, y)));
+      for (int x = 0; x < out.size; ++x)
+        out.lum.push_back(luminance(c.levels[static_cast<size_t>(m)].rgb(f * out.size + x, y)));
   return out;
 }
 
@@ -186,8 +189,8 @@ class CmgenModel {
       for (int f = 0; f < 6; ++f)
         for (int y = 0; y < next.size; ++y)
           for (int x = 0; x < next.size; ++x)
-            next.lum.push_back(0.25 * (cur.at(f, 2 * x, 2 * y) + cur.at(f, 2 * x + 1, 2 * y) + cur.at(f, 2 * x, 2 * y + 1) +
-                                       cur.at(f, 2 * x + 1, 2 * y + 1)));
+            next.lum.push_back(0.25 * (cur.at(f, 2 * x, 2 * y) + cur.at(f, 2 * x + 1, 2 * y) +
+                                       cur.at(f, 2 * x, 2 * y + 1) + cur.at(f, 2 * x + 1, 2 * y + 1)));
       cur = std::move(next);
     }
   }
@@ -251,7 +254,8 @@ class CmgenModel {
         for (int x = -1; x <= n; ++x) {
           double s = 2.0 * (x + 0.5) / n - 1, t = 2.0 * (y + 0.5) / n - 1;
           const int g = sphere::cube_face_of(sphere::cube_face_point(f, s, t), &s, &t);
-          const int ix = std::min(n - 1, static_cast<int>((s + 1) * 0.5 * n)), iy = std::min(n - 1, static_cast<int>((t + 1) * 0.5 * n));
+          const int ix = std::min(n - 1, static_cast<int>((s + 1) * 0.5 * n)),
+                    iy = std::min(n - 1, static_cast<int>((t + 1) * 0.5 * n));
           lv.t[(static_cast<size_t>(f) * (n + 2) + y + 1) * (n + 2) + x + 1] = a.at(g, ix, iy);
         }
     levels_.push_back(std::move(lv));
@@ -264,8 +268,8 @@ class CmgenModel {
     const double x = std::min((s + 1) * 0.5 * lv.n, top) - offset, y = std::min((t + 1) * 0.5 * lv.n, top) - offset;
     const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
     const double u = x - x0, v = y - y0;
-    return (1 - u) * (1 - v) * lv.at(f, x0, y0) + u * (1 - v) * lv.at(f, x0 + 1, y0) + (1 - u) * v * lv.at(f, x0, y0 + 1) +
-           u * v * lv.at(f, x0 + 1, y0 + 1);
+    return (1 - u) * (1 - v) * lv.at(f, x0, y0) + u * (1 - v) * lv.at(f, x0 + 1, y0) +
+           (1 - u) * v * lv.at(f, x0, y0 + 1) + u * v * lv.at(f, x0 + 1, y0 + 1);
   }
 
   std::vector<Level> levels_;
@@ -285,7 +289,8 @@ std::string spot_probe(const fs::path& dir) {
       im.set_rgb(x, y, {v, v, v});
     }
   const std::string path = (dir / "spot_cross.exr").string();
-  io::write_image(path, sphere::resample(sphere::EnvMap(std::move(im), ll), sphere::Mapping(sphere::MappingKind::CubeHCross, 256, 192)));
+  io::write_image(path, sphere::resample(sphere::EnvMap(std::move(im), ll),
+                                         sphere::Mapping(sphere::MappingKind::CubeHCross, 256, 192)));
   return path;
 }
 
@@ -309,12 +314,12 @@ constexpr double kLatLongLevel0Tol = 0.16;  // cmgen's nearest-pixel equirect �
                                             // resampling of a 1024×512 lat-long to 64² faces (measured 0.141)
 constexpr double kModelPeerTol = 0.02;      // the model (offset 0) against cmgen: FIS noise, cmgen's random turn of its
                                             // sample set per texel, float rounding (measured ≤ 0.013)
-constexpr double kModelOursTol = 0.07;      // the model (offset ½) against iblkit: FIS against iblkit's exact sums, which
-                                            // read the 8² level at ρ = 1 (measured ≤ 0.054, the spot's level 2)
+constexpr double kModelOursTol = 0.07;  // the model (offset ½) against iblkit: FIS against iblkit's exact sums, which
+                                        // read the 8² level at ρ = 1 (measured ≤ 0.054, the spot's level 2)
 constexpr double kOffsetTol[3] = {0.08, 0.16, 0.25};  // iblkit against cmgen on ρ > 0, forest cross / lat-long / spot:
-                                            // cmgen's half-texel offset (measured ≤ 0.064 / 0.143 / 0.221)
-constexpr double kPowerTol = 0.01;          // iblkit's ∫L̄ dω of every level against level 0's (measured ≤ 0.003)
-constexpr double kBruteTol = 0.03;          // iblkit against (1) by brute force, 54 texels (measured ≤ 0.024)
+                                                      // cmgen's half-texel offset (measured ≤ 0.064 / 0.143 / 0.221)
+constexpr double kPowerTol = 0.01;  // iblkit's ∫L̄ dω of every level against level 0's (measured ≤ 0.003)
+constexpr double kBruteTol = 0.03;  // iblkit against (1) by brute force, 54 texels (measured ≤ 0.024)
 TEST(Cmgen, SpecularMatchesIblLd) {
   REQUIRE_PEER();
   const fs::path dir = scratch("ld");
@@ -346,10 +351,11 @@ TEST(Cmgen, SpecularMatchesIblLd) {
       const double diff = difference(mine, peer), shifted = difference(model.level(alpha, n, samples, 0.0), peer),
                    centred = difference(model.level(alpha, n, samples, 0.5), mine);
       const double p_ours = power(mine) / power(ours0), p_peer = power(peer) / power(peer0);
-      std::printf("cmgen --ibl-ld %-14s level %d (ρ %.3f, %s): iblkit vs cmgen %.4f | model offset 0 vs cmgen %.4f, "
-                  "offset ½ vs iblkit %.4f | ∫L̄dω / level 0: iblkit %.4f, cmgen %.4f\n",
-                  names[p], m, ours.info[m].roughness, level_method_name(ours.info[m].method).c_str(), diff, shifted, centred,
-                  p_ours, p_peer);
+      std::printf(
+          "cmgen --ibl-ld %-14s level %d (ρ %.3f, %s): iblkit vs cmgen %.4f | model offset 0 vs cmgen %.4f, "
+          "offset ½ vs iblkit %.4f | ∫L̄dω / level 0: iblkit %.4f, cmgen %.4f\n",
+          names[p], m, ours.info[m].roughness, level_method_name(ours.info[m].method).c_str(), diff, shifted, centred,
+          p_ours, p_peer);
       EXPECT_LT(diff, kOffsetTol[p]) << probe << " level " << m;
       EXPECT_LT(shifted, kModelPeerTol) << probe << " level " << m;
       EXPECT_LT(shifted, diff / 3) << probe << " level " << m;  // the offset is what makes most of the difference
@@ -369,7 +375,8 @@ TEST(Cmgen, SpecularMatchesIblLd) {
           }
       e_ours = std::sqrt(e_ours / e_ref);
       e_peer = std::sqrt(e_peer / e_ref);
-      std::printf("cmgen --ibl-ld %-14s level %d against brute force at 54 texels: iblkit %.4f, cmgen %.4f\n", names[p], m, e_ours, e_peer);
+      std::printf("cmgen --ibl-ld %-14s level %d against brute force at 54 texels: iblkit %.4f, cmgen %.4f\n", names[p],
+                  m, e_ours, e_peer);
       EXPECT_LT(e_ours, kBruteTol) << probe << " level " << m;
       EXPECT_LT(e_ours, e_peer) << probe << " level " << m;
     }

@@ -34,7 +34,8 @@ Vec3 face_bilinear(const Image& strip, int f, double s, double t) {
   const int xa = std::clamp(x0, 0, n - 1) + f * n, xb = std::clamp(x0 + 1, 0, n - 1) + f * n;
   const int ya = std::clamp(y0, 0, n - 1), yb = std::clamp(y0 + 1, 0, n - 1);
   const float w00 = (1 - tx) * (1 - ty), w10 = tx * (1 - ty), w01 = (1 - tx) * ty, w11 = tx * ty;
-  const float *p00 = strip.pixel(xa, ya), *p10 = strip.pixel(xb, ya), *p01 = strip.pixel(xa, yb), *p11 = strip.pixel(xb, yb);
+  const float *p00 = strip.pixel(xa, ya), *p10 = strip.pixel(xb, ya), *p01 = strip.pixel(xa, yb),
+              *p11 = strip.pixel(xb, yb);
   float c[3];
   for (int k = 0; k < 3; ++k) c[k] = w00 * p00[k] + w10 * p10[k] + w01 * p01[k] + w11 * p11[k];
   return {c[0], c[1], c[2]};
@@ -87,7 +88,9 @@ CubeChain build_cube_chain(const sphere::EnvMap& probe, int size, const Mat3& ro
   rd.rotation = rotation;
   CubeChain chain;
   Image base = texel_copy(probe, size, rotation);
-  if (base.empty()) base = sphere::resample(probe, sphere::Mapping(sphere::MappingKind::CubeStrip, 6 * size, size), rd).with_channels(3);
+  if (base.empty())
+    base =
+        sphere::resample(probe, sphere::Mapping(sphere::MappingKind::CubeStrip, 6 * size, size), rd).with_channels(3);
   chain.levels.push_back(std::move(base));
   while (chain.size(chain.count() - 1) > 1 && (levels <= 0 || chain.count() < levels)) {
     const Image& fine = chain.levels.back();

@@ -35,7 +35,8 @@ std::vector<double> cube_face_solid_angles(int size);
 // its texels moved as they are — then halved down to 1×1 by
 // solid-angle-weighted 2×2 averages (each level keeps ∫L dω of the one above).
 // `levels` 0 keeps the whole chain; otherwise the first `levels` levels.
-CubeChain build_cube_chain(const sphere::EnvMap& probe, int size, const Mat3& rotation = Mat3::identity(), int levels = 0);
+CubeChain build_cube_chain(const sphere::EnvMap& probe, int size, const Mat3& rotation = Mat3::identity(),
+                           int levels = 0);
 
 // Exact convolution of a cube level with a rotationally symmetric kernel k(c) ≥ 0 of c = r·l
 // (zero for c ≤ 0):

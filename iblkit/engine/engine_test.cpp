@@ -106,9 +106,9 @@ TEST(Ktx2, CubeMapBytesFollowTheSpecification) {
   EXPECT_EQ(dfd_at, 80u + 3 * 24);  // right after the level index
   EXPECT_EQ(dfd_len, 92u);          // 4 + 24 + 4 samples × 16
   EXPECT_EQ(u32(s, dfd_at), 92u);
-  EXPECT_EQ(u32(s, dfd_at + 8) >> 16, 88u);  // descriptorBlockSize
+  EXPECT_EQ(u32(s, dfd_at + 8) >> 16, 88u);              // descriptorBlockSize
   EXPECT_EQ(u32(s, dfd_at + 12) & 0xFFFFFF, 0x010101u);  // RGBSDA, BT709, linear
-  EXPECT_EQ(u32(s, dfd_at + 20), 8u);                   // bytesPlane0
+  EXPECT_EQ(u32(s, dfd_at + 20), 8u);                    // bytesPlane0
   EXPECT_EQ(u32(s, dfd_at + 28 + 3 * 16) >> 24, 0xCFu);  // alpha: channel 15, signed float
   // Levels: the smallest first, each at a multiple of 8, lengths 6·S²·8 bytes.
   uint64_t prev_end = 0, off[3];
@@ -124,7 +124,8 @@ TEST(Ktx2, CubeMapBytesFollowTheSpecification) {
   EXPECT_EQ(prev_end, s.size());
   // Face 3 (−Y) of level 1 starts 3 faces into the level: its first value is 10 + 3 = 13.
   const size_t at = off[1] + 3 * 2 * 2 * 8;
-  EXPECT_EQ(from_half(uint16_t(static_cast<unsigned char>(s[at]) | (static_cast<unsigned char>(s[at + 1]) << 8))), 13.0f);
+  EXPECT_EQ(from_half(uint16_t(static_cast<unsigned char>(s[at]) | (static_cast<unsigned char>(s[at + 1]) << 8))),
+            13.0f);
   EXPECT_NE(s.find("KTXwriter"), std::string::npos);
   EXPECT_EQ(s.find("KTXorientation"), std::string::npos);  // cube faces have their fixed orientation
 }
@@ -199,7 +200,8 @@ TEST(Specular, MatchesBruteForceConvolution) {
         const double err = std::abs(luminance(got) - luminance(ref)) / luminance(ref);
         std::printf("GGX level %d α %.4f %-10s r (%+.2f %+.2f %+.2f): rel. error %.4f\n", m, lv.alpha,
                     level_method_name(lv.method).c_str(), r.x, r.y, r.z, err);
-        EXPECT_LT(err, lv.method == LevelMethod::Exact ? kExactTol : kFisTol) << "level " << m << " α " << lv.alpha << " r " << r.x << "," << r.y << "," << r.z;
+        EXPECT_LT(err, lv.method == LevelMethod::Exact ? kExactTol : kFisTol)
+            << "level " << m << " α " << lv.alpha << " r " << r.x << "," << r.y << "," << r.z;
       }
     }
   }
@@ -252,7 +254,8 @@ TEST(Dfg, ClosedFormLimitsAndConvergence) {
 
 // E/π of a constant environment is that constant; of a real probe it matches the SH irradiance
 // (9 bands: the cosine kernel's Â_l beyond l = 8 is < 0.2 % of Â_0).
-constexpr double kIrradianceTol = 0.015;  // of the mean: SH truncation at 9 bands plus the 32² source cube (measured 1.2 %)
+constexpr double kIrradianceTol =
+    0.015;  // of the mean: SH truncation at 9 bands plus the 32² source cube (measured 1.2 %)
 TEST(Diffuse, IrradianceCubeMatchesShIrradiance) {
   sphere::EnvMap flat(Image(64, 32, 3, 1.5f), sphere::Mapping(sphere::MappingKind::LatLong, 64, 32));
   Image f = irradiance_cube(flat, 8);

@@ -35,7 +35,9 @@ void make_dir(const std::string& dir) {
 
 std::string engine_frame_name(EngineFrame f) { return name_of(kFrameNames, f); }
 EngineFrame parse_engine_frame(const std::string& name) { return parse_enum(kFrameNames, name, "engine frame"); }
-Mat3 frame_rotation(EngineFrame f, sphere::MappingKind k) { return f == EngineFrame::Filament ? sh::filament_frame(k) : Mat3::identity(); }
+Mat3 frame_rotation(EngineFrame f, sphere::MappingKind k) {
+  return f == EngineFrame::Filament ? sh::filament_frame(k) : Mat3::identity();
+}
 
 Image cube_face(const CubeChain& cube, int level, int face) {
   const int s = cube.size(level);
@@ -82,7 +84,8 @@ void write_cube(const std::string& path, const Image& strip) {
   one.levels.push_back(strip);
   if (lower_ext(path) == ".ktx2") return write_ktx2(path, cube_ktx2(one));
   make_dir(path);
-  for (int f = 0; f < 6; ++f) io::write_image((fs::path(path) / fmt::format("{}.exr", kFaceNames[f])).string(), cube_face(one, 0, f));
+  for (int f = 0; f < 6; ++f)
+    io::write_image((fs::path(path) / fmt::format("{}.exr", kFaceNames[f])).string(), cube_face(one, 0, f));
 }
 
 void write_dfg(const std::string& path, const Image& table) {

@@ -45,7 +45,8 @@ std::vector<Sample> fis_samples(double alpha, int count, int base_size, int chai
   for (int i = 0; i < count; ++i) {
     const double u1 = (i + 0.5) / count, u2 = radical_inverse(static_cast<uint32_t>(i));
     const double phi = kTwoPi * u1;
-    const double cos2 = (1 - u2) / (1 + (a2 - 1) * u2), cos_h = std::sqrt(cos2), sin_h = std::sqrt(std::max(0.0, 1 - cos2));
+    const double cos2 = (1 - u2) / (1 + (a2 - 1) * u2), cos_h = std::sqrt(cos2),
+                 sin_h = std::sqrt(std::max(0.0, 1 - cos2));
     const Vec3 h{sin_h * std::cos(phi), sin_h * std::sin(phi), cos_h};
     const double nl = 2 * cos2 - 1;
     if (nl <= 0) continue;
@@ -131,7 +132,8 @@ SpecularCube prefilter_ggx(const sphere::EnvMap& probe, const SpecularDesc& desc
         lv.source_size = src;
         const Image& source = chain.levels[static_cast<size_t>(log2i(desc.size / src))];
         const double a = lv.alpha;
-        out.cube.levels.push_back(convolve_cube(source, s, [a](double c) { return ggx_kernel(c, a); }, sub));
+        out.cube.levels.push_back(convolve_cube(
+            source, s, [a](double c) { return ggx_kernel(c, a); }, sub));
       } else {
         lv.method = LevelMethod::Importance;
         lv.source_size = desc.size;

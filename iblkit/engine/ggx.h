@@ -45,28 +45,28 @@ LodMapping parse_lod_mapping(const std::string& name);  // "linear", "filament";
 double level_roughness(int m, int n, LodMapping mapping);
 
 struct SpecularDesc {
-  int size = 256;                           // face size of level 0 (a power of two, 8..4096)
-  int levels = 0;                           // mip levels N; 0: log2(size) − 3 (cmgen's count: down to 16²)
-  LodMapping lod = LodMapping::Linear;      // level → roughness rule above
-  int samples = 1024;                       // importance samples per texel on FIS levels (16..65536)
-  double exact_budget = 1.5e8;              // largest output × source texel count summed exactly
-  Mat3 rotation = Mat3::identity();         // the environment is turned by this first (engine frames)
+  int size = 256;                       // face size of level 0 (a power of two, 8..4096)
+  int levels = 0;                       // mip levels N; 0: log2(size) − 3 (cmgen's count: down to 16²)
+  LodMapping lod = LodMapping::Linear;  // level → roughness rule above
+  int samples = 1024;                   // importance samples per texel on FIS levels (16..65536)
+  double exact_budget = 1.5e8;          // largest output × source texel count summed exactly
+  Mat3 rotation = Mat3::identity();     // the environment is turned by this first (engine frames)
 };
 
 enum class LevelMethod { Resample, Exact, Importance };
 std::string level_method_name(LevelMethod m);
 
 struct SpecularLevel {
-  double roughness = 0;      // perceptual
-  double alpha = 0;          // roughness²
+  double roughness = 0;  // perceptual
+  double alpha = 0;      // roughness²
   LevelMethod method = LevelMethod::Resample;
-  int source_size = 0;       // face size of the chain level read (exact) or of the chain's base (FIS)
-  double seconds = 0;        // time this level took
+  int source_size = 0;  // face size of the chain level read (exact) or of the chain's base (FIS)
+  double seconds = 0;   // time this level took
 };
 
 struct SpecularCube {
-  CubeChain cube;                    // level m: face size max(1, size >> m)
-  std::vector<SpecularLevel> info;   // one per level
+  CubeChain cube;                   // level m: face size max(1, size >> m)
+  std::vector<SpecularLevel> info;  // one per level
 };
 
 // The number of levels `levels` 0 stands for, and the checks of the desc (throws ibl::Error).
@@ -82,6 +82,7 @@ inline double ggx_kernel(double c, double alpha) {
 
 // (1) by brute force over the probe's own pixels (exact solid angles, `sub`² sub-pixel directions
 // each), for direction r of the rotated frame: for tests and the accuracy table, not for maps.
-Vec3 ggx_reference(const sphere::EnvMap& probe, Vec3 r, double alpha, const Mat3& rotation = Mat3::identity(), int sub = 2);
+Vec3 ggx_reference(const sphere::EnvMap& probe, Vec3 r, double alpha, const Mat3& rotation = Mat3::identity(),
+                   int sub = 2);
 
 }  // namespace ibl::engine

@@ -23,8 +23,7 @@ constexpr const char* kFaceNames[6] = {"px", "nx", "py", "ny", "pz", "nz"};
 Image flip_rows(const Image& img) {
   Image out(img.width(), img.height(), img.channels());
   const size_t row = static_cast<size_t>(img.width()) * img.channels();
-  for (int y = 0; y < img.height(); ++y)
-    std::copy_n(img.pixel(0, img.height() - 1 - y), row, out.pixel(0, y));
+  for (int y = 0; y < img.height(); ++y) std::copy_n(img.pixel(0, img.height() - 1 - y), row, out.pixel(0, y));
   return out;
 }
 
@@ -32,8 +31,10 @@ Image flip_rows(const Image& img) {
 std::string uri_of(const std::string& name) {
   std::string u;
   for (unsigned char c : name) {
-    if (std::isalnum(c) || c == '-' || c == '.' || c == '_' || c == '~') u += static_cast<char>(c);
-    else u += fmt::format("%{:02X}", c);
+    if (std::isalnum(c) || c == '-' || c == '.' || c == '_' || c == '~')
+      u += static_cast<char>(c);
+    else
+      u += fmt::format("%{:02X}", c);
   }
   return u;
 }
@@ -60,10 +61,12 @@ CubeChain read_cube_faces(const std::string& pattern) {
     if (present < 6) {
       for (int f = 0; f < 6; ++f)
         if (!fs::exists(face_path(pattern, level, f)))
-          fail(ErrorKind::Io, "{}: level {} has {} of its six faces ({} is missing)", pattern, level, present, face_path(pattern, level, f));
+          fail(ErrorKind::Io, "{}: level {} has {} of its six faces ({} is missing)", pattern, level, present,
+               face_path(pattern, level, f));
     }
     const int want = level == 0 ? 0 : std::max(1, chain.size(0) >> level);
-    if (level > 0 && chain.size(level - 1) == 1) fail(ErrorKind::Value, "{}: level {} follows a 1×1 level", pattern, level);
+    if (level > 0 && chain.size(level - 1) == 1)
+      fail(ErrorKind::Value, "{}: level {} follows a 1×1 level", pattern, level);
     Image strip;
     for (int f = 0; f < 6; ++f) {
       const std::string p = face_path(pattern, level, f);
@@ -72,18 +75,23 @@ CubeChain read_cube_faces(const std::string& pattern) {
       Image face = io::read_image(p, rd);
       if (face.channels() < 3) face = face.with_channels(3);
       const int s = face.width();
-      if (face.height() != s) fail(ErrorKind::Value, "{}: a cube face must be square (got {}×{})", p, face.width(), face.height());
-      if (level == 0 && f == 0 && (s & (s - 1)) != 0) fail(ErrorKind::Value, "{}: face size {} is not a power of two", p, s);
+      if (face.height() != s)
+        fail(ErrorKind::Value, "{}: a cube face must be square (got {}×{})", p, face.width(), face.height());
+      if (level == 0 && f == 0 && (s & (s - 1)) != 0)
+        fail(ErrorKind::Value, "{}: face size {} is not a power of two", p, s);
       if (f == 0 && level > 0 && s != want)
-        fail(ErrorKind::Value, "{}: level {} must be {}×{} (level 0 is {}×{}), got {}×{}", p, level, want, want, chain.size(0), chain.size(0), s, s);
+        fail(ErrorKind::Value, "{}: level {} must be {}×{} (level 0 is {}×{}), got {}×{}", p, level, want, want,
+             chain.size(0), chain.size(0), s, s);
       if (f == 0) strip = Image(6 * s, s, 3);
-      if (s != strip.height()) fail(ErrorKind::Value, "{}: {}×{}, but the level's +X face is {}×{}", p, s, s, strip.height(), strip.height());
+      if (s != strip.height())
+        fail(ErrorKind::Value, "{}: {}×{}, but the level's +X face is {}×{}", p, s, s, strip.height(), strip.height());
       for (int y = 0; y < s; ++y)
         for (int x = 0; x < s; ++x) strip.set_rgb(f * s + x, y, face.rgb(x, y));
     }
     chain.levels.push_back(std::move(strip));
   }
-  if (chain.levels.empty()) fail(ErrorKind::Io, "{}: no level 0 with all six faces ({} missing)", pattern, face_path(pattern, 0, 0));
+  if (chain.levels.empty())
+    fail(ErrorKind::Io, "{}: no level 0 with all six faces ({} missing)", pattern, face_path(pattern, 0, 0));
   return chain;
 }
 
@@ -92,7 +100,8 @@ std::string gltf_specular_image_name(const std::string& gltf_path, int level, in
   return (p.parent_path() / fmt::format("{}_m{}_{}.png", p.stem().string(), level, kFaceNames[face])).string();
 }
 
-std::vector<std::string> write_gltf_ibl(const std::string& gltf_path, const sh::Coeffs& radiance, const CubeChain& specular) {
+std::vector<std::string> write_gltf_ibl(const std::string& gltf_path, const sh::Coeffs& radiance,
+                                        const CubeChain& specular) {
   if (specular.count() < 1) fail(ErrorKind::Value, "{}: the specular cube has no levels", gltf_path);
   sh::GltfSpecular spec;
   spec.size = specular.size(0);

@@ -33,6 +33,7 @@ std::string gltf_specular_image_name(const std::string& gltf_path, int level, in
 // Writes the glTF document to `gltf_path` and its specular images beside it (each atomically; a
 // command's OutputTransaction removes them all when it fails). Returns the paths written, images
 // first, the document last.
-std::vector<std::string> write_gltf_ibl(const std::string& gltf_path, const sh::Coeffs& radiance, const CubeChain& specular);
+std::vector<std::string> write_gltf_ibl(const std::string& gltf_path, const sh::Coeffs& radiance,
+                                        const CubeChain& specular);
 
 }  // namespace ibl::engine

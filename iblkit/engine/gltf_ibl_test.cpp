@@ -60,7 +60,8 @@ Png read_png(const std::string& path) {
   p.channels = in->spec().nchannels;
   p.uint8 = in->spec().format == OIIO::TypeDesc::UINT8;
   p.bytes.resize(static_cast<size_t>(p.width) * p.height * p.channels);
-  if (!in->read_image(0, 0, 0, p.channels, OIIO::TypeDesc::UINT8, p.bytes.data())) throw std::runtime_error(in->geterror());
+  if (!in->read_image(0, 0, 0, p.channels, OIIO::TypeDesc::UINT8, p.bytes.data()))
+    throw std::runtime_error(in->geterror());
   return p;
 }
 
@@ -135,7 +136,7 @@ TEST(GltfIbl, FacesAreRgbdPngsFlippedUpsideDown) {
         EXPECT_EQ(p.at(1, s - 1)[3], 1);
         EXPECT_EQ(p.at(1, s - 1)[0], 255);
         EXPECT_DOUBLE_EQ(babylon_from_rgbd(p.at(1, s - 1)).x, 255.0);
-        EXPECT_LT(babylon_from_rgbd(p.at(1, 0)).x, 1.0);  // the top row is the face's dim bottom row
+        EXPECT_LT(babylon_from_rgbd(p.at(1, 0)).x, 1.0);           // the top row is the face's dim bottom row
         EXPECT_LT(babylon_from_rgbd(p.at(s - 2, s - 1)).x, 10.0);  // not mirrored left–right
       }
     }
@@ -208,7 +209,8 @@ TEST(GltfIbl, BadFaceSetsAreRefused) {
   EXPECT_THROW(read_cube_faces(pattern), Error);
   io::write_image((d / "f" / "m1_ny.exr").string(), Image(2, 2, 3, 1.0f));  // not the level's size
   EXPECT_THROW(read_cube_faces(pattern), Error);
-  for (int f = 0; f < 6; ++f) io::write_image((d / "f" / fmt::format("m0_{}.exr", kFaces[f])).string(), Image(6, 6, 3, 1.0f));
+  for (int f = 0; f < 6; ++f)
+    io::write_image((d / "f" / fmt::format("m0_{}.exr", kFaces[f])).string(), Image(6, 6, 3, 1.0f));
   EXPECT_THROW(read_cube_faces(pattern), Error);  // level 0 not a power of two
   EXPECT_THROW(read_cube_faces((d / "none" / "m{level}_{face}.exr").string()), Error);
   fs::remove_all(d);

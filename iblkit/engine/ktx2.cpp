@@ -23,7 +23,8 @@ constexpr size_t kHeaderBytes = 12 + 68;  // identifier, header and index up to 
 int channels_of(int vk_format) {
   if (vk_format == kVkFormatRgba16f) return 4;
   if (vk_format == kVkFormatRg16f) return 2;
-  fail(ErrorKind::Value, "KTX2: vkFormat {} is not one iblkit writes (97 R16G16B16A16_SFLOAT, 83 R16G16_SFLOAT)", vk_format);
+  fail(ErrorKind::Value, "KTX2: vkFormat {} is not one iblkit writes (97 R16G16B16A16_SFLOAT, 83 R16G16_SFLOAT)",
+       vk_format);
 }
 
 void put32(std::string& s, uint32_t v) {
@@ -43,20 +44,20 @@ void pad_to(std::string& s, size_t align) {
 std::string data_format_descriptor(int nc) {
   std::string d;
   const uint32_t block = 24 + 16 * nc;
-  put32(d, 4 + block);                 // dfdTotalSize
-  put32(d, 0);                         // vendorId 0 (Khronos), descriptorType 0 (basic)
-  put32(d, 2u | (block << 16));        // versionNumber 2 (KDF 1.3), descriptorBlockSize
-  put32(d, 1u | (1u << 8) | (1u << 16));  // colorModel RGBSDA, primaries BT709, transfer LINEAR, flags 0
-  put32(d, 0);                         // texelBlockDimension 1×1×1×1 (stored minus one)
+  put32(d, 4 + block);                      // dfdTotalSize
+  put32(d, 0);                              // vendorId 0 (Khronos), descriptorType 0 (basic)
+  put32(d, 2u | (block << 16));             // versionNumber 2 (KDF 1.3), descriptorBlockSize
+  put32(d, 1u | (1u << 8) | (1u << 16));    // colorModel RGBSDA, primaries BT709, transfer LINEAR, flags 0
+  put32(d, 0);                              // texelBlockDimension 1×1×1×1 (stored minus one)
   put32(d, static_cast<uint32_t>(2 * nc));  // bytesPlane0
-  put32(d, 0);                         // bytesPlane4..7
+  put32(d, 0);                              // bytesPlane4..7
   constexpr uint32_t kSignedFloat = 0x40 | 0x80;
   for (int c = 0; c < nc; ++c) {
-    uint32_t channel = (nc == 4 && c == 3) ? 15u : static_cast<uint32_t>(c);  // R 0, G 1, B 2, A 15
+    uint32_t channel = (nc == 4 && c == 3) ? 15u : static_cast<uint32_t>(c);                   // R 0, G 1, B 2, A 15
     put32(d, static_cast<uint32_t>(16 * c) | (15u << 16) | ((channel | kSignedFloat) << 24));  // offset, length−1
-    put32(d, 0);                       // samplePosition 0
-    put32(d, 0xBF800000u);             // sampleLower −1.0f
-    put32(d, 0x3F800000u);             // sampleUpper  1.0f
+    put32(d, 0);                                                                               // samplePosition 0
+    put32(d, 0xBF800000u);                                                                     // sampleLower −1.0f
+    put32(d, 0x3F800000u);                                                                     // sampleUpper  1.0f
   }
   return d;
 }
@@ -180,30 +181,34 @@ Ktx2Texture read_ktx2(const std::string& path) {
   Ktx2Texture t;
   t.vk_format = static_cast<int>(get32(s, 12, path, "vkFormat"));
   if (t.vk_format != kVkFormatRgba16f && t.vk_format != kVkFormatRg16f)
-    fail(ErrorKind::Format, "{}: vkFormat {} (iblkit reads 97 R16G16B16A16_SFLOAT and 83 R16G16_SFLOAT)", path, t.vk_format);
+    fail(ErrorKind::Format, "{}: vkFormat {} (iblkit reads 97 R16G16B16A16_SFLOAT and 83 R16G16_SFLOAT)", path,
+         t.vk_format);
   const int nc = channels_of(t.vk_format);
   const uint32_t w = get32(s, 20, path, "pixelWidth"), h = std::max(1u, get32(s, 24, path, "pixelHeight"));
   if (get32(s, 28, path, "pixelDepth") != 0 || get32(s, 32, path, "layerCount") > 1)
     fail(ErrorKind::Format, "{}: 3D and array textures are not read", path);
   t.faces = static_cast<int>(get32(s, 36, path, "faceCount"));
   const uint32_t n = std::max(1u, get32(s, 40, path, "levelCount"));
-  if (get32(s, 44, path, "supercompressionScheme") != 0) fail(ErrorKind::Format, "{}: supercompressed levels are not read", path);
+  if (get32(s, 44, path, "supercompressionScheme") != 0)
+    fail(ErrorKind::Format, "{}: supercompressed levels are not read", path);
   if (t.faces != 1 && t.faces != 6) fail(ErrorKind::Format, "{}: faceCount {} (1 or 6)", path, t.faces);
-  if (w < 1 || w > 65536 || h > 65536 || n > 17) fail(ErrorKind::Format, "{}: size {}×{} with {} levels is out of range", path, w, h, n);
+  if (w < 1 || w > 65536 || h > 65536 || n > 17)
+    fail(ErrorKind::Format, "{}: size {}×{} with {} levels is out of range", path, w, h, n);
   for (uint32_t m = 0; m < n; ++m) {
     const uint32_t lw = std::max(1u, w >> m), lh = std::max(1u, h >> m);
     const uint64_t off = get64(s, kHeaderBytes + 24 * m, path, "level index");
     const uint64_t len = get64(s, kHeaderBytes + 24 * m + 8, path, "level index");
     const uint64_t want = uint64_t(lw) * lh * nc * 2 * t.faces;
     if (len != want || off > s.size() || len > s.size() - off)
-      fail(ErrorKind::Format, "{}: level {} holds {} bytes at {} (expected {} within the file's {})", path, m, len, off, want, s.size());
+      fail(ErrorKind::Format, "{}: level {} holds {} bytes at {} (expected {} within the file's {})", path, m, len, off,
+           want, s.size());
     std::vector<Image> faces;
     size_t at = off;
     for (int f = 0; f < t.faces; ++f) {
       Image im(static_cast<int>(lw), static_cast<int>(lh), nc);
       for (size_t i = 0; i < im.size(); ++i, at += 2)
-        im.data()[i] = from_half(static_cast<uint16_t>(static_cast<unsigned char>(s[at]) |
-                                                       (static_cast<unsigned char>(s[at + 1]) << 8)));
+        im.data()[i] = from_half(
+            static_cast<uint16_t>(static_cast<unsigned char>(s[at]) | (static_cast<unsigned char>(s[at + 1]) << 8)));
       faces.push_back(std::move(im));
     }
     t.levels.push_back(std::move(faces));

@@ -12,8 +12,8 @@ namespace ibl::fusion {
 double image_rmse(const sphere::EnvMap& est, const sphere::EnvMap& truth) {
   const auto& m = truth.mapping;
   if (est.mapping.kind() != m.kind() || est.mapping.width() != m.width() || est.mapping.height() != m.height())
-    fail(ErrorKind::Value, "image error: a {}x{} map against a {}x{} truth in another mapping or size", est.mapping.width(),
-         est.mapping.height(), m.width(), m.height());
+    fail(ErrorKind::Value, "image error: a {}x{} map against a {}x{} truth in another mapping or size",
+         est.mapping.width(), est.mapping.height(), m.width(), m.height());
   double s2 = 0, sy = 0, sw = 0;
   for (int y = 0; y < m.height(); ++y)
     for (int x = 0; x < m.width(); ++x) {
@@ -58,7 +58,8 @@ Image view_image(const geometry::Camera& c, const std::vector<Vec3>& L) {
 
 PointEval evaluate_point(const ProbeSet& set, Vec3 x, const Reference& ref, const EvalDesc& desc) {
   if (!ref.radiance_map) fail(ErrorKind::Value, "fusion evaluation: the reference has no radiance map");
-  if (desc.view && !ref.radiance_along) fail(ErrorKind::Value, "fusion evaluation: a view needs the reference's radiance along rays");
+  if (desc.view && !ref.radiance_along)
+    fail(ErrorKind::Value, "fusion evaluation: a view needs the reference's radiance along rays");
   require_point("evaluation point", x);
   static const std::vector<Vec3> normals = sphere::icosphere_face_centres(5);  // 20480 (Madsen & Laursen)
   PointEval pe;

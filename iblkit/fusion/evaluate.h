@@ -27,34 +27,34 @@ struct Reference {
 };
 
 struct EvalDesc {
-  FuseDesc fuse;              // every fusing setting but those swept: blend, visibility (and mapping: lat-long)
-  std::optional<Vec3> view;   // also a pinhole view (view_camera) from each point along this direction
+  FuseDesc fuse;             // every fusing setting but those swept: blend, visibility (and mapping: lat-long)
+  std::optional<Vec3> view;  // also a pinhole view (view_camera) from each point along this direction
 };
 
 struct EvalRow {
-  Vec3 point;                       // x
+  Vec3 point;  // x
   Blend blend = Blend::Footprint;
   bool visibility = true;
-  double image_rmse = 0;            // image_rmse(fused, truth)
-  double irradiance_mean_rel = 0;   // mean relative irradiance error over the normals
-  double irradiance_max_rel = 0;    // largest relative irradiance error
-  CoverageStats coverage;           // of the fused map
+  double image_rmse = 0;           // image_rmse(fused, truth)
+  double irradiance_mean_rel = 0;  // mean relative irradiance error over the normals
+  double irradiance_max_rel = 0;   // largest relative irradiance error
+  CoverageStats coverage;          // of the fused map
 };
 
 struct ViewEval {
   Blend blend = Blend::Angle;
   bool visibility = true;
-  Image image;                      // RGB radiance, camera.width × camera.height
+  Image image;  // RGB radiance, camera.width × camera.height
 };
 
 struct PointEval {
   sphere::EnvMap truth{Image(2, 1, 3), sphere::Mapping(sphere::MappingKind::LatLong, 2, 1)};  // the reference map
-  std::vector<EvalRow> rows;        // nearest, angle, footprint (outer) × visibility off, on
-  std::vector<LocalMap> maps;       // the fused map of each row
+  std::vector<EvalRow> rows;   // nearest, angle, footprint (outer) × visibility off, on
+  std::vector<LocalMap> maps;  // the fused map of each row
   // With EvalDesc::view:
-  geometry::Camera camera;          // view_camera(x, *view)
-  Image view_truth;                 // the reference's view
-  std::vector<ViewEval> views;      // visibility off, on (outer) × angle, footprint
+  geometry::Camera camera;      // view_camera(x, *view)
+  Image view_truth;             // the reference's view
+  std::vector<ViewEval> views;  // visibility off, on (outer) × angle, footprint
 };
 
 // Solid-angle weighted RMS of the luminance difference, over the truth's mean luminance (0 for a black

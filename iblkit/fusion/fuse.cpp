@@ -12,7 +12,8 @@
 namespace ibl::fusion {
 
 namespace {
-constexpr EnumName<Blend> kBlendNames[] = {{Blend::Nearest, "nearest"}, {Blend::Angle, "angle"}, {Blend::Footprint, "footprint"}};
+constexpr EnumName<Blend> kBlendNames[] = {
+    {Blend::Nearest, "nearest"}, {Blend::Angle, "angle"}, {Blend::Footprint, "footprint"}};
 }  // namespace
 
 std::string blend_name(Blend b) { return name_of(kBlendNames, b); }
@@ -21,20 +22,25 @@ Blend parse_blend(const std::string& s) { return parse_enum(kBlendNames, s, "ble
 sphere::Mapping output_mapping(sphere::MappingKind k, int size) {
   if (size < 1 || size > 8192) fail(ErrorKind::Value, "output size {} is out of range [1, 8192]", size);
   switch (k) {
-    case sphere::MappingKind::LatLong: return {k, 2 * size, size};
-    case sphere::MappingKind::CubeHCross: return {k, 4 * size, 3 * size};
-    case sphere::MappingKind::CubeVCross: return {k, 3 * size, 4 * size};
-    case sphere::MappingKind::CubeStrip: return {k, 6 * size, size};
-    default: return {k, size, size};
+    case sphere::MappingKind::LatLong:
+      return {k, 2 * size, size};
+    case sphere::MappingKind::CubeHCross:
+      return {k, 4 * size, 3 * size};
+    case sphere::MappingKind::CubeVCross:
+      return {k, 3 * size, 4 * size};
+    case sphere::MappingKind::CubeStrip:
+      return {k, 6 * size, size};
+    default:
+      return {k, size, size};
   }
 }
 
 namespace {
 
 constexpr double kFallbackSoftening2 = 0.01;  // h² in 1/(|x − x_i|² + h²): h = 0.1 m keeps weights finite at a probe
-constexpr double kMaxTan = 20;                 // tan α cap of the slope bias (α ≈ 87°)
-constexpr double kNegligibleWeight = 1e-3;     // blend weights below this share of the total are skipped
-constexpr double kMinCos = 0.05;               // cos α floor of the footprint weight (grazing views still count a little)
+constexpr double kMaxTan = 20;                // tan α cap of the slope bias (α ≈ 87°)
+constexpr double kNegligibleWeight = 1e-3;    // blend weights below this share of the total are skipped
+constexpr double kMinCos = 0.05;  // cos α floor of the footprint weight (grazing views still count a little)
 
 // Per-probe data in the form the inner loop wants.
 struct Lut {
@@ -101,7 +107,10 @@ struct Lut {
       float m00 = ok(a) ? w00 : 0, m10 = ok(b) ? w10 : 0, m01 = ok(c) ? w01 : 0, m11 = ok(e) ? w11 : 0;
       float sum = m00 + m10 + m01 + m11;
       if (sum > 0 && sum < 1) {
-        w00 = m00 / sum; w10 = m10 / sum; w01 = m01 / sum; w11 = m11 / sum;
+        w00 = m00 / sum;
+        w10 = m10 / sum;
+        w01 = m01 / sum;
+        w11 = m11 / sum;
       }
     }
     return {w00 * a[0] + w10 * b[0] + w01 * c[0] + w11 * e[0], w00 * a[1] + w10 * b[1] + w01 * c[1] + w11 * e[1],
@@ -120,7 +129,8 @@ class Fuser {
  public:
   Fuser(const ProbeSet& set, const FuseDesc& desc) : set_(set), desc_(desc) {
     if (!set.tracer) fail(ErrorKind::Value, "fuse: the probe set is not prepared (call fusion::prepare)");
-    if (desc.samples < 1 || desc.samples > 16) fail(ErrorKind::Value, "fuse: samples {} is out of range [1, 16]", desc.samples);
+    if (desc.samples < 1 || desc.samples > 16)
+      fail(ErrorKind::Value, "fuse: samples {} is out of range [1, 16]", desc.samples);
     if (!(desc.depth_bias >= 0) || !(desc.slope_bias >= 0) || !(desc.depth_tolerance >= 0))
       fail(ErrorKind::Value, "fuse: depth bias {}, slope bias {} and depth tolerance {} must be ≥ 0", desc.depth_bias,
            desc.slope_bias, desc.depth_tolerance);
@@ -134,8 +144,10 @@ class Fuser {
       l.latlong = p.radiance.mapping.kind() == sphere::MappingKind::LatLong;
       l.w = p.radiance.image.width();
       l.h = p.radiance.image.height();
-      if (p.radiance.image.channels() != 3 || p.depth.width() != l.w || p.depth.height() != l.h || p.depth.channels() != 1)
-        fail(ErrorKind::Value, "fuse: probe {} is not prepared (3-channel radiance and a 1-channel depth map of its size)", p.image);
+      if (p.radiance.image.channels() != 3 || p.depth.width() != l.w || p.depth.height() != l.h ||
+          p.depth.channels() != 1)
+        fail(ErrorKind::Value,
+             "fuse: probe {} is not prepared (3-channel radiance and a 1-channel depth map of its size)", p.image);
       if (l.latlong && p.rgbd.size() != p.radiance.image.pixel_count() * 4)
         fail(ErrorKind::Value, "fuse: probe {} is not prepared (call fusion::prepare)", p.image);
       l.rgbd = p.rgbd.data();
@@ -151,7 +163,8 @@ class Fuser {
       l.delta = std::sqrt(kFourPi / std::max(n, 1.0));
       luts_.push_back(l);
     }
-    if (desc.angle_power == std::floor(desc.angle_power) && desc.angle_power <= 32) int_power_ = static_cast<int>(desc.angle_power);
+    if (desc.angle_power == std::floor(desc.angle_power) && desc.angle_power <= 32)
+      int_power_ = static_cast<int>(desc.angle_power);
     normals_.resize(set.proxy.triangle_count());
     for (size_t i = 0; i < normals_.size(); ++i) normals_[i] = set.proxy.normal(i);
   }
@@ -192,22 +205,34 @@ class Fuser {
       Lut::Px px = l.locate(local);
       if (desc_.visibility) {
         double d = l.depth_at(px);
-        double ca = std::abs(cos_a), tan_a = std::min(std::sqrt(std::max(0.0, 1 - ca * ca)) / std::max(ca, 1e-9), kMaxTan);
+        double ca = std::abs(cos_a),
+               tan_a = std::min(std::sqrt(std::max(0.0, 1 - ca * ca)) / std::max(ca, 1e-9), kMaxTan);
         double rel = desc_.depth_bias + desc_.slope_bias * l.delta * tan_a;
         if (!(d > 0) || r > d * (1 + rel) + desc_.depth_tolerance) continue;
         // Taps one texel further away may see the surface at most ~2× the slope term off.
-        if (desc_.edge_aware) tol = r * (desc_.depth_bias + 2 * desc_.slope_bias * l.delta * tan_a) + desc_.depth_tolerance;
+        if (desc_.edge_aware)
+          tol = r * (desc_.depth_bias + 2 * desc_.slope_bias * l.delta * tan_a) + desc_.depth_tolerance;
       }
       double s = dot(w, u);
       double wgt = 0;
       switch (desc_.blend) {
-        case Blend::Nearest: break;
-        case Blend::Angle: wgt = s >= desc_.angle_threshold && s > 0 ? s : 0; break;
+        case Blend::Nearest:
+          break;
+        case Blend::Angle:
+          wgt = s >= desc_.angle_threshold && s > 0 ? s : 0;
+          break;
         case Blend::Footprint:
           wgt = power(0.5 * (1 + s)) * std::max(std::abs(cos_a), kMinCos) * l.inv_omega / (r * r);
           break;
       }
-      if (s > best_s) { best_s = s; best = static_cast<int>(i); best_local = local; best_px = px; best_r = r; best_tol = tol; }
+      if (s > best_s) {
+        best_s = s;
+        best = static_cast<int>(i);
+        best_local = local;
+        best_px = px;
+        best_r = r;
+        best_tol = tol;
+      }
       if (wgt > 0) cand.push_back({static_cast<int>(i), wgt, local, px, r, tol});
       ++out.seen;
     }
@@ -276,9 +301,11 @@ class Fuser {
 void check_x(const ProbeSet& set, Vec3 x) {
   PointCheck c = check_point(set, x);
   if (c.backface > 0.5)
-    fail(ErrorKind::Value,
-         "fuse: the point ({}, {}, {}) is inside geometry or outside the proxy ({:.0f}% of its rays reach the back of a "
-         "proxy face)", x.x, x.y, x.z, 100 * c.backface);
+    fail(
+        ErrorKind::Value,
+        "fuse: the point ({}, {}, {}) is inside geometry or outside the proxy ({:.0f}% of its rays reach the back of a "
+        "proxy face)",
+        x.x, x.y, x.z, 100 * c.backface);
 }
 
 }  // namespace
@@ -289,11 +316,14 @@ std::vector<Vec3> fuse_rays(const ProbeSet& set, Vec3 x, const std::vector<Vec3>
   Fuser f(set, desc);
   std::vector<Vec3> out(dirs.size());
   if (status) status->assign(dirs.size(), PixelStatus::NoData);
-  parallel_for(0, static_cast<int64_t>(dirs.size()), [&](int64_t i) {
-    RayOut r = f.shade(x, normalize(dirs[i]));
-    out[i] = r.L;
-    if (status) (*status)[i] = r.status;
-  }, 256);
+  parallel_for(
+      0, static_cast<int64_t>(dirs.size()),
+      [&](int64_t i) {
+        RayOut r = f.shade(x, normalize(dirs[i]));
+        out[i] = r.L;
+        if (status) (*status)[i] = r.status;
+      },
+      256);
   return out;
 }
 
@@ -319,31 +349,34 @@ LocalMap fuse(const ProbeSet& set, Vec3 x, const FuseDesc& desc) {
   out.coverage = Image(W, H, 1);
   out.status.assign(static_cast<size_t>(W) * H, PixelStatus::NoData);
   std::atomic<int> rows{0};
-  parallel_for(0, H, [&](int64_t yy) {
-    int y = static_cast<int>(yy);
-    for (int xx = 0; xx < W; ++xx) {
-      Vec3 d;
-      if (!m.to_direction(xx + 0.5, y + 0.5, &d)) continue;
-      RayOut c = fuser.shade(x, d);
-      Vec3 L = c.L;
-      if (n > 1) {
-        Vec3 sum;
-        int used = 0;
-        for (int s = 0; s < n * n; ++s) {
-          Vec3 ds;
-          if (!m.to_direction(xx + (s % n + 0.5) / n, y + (s / n + 0.5) / n, &ds)) continue;
-          sum += fuser.shade(x, ds).L;
-          ++used;
+  parallel_for(
+      0, H,
+      [&](int64_t yy) {
+        int y = static_cast<int>(yy);
+        for (int xx = 0; xx < W; ++xx) {
+          Vec3 d;
+          if (!m.to_direction(xx + 0.5, y + 0.5, &d)) continue;
+          RayOut c = fuser.shade(x, d);
+          Vec3 L = c.L;
+          if (n > 1) {
+            Vec3 sum;
+            int used = 0;
+            for (int s = 0; s < n * n; ++s) {
+              Vec3 ds;
+              if (!m.to_direction(xx + (s % n + 0.5) / n, y + (s / n + 0.5) / n, &ds)) continue;
+              sum += fuser.shade(x, ds).L;
+              ++used;
+            }
+            if (used) L = sum / used;
+          }
+          rad.set_rgb(xx, y, L);
+          out.depth.at(xx, y, 0) = static_cast<float>(c.t);
+          out.coverage.at(xx, y, 0) = static_cast<float>(c.status == PixelStatus::Fused ? c.seen : 0);
+          out.status[static_cast<size_t>(y) * W + xx] = c.status;
         }
-        if (used) L = sum / used;
-      }
-      rad.set_rgb(xx, y, L);
-      out.depth.at(xx, y, 0) = static_cast<float>(c.t);
-      out.coverage.at(xx, y, 0) = static_cast<float>(c.status == PixelStatus::Fused ? c.seen : 0);
-      out.status[static_cast<size_t>(y) * W + xx] = c.status;
-    }
-    report(desc.progress, "fuse", static_cast<double>(++rows) / H);
-  }, 4);
+        report(desc.progress, "fuse", static_cast<double>(++rows) / H);
+      },
+      4);
   out.radiance = sphere::EnvMap(std::move(rad), m);
   double all = 0, fused = 0, left = 0, unseen = 0, probes = 0;
   for (int y = 0; y < H; ++y)
@@ -352,7 +385,10 @@ LocalMap fuse(const ProbeSet& set, Vec3 x, const FuseDesc& desc) {
       if (s == PixelStatus::NoData) continue;
       double w = m.solid_angle_estimate(xx, y);
       all += w;
-      if (s == PixelStatus::Fused) { fused += w; probes += w * out.coverage.at(xx, y, 0); }
+      if (s == PixelStatus::Fused) {
+        fused += w;
+        probes += w * out.coverage.at(xx, y, 0);
+      }
       if (s == PixelStatus::LeftProxy) left += w;
       if (s == PixelStatus::Unseen) unseen += w;
     }
@@ -363,11 +399,15 @@ LocalMap fuse(const ProbeSet& set, Vec3 x, const FuseDesc& desc) {
     out.stats.mean_probes = fused > 0 ? probes / fused : 0;
   }
   if (out.stats.fused == 0)
-    out.warnings.push_back(fmt::format("no direction at ({}, {}, {}) reaches a proxy point a probe sees: the whole map is the "
-                                       "distant fallback", x.x, x.y, x.z));
+    out.warnings.push_back(
+        fmt::format("no direction at ({}, {}, {}) reaches a proxy point a probe sees: the whole map is the "
+                    "distant fallback",
+                    x.x, x.y, x.z));
   else if (out.stats.unseen > 0.01)
-    out.warnings.push_back(fmt::format("{:.1f}% of the sphere at ({}, {}, {}) hits proxy points no probe sees (distant fallback; "
-                                       "see the coverage map)", 100 * out.stats.unseen, x.x, x.y, x.z));
+    out.warnings.push_back(
+        fmt::format("{:.1f}% of the sphere at ({}, {}, {}) hits proxy points no probe sees (distant fallback; "
+                    "see the coverage map)",
+                    100 * out.stats.unseen, x.x, x.y, x.z));
   return out;
 }
 

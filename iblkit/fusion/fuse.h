@@ -54,18 +54,18 @@ Blend parse_blend(const std::string& s);  // throws ibl::Error on an unknown nam
 
 struct FuseDesc {
   sphere::MappingKind mapping = sphere::MappingKind::LatLong;  // output layout (any sphere/ mapping)
-  int size = 64;                  // lat-long height, cube face edge, or disc/octahedral diameter (pixels)
-  Blend blend = Blend::Footprint; // how the probes that see a point are combined
-  bool visibility = true;         // the per-probe depth test; false reproduces the thesis's Fig. 7.8
-  double depth_bias = 0.01;       // ε: relative depth tolerance of the visibility test
-  double depth_tolerance = 0.10;  // τ: absolute tolerance (metres) for depth maps that show more than the proxy
-  double slope_bias = 1.5;        // κ: multiplies δ_i·tan α_i, the slope-scaled part of the bias
-  double angle_threshold = 0.0;   // angle blend: probes with ω·ω'_i below this cosine are left out
-  double angle_power = 4.0;       // footprint blend: k of the angular term ((1 + s)/2)^k
-  bool edge_aware = true;         // with visibility: bilinear probe lookups skip taps at another depth
-  int samples = 1;                // n×n rays per output pixel (radiance averaged; depth from the centre)
-  bool check_point = true;        // throw when x is inside geometry or outside the proxy
-  ProgressFn progress;            // stage "fuse", by rows
+  int size = 64;                   // lat-long height, cube face edge, or disc/octahedral diameter (pixels)
+  Blend blend = Blend::Footprint;  // how the probes that see a point are combined
+  bool visibility = true;          // the per-probe depth test; false reproduces the thesis's Fig. 7.8
+  double depth_bias = 0.01;        // ε: relative depth tolerance of the visibility test
+  double depth_tolerance = 0.10;   // τ: absolute tolerance (metres) for depth maps that show more than the proxy
+  double slope_bias = 1.5;         // κ: multiplies δ_i·tan α_i, the slope-scaled part of the bias
+  double angle_threshold = 0.0;    // angle blend: probes with ω·ω'_i below this cosine are left out
+  double angle_power = 4.0;        // footprint blend: k of the angular term ((1 + s)/2)^k
+  bool edge_aware = true;          // with visibility: bilinear probe lookups skip taps at another depth
+  int samples = 1;                 // n×n rays per output pixel (radiance averaged; depth from the centre)
+  bool check_point = true;         // throw when x is inside geometry or outside the proxy
+  ProgressFn progress;             // stage "fuse", by rows
 };
 
 // What happened to an output pixel's centre ray.
@@ -77,20 +77,20 @@ enum class PixelStatus : uint8_t {
 };
 
 struct CoverageStats {
-  double fused = 0;       // share of the sphere (solid angle) fused from probes that see it
-  double left_proxy = 0;  // share whose rays left the proxy
-  double unseen = 0;      // share that hit the proxy where no probe sees
-  double mean_probes = 0; // mean number of probes that see a fused pixel (solid-angle weighted)
+  double fused = 0;        // share of the sphere (solid angle) fused from probes that see it
+  double left_proxy = 0;   // share whose rays left the proxy
+  double unseen = 0;       // share that hit the proxy where no probe sees
+  double mean_probes = 0;  // mean number of probes that see a fused pixel (solid-angle weighted)
 };
 
 struct LocalMap {
-  Vec3 point;                                  // x, world metres
+  Vec3 point;                                                                                    // x, world metres
   sphere::EnvMap radiance{Image(2, 1, 3), sphere::Mapping(sphere::MappingKind::LatLong, 2, 1)};  // RGB
-  Image depth;                                 // 1 channel: |p − x| in metres, 0 where the ray left the proxy
-  Image coverage;                              // 1 channel: the number of probes that see the pixel's p (0: fallback)
-  std::vector<PixelStatus> status;             // per pixel, row-major
+  Image depth;                      // 1 channel: |p − x| in metres, 0 where the ray left the proxy
+  Image coverage;                   // 1 channel: the number of probes that see the pixel's p (0: fallback)
+  std::vector<PixelStatus> status;  // per pixel, row-major
   CoverageStats stats;
-  std::vector<std::string> warnings;           // e.g. nothing fused at all
+  std::vector<std::string> warnings;  // e.g. nothing fused at all
 };
 
 // The mapping of an output map: width × height from `size` (see FuseDesc::size).

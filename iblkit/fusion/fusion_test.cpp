@@ -215,7 +215,8 @@ TEST(FusionVisibility, TheOccludedProbeIsLeftOutOnlyWithVisibility) {
     if (vis)
       EXPECT_NEAR(luminance(L), luminance(want), 1e-3);
     else
-      EXPECT_GT(std::abs(luminance(L) - luminance(want)), 0.1) << "without visibility probe 1's view of the +x face leaks in";
+      EXPECT_GT(std::abs(luminance(L) - luminance(want)), 0.1)
+          << "without visibility probe 1's view of the +x face leaks in";
   }
   // With visibility only pixels along the edges where the paint jumps are off (bilinear lookups blend
   // the two faces there: ~5% of a 96×48 map with 24 box edges); without, a large part of the map.
@@ -297,7 +298,8 @@ TEST(FusionBadInput, ClearErrorsAndWarnings) {
   // Bad manifests name the field.
   std::ofstream((dir / "x.json").string()) << R"({"format":"iblkit.probes/1","probes":[]})";
   expect_error([&] { load_probe_set((dir / "x.json").string()); }, "\"proxy\"");
-  std::ofstream((dir / "y.json").string()) << R"({"format":"iblkit.probes/1","proxy":"proxy.obj","probes":[{"image":"p0.exr"}]})";
+  std::ofstream((dir / "y.json").string())
+      << R"({"format":"iblkit.probes/1","proxy":"proxy.obj","probes":[{"image":"p0.exr"}]})";
   expect_error([&] { load_probe_set((dir / "y.json").string()); }, "\"position\"");
   // A point inside geometry (inside the occluder) or behind a wall.
   auto set = painted_set(room_with_occluder(), {{-2, 1.5, 0}}, {}, 16, smooth_paint);
@@ -408,7 +410,8 @@ TEST(FusionTrack, AssignmentMatchesBruteForce) {
 TEST(FusionTrack, IdentitiesSurviveShufflingAndTheFilterCutsFlicker) {
   // Four lights with fixed true directions; each frame lists them in a random order with a random
   // direction jitter and power noise (median cut on a moving map does both).
-  std::vector<Vec3> dirs = {normalize(Vec3{1, 1, 0}), normalize(Vec3{-1, 0.5, 0.2}), normalize(Vec3{0, 1, 1}), normalize(Vec3{0.2, -1, -1})};
+  std::vector<Vec3> dirs = {normalize(Vec3{1, 1, 0}), normalize(Vec3{-1, 0.5, 0.2}), normalize(Vec3{0, 1, 1}),
+                            normalize(Vec3{0.2, -1, -1})};
   std::mt19937 rng(3);
   std::normal_distribution<double> jit(0, 0.05);
   LightTracker raw_tr({false, 1.0}), filt_tr({true, 3.0});

@@ -46,7 +46,10 @@ lights::LightSet localize_lights(const LocalMap& map, const LocalLightsDesc& des
     std::sort(d.begin(), d.end());
     double acc = 0, t = d.back().first;
     for (const auto& [depth, e] : d)
-      if ((acc += e) >= 0.5 * e_hit[i]) { t = depth; break; }
+      if ((acc += e) >= 0.5 * e_hit[i]) {
+        t = depth;
+        break;
+      }
     set.lights[i].position = map.point + set.lights[i].direction * t;
   }
   set.origin = map.point;
@@ -69,7 +72,8 @@ std::vector<PathPoint> read_path(const std::string& path) {
     if (!a.is_array() || a.size() != 3 || !a[0].is_number() || !a[1].is_number() || !a[2].is_number())
       fail(ErrorKind::Format, "{}: {} must be an array of 3 numbers", path, where);
     Vec3 v{a[0].get<double>(), a[1].get<double>(), a[2].get<double>()};
-    if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z)) fail(ErrorKind::Format, "{}: {} is not finite", path, where);
+    if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
+      fail(ErrorKind::Format, "{}: {} is not finite", path, where);
     return v;
   };
   std::vector<PathPoint> out;
@@ -92,11 +96,13 @@ std::vector<PathPoint> read_path(const std::string& path) {
     out.push_back(q);
   }
   if (timed != 0 && timed != static_cast<int>(out.size()))
-    fail(ErrorKind::Format, "{}: \"time\" must be on every point or on none ({} of {} have it)", path, timed, out.size());
+    fail(ErrorKind::Format, "{}: \"time\" must be on every point or on none ({} of {} have it)", path, timed,
+         out.size());
   for (size_t k = 0; k < out.size(); ++k) {
     if (timed == 0) out[k].time = static_cast<double>(k);
     if (k > 0 && !(out[k].time > out[k - 1].time))
-      fail(ErrorKind::Value, "{}: times must increase (points[{}].time = {} after {})", path, k, out[k].time, out[k - 1].time);
+      fail(ErrorKind::Value, "{}: times must increase (points[{}].time = {} after {})", path, k, out[k].time,
+           out[k - 1].time);
   }
   return out;
 }
@@ -133,12 +139,21 @@ std::vector<int> assign_min_cost(const std::vector<double>& cost, int rows, int 
       for (int j = 1; j <= m; ++j) {
         if (used[j]) continue;
         double cur = a(i0, j) - u[i0] - v[j];
-        if (cur < minv[j]) { minv[j] = cur; way[j] = j0; }
-        if (minv[j] < delta) { delta = minv[j]; j1 = j; }
+        if (cur < minv[j]) {
+          minv[j] = cur;
+          way[j] = j0;
+        }
+        if (minv[j] < delta) {
+          delta = minv[j];
+          j1 = j;
+        }
       }
       for (int j = 0; j <= m; ++j) {
-        if (used[j]) { u[match[j]] += delta; v[j] -= delta; }
-        else minv[j] -= delta;
+        if (used[j]) {
+          u[match[j]] += delta;
+          v[j] -= delta;
+        } else
+          minv[j] -= delta;
       }
       j0 = j1;
     } while (match[j0] != 0);
@@ -164,7 +179,8 @@ lights::LightSet LightTracker::update(const lights::LightSet& raw, double dt) {
   for (int a = 0; a < n; ++a)
     for (int b = 0; b < m; ++b) {
       double ya = luminance(tracks_[a].irradiance) + 1e-12, yb = luminance(raw.lights[b].irradiance) + 1e-12;
-      cost[static_cast<size_t>(a) * m + b] = 1 - dot(tracks_[a].direction, raw.lights[b].direction) + 0.5 * std::abs(std::log(ya / yb));
+      cost[static_cast<size_t>(a) * m + b] =
+          1 - dot(tracks_[a].direction, raw.lights[b].direction) + 0.5 * std::abs(std::log(ya / yb));
     }
   std::vector<int> of_track = assign_min_cost(cost, n, m);
   std::vector<int> track_of(m, -1);
@@ -185,7 +201,8 @@ lights::LightSet LightTracker::update(const lights::LightSet& raw, double dt) {
       t = tracks_[track_of[b]];
       if (l.position && t.position) {
         t.position = *t.position + (*l.position - *t.position) * alpha;
-        t.direction = raw.origin ? normalize(*t.position - origin) : normalize(t.direction + (l.direction - t.direction) * alpha);
+        t.direction =
+            raw.origin ? normalize(*t.position - origin) : normalize(t.direction + (l.direction - t.direction) * alpha);
       } else {
         t.position = l.position;
         t.direction = normalize(t.direction + (l.direction - t.direction) * alpha);
@@ -260,7 +277,8 @@ FlickerStats map_flicker(const std::vector<sphere::EnvMap>& maps) {
 }
 
 double excess_flicker(const std::vector<lights::LightSet>& frames, const std::vector<sphere::EnvMap>& maps) {
-  if (frames.size() != maps.size()) fail(ErrorKind::Internal, "excess_flicker: {} light sets for {} maps", frames.size(), maps.size());
+  if (frames.size() != maps.size())
+    fail(ErrorKind::Internal, "excess_flicker: {} light sets for {} maps", frames.size(), maps.size());
   std::vector<std::vector<double>> e, m;
   for (size_t k = 0; k < frames.size(); ++k) {
     e.push_back(lum(lights::irradiance_from_lights(frames[k].lights, flicker_normals())));
@@ -275,8 +293,10 @@ double excess_flicker(const std::vector<lights::LightSet>& frames, const std::ve
   return frames.size() > 1 ? sum / (frames.size() - 1) : 0.0;
 }
 
-double shadow_light_jitter(const std::vector<lights::LightSet>& frames, const std::vector<std::vector<int>>& ids, int count) {
-  if (frames.size() != ids.size()) fail(ErrorKind::Internal, "shadow_light_jitter: {} light sets for {} id lists", frames.size(), ids.size());
+double shadow_light_jitter(const std::vector<lights::LightSet>& frames, const std::vector<std::vector<int>>& ids,
+                           int count) {
+  if (frames.size() != ids.size())
+    fail(ErrorKind::Internal, "shadow_light_jitter: {} light sets for {} id lists", frames.size(), ids.size());
   double sum = 0;
   int pairs = 0;
   for (size_t k = 1; k < frames.size(); ++k) {
@@ -290,13 +310,17 @@ double shadow_light_jitter(const std::vector<lights::LightSet>& frames, const st
         w += y;
       }
     }
-    if (w > 0) { sum += a / w; ++pairs; }
+    if (w > 0) {
+      sum += a / w;
+      ++pairs;
+    }
   }
   return pairs ? sum / pairs : 0.0;
 }
 
 double lights_vs_maps(const std::vector<lights::LightSet>& frames, const std::vector<sphere::EnvMap>& maps) {
-  if (frames.size() != maps.size()) fail(ErrorKind::Internal, "lights_vs_maps: {} light sets for {} maps", frames.size(), maps.size());
+  if (frames.size() != maps.size())
+    fail(ErrorKind::Internal, "lights_vs_maps: {} light sets for {} maps", frames.size(), maps.size());
   double sum = 0;
   for (size_t k = 0; k < frames.size(); ++k) {
     auto e = lum(lights::irradiance_from_lights(frames[k].lights, flicker_normals()));

@@ -42,16 +42,16 @@ lights::LightSet localize_lights(const LocalMap& map, const LocalLightsDesc& des
 // ---- paths ------------------------------------------------------------------------------------
 
 struct PathPoint {
-  Vec3 position;   // world metres
-  double time = 0; // seconds; frame index when the path has no times
+  Vec3 position;    // world metres
+  double time = 0;  // seconds; frame index when the path has no times
 };
 // A path file: {"format":"iblkit.path/1","points":[{"position":[x,y,z],"time":t}, …]} ("time"
 // optional, increasing, on every point or none) or a bare array [[x,y,z], …]. Throws ibl::Error.
 std::vector<PathPoint> read_path(const std::string& path);
 
 struct TrackDesc {
-  bool filter = true;           // false: identities only, no low-pass filter
-  double time_constant = 2.0;   // τ of the filter, in the path's time unit (frames when untimed)
+  bool filter = true;          // false: identities only, no low-pass filter
+  double time_constant = 2.0;  // τ of the filter, in the path's time unit (frames when untimed)
 };
 
 // Frame-to-frame light tracking and filtering.
@@ -97,7 +97,8 @@ double excess_flicker(const std::vector<lights::LightSet>& frames, const std::ve
 // How far the shadow-casting lights jump: mean over frame pairs of the luminance-weighted angle (radians)
 // between each of the first `count` lights of frame k (shadow-map priority order) and the light with
 // the same track id in frame k−1 (lights without one there are skipped).
-double shadow_light_jitter(const std::vector<lights::LightSet>& frames, const std::vector<std::vector<int>>& ids, int count);
+double shadow_light_jitter(const std::vector<lights::LightSet>& frames, const std::vector<std::vector<int>>& ids,
+                           int count);
 // Mean over frames of RMS_n |E_lights(n) − E_map(n)| / mean_n E_map(n): how far filtered lights lag
 // behind (or raw lights miss) the map they stand for.
 double lights_vs_maps(const std::vector<lights::LightSet>& frames, const std::vector<sphere::EnvMap>& maps);

@@ -16,7 +16,8 @@ PathResult fuse_path(const ProbeSet& set, const std::vector<PathPoint>& path, co
   if (desc.lights < 1) fail(ErrorKind::Value, "fuse_path: lights = {} must be at least 1", desc.lights);
   for (size_t k = 0; k < path.size(); ++k) {
     require_point(fmt::format("fuse_path: point {}", k + 1), path[k].position);
-    if (!std::isfinite(path[k].time)) fail(ErrorKind::Value, "fuse_path: point {} has time {}, not a finite number", k + 1, path[k].time);
+    if (!std::isfinite(path[k].time))
+      fail(ErrorKind::Value, "fuse_path: point {} has time {}, not a finite number", k + 1, path[k].time);
   }
   FuseDesc fd = desc.fuse;
   fd.progress = {};

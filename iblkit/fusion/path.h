@@ -14,11 +14,11 @@
 namespace ibl::fusion {
 
 struct PathDesc {
-  FuseDesc fuse;              // the maps (mapping must be lat-long: the lights are cut from them; progress unused)
-  int lights = 16;            // median-cut lights per frame (N ≥ 1)
-  TrackDesc track;            // the filtered tracker's settings (the raw one never filters)
-  int shadow_lights = 4;      // the first K lights a renderer would give shadow maps (their jitter is measured)
-  ProgressFn progress;        // optional: stage "path", per frame
+  FuseDesc fuse;          // the maps (mapping must be lat-long: the lights are cut from them; progress unused)
+  int lights = 16;        // median-cut lights per frame (N ≥ 1)
+  TrackDesc track;        // the filtered tracker's settings (the raw one never filters)
+  int shadow_lights = 4;  // the first K lights a renderer would give shadow maps (their jitter is measured)
+  ProgressFn progress;    // optional: stage "path", per frame
 };
 
 // One frame, as fuse_path hands it to its callback (valid during the call).
@@ -36,11 +36,11 @@ using PathFrameFn = std::function<void(const PathFrame&)>;
 
 struct PathResult {
   size_t frames = 0;
-  double seconds = 0;                       // wall time of the whole path (the callback's time included)
-  FlickerStats map_flicker;                 // the maps' own change from frame to frame
-  FlickerStats raw_flicker, filtered_flicker;  // the lights', unfiltered and filtered
-  double raw_excess = 0, filtered_excess = 0;  // excess_flicker: the change the maps do not make
-  double raw_jitter = 0, filtered_jitter = 0;  // shadow_light_jitter of the first shadow_lights lights, radians
+  double seconds = 0;                            // wall time of the whole path (the callback's time included)
+  FlickerStats map_flicker;                      // the maps' own change from frame to frame
+  FlickerStats raw_flicker, filtered_flicker;    // the lights', unfiltered and filtered
+  double raw_excess = 0, filtered_excess = 0;    // excess_flicker: the change the maps do not make
+  double raw_jitter = 0, filtered_jitter = 0;    // shadow_light_jitter of the first shadow_lights lights, radians
   double raw_vs_maps = 0, filtered_vs_maps = 0;  // lights_vs_maps: how far the lights miss their maps
 };
 

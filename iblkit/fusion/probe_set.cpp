@@ -27,7 +27,8 @@ Vec3 vec3_field(const json& j, const std::string& what) {
   if (!j.is_array() || j.size() != 3 || !j[0].is_number() || !j[1].is_number() || !j[2].is_number())
     fail(ErrorKind::Format, "{} must be an array of 3 numbers", what);
   Vec3 v{j[0].get<double>(), j[1].get<double>(), j[2].get<double>()};
-  if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z)) fail(ErrorKind::Format, "{} is not finite", what);
+  if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
+    fail(ErrorKind::Format, "{} is not finite", what);
   return v;
 }
 
@@ -52,7 +53,8 @@ Image read_depth(const std::string& path) {
     for (int x = 0; x < d.width(); ++x) {
       float v = d.at(x, y, 0);
       if (!std::isfinite(v) || v < 0)
-        fail(ErrorKind::Value, "depth map {}: pixel ({}, {}) is {} (depths are metres ≥ 0, 0 = no surface)", path, x, y, v);
+        fail(ErrorKind::Value, "depth map {}: pixel ({}, {}) is {} (depths are metres ≥ 0, 0 = no surface)", path, x, y,
+             v);
     }
   return d;
 }
@@ -138,7 +140,8 @@ void prepare(ProbeSet& set, const ProgressFn& progress) {
     build();
     set.warnings.push_back(fmt::format(
         "{}: every probe sees the back of the proxy's faces: the proxy was turned inside out and has been flipped "
-        "(front faces must face the probes)", what));
+        "(front faces must face the probes)",
+        what));
     checks.clear();
     for (const auto& p : set.probes) checks.push_back(check_point(set, p.position));
   }
@@ -147,7 +150,8 @@ void prepare(ProbeSet& set, const ProgressFn& progress) {
     if (checks[k].backface > 0.5)
       fail(ErrorKind::Value,
            "{}: {} at ({}, {}, {}) is outside the proxy or inside geometry ({:.0f}% of its rays reach the back of a "
-           "proxy face)", what, probe_name(p, k), p.position.x, p.position.y, p.position.z, 100 * checks[k].backface);
+           "proxy face)",
+           what, probe_name(p, k), p.position.x, p.position.y, p.position.z, 100 * checks[k].backface);
     if (checks[k].escape >= 1.0)
       fail(ErrorKind::Value, "{}: {} at ({}, {}, {}) sees no proxy geometry at all (every ray leaves it)", what,
            probe_name(p, k), p.position.x, p.position.y, p.position.z);
@@ -164,8 +168,9 @@ void prepare(ProbeSet& set, const ProgressFn& progress) {
       p.depth_source = DepthSource::Computed;
       report(progress, "depth", static_cast<double>(++done) / todo);
     } else if (p.depth.width() != m.width() || p.depth.height() != m.height()) {
-      fail(ErrorKind::Value, "{}: {}: its depth map {} is {}×{} but the probe is {}×{} (they must match pixel for pixel)",
-           what, probe_name(p, k), p.depth_file.empty() ? std::string("(in memory)") : p.depth_file, p.depth.width(),
+      fail(ErrorKind::Value,
+           "{}: {}: its depth map {} is {}×{} but the probe is {}×{} (they must match pixel for pixel)", what,
+           probe_name(p, k), p.depth_file.empty() ? std::string("(in memory)") : p.depth_file, p.depth.width(),
            p.depth.height(), m.width(), m.height());
     }
     if (p.radiance.image.channels() != 3) p.radiance.image = p.radiance.image.with_channels(3);
@@ -186,7 +191,8 @@ void prepare(ProbeSet& set, const ProgressFn& progress) {
     if (p.escape_fraction > kEscapeWarn)
       set.warnings.push_back(fmt::format(
           "{}: the proxy is not closed: {:.1f}% of {}'s directions leave it (fused rays there fall back to the "
-          "distant lookup; see the coverage map)", what, 100 * p.escape_fraction, probe_name(p, k)));
+          "distant lookup; see the coverage map)",
+          what, 100 * p.escape_fraction, probe_name(p, k)));
   }
 }
 
@@ -231,7 +237,8 @@ ProbeSet load_probe_set(const std::string& manifest, const LoadDesc& desc) {
       p.depth = read_depth(p.depth_file);
       p.depth_source = DepthSource::File;
     } else if (!trace && desc.use_cache && fs::exists(depth_cache_path(p.image)) &&
-               newer_or_same(depth_cache_path(p.image), proxy_path) && newer_or_same(depth_cache_path(p.image), p.image) &&
+               newer_or_same(depth_cache_path(p.image), proxy_path) &&
+               newer_or_same(depth_cache_path(p.image), p.image) &&
                newer_or_same(depth_cache_path(p.image), manifest)) {
       p.depth_file = depth_cache_path(p.image);
       p.depth = read_depth(p.depth_file);

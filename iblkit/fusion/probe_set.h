@@ -30,33 +30,33 @@ enum class DepthSource {
 };
 
 struct Probe {
-  std::string image;        // radiance file (empty when built in memory)
-  std::string depth_file;   // depth file read or written (empty when none)
-  Vec3 position;            // where the probe was captured, world metres
-  Mat3 rotation;            // probe frame -> world
+  std::string image;       // radiance file (empty when built in memory)
+  std::string depth_file;  // depth file read or written (empty when none)
+  Vec3 position;           // where the probe was captured, world metres
+  Mat3 rotation;           // probe frame -> world
   sphere::EnvMap radiance{Image(2, 1, 3), sphere::Mapping(sphere::MappingKind::LatLong, 2, 1)};
-  Image depth;              // 1 channel, same size as `radiance`: metres from `position` to the proxy
-                            // along each pixel centre's direction; 0 where the ray leaves the proxy
+  Image depth;  // 1 channel, same size as `radiance`: metres from `position` to the proxy
+                // along each pixel centre's direction; 0 where the ray leaves the proxy
   DepthSource depth_source = DepthSource::Computed;
-  std::vector<float> rgbd;  // lat-long probes: radiance and depth interleaved (R,G,B,depth per pixel), built
-                            // by prepare() so that a fused lookup touches one cache line, not two
+  std::vector<float> rgbd;     // lat-long probes: radiance and depth interleaved (R,G,B,depth per pixel), built
+                               // by prepare() so that a fused lookup touches one cache line, not two
   double escape_fraction = 0;  // share of the probe's solid angle whose rays leave the proxy
 };
 
 struct ProbeSet {
-  std::string manifest;                             // the file it came from (empty when in memory)
-  geometry::TriMesh proxy;                          // the scene proxy, world metres
-  std::shared_ptr<geometry::RayTracer> tracer;      // Embree scene of `proxy` (built by prepare)
+  std::string manifest;                         // the file it came from (empty when in memory)
+  geometry::TriMesh proxy;                      // the scene proxy, world metres
+  std::shared_ptr<geometry::RayTracer> tracer;  // Embree scene of `proxy` (built by prepare)
   std::vector<Probe> probes;
-  std::vector<std::string> warnings;                // e.g. an open proxy; the CLI prints them
+  std::vector<std::string> warnings;  // e.g. an open proxy; the CLI prints them
 };
 
 struct LoadDesc {
-  bool use_depth_files = true;   // false: ignore the manifest's depth maps and trace the proxy
-  bool use_cache = true;         // read <stem>_proxydepth.exr beside a probe when the manifest names none
-  bool write_cache = true;       // write depth maps that had to be traced beside their probes
-  bool force_depth = false;      // trace every depth map again (and rewrite the cache)
-  ProgressFn progress;           // stages "load", "depth"
+  bool use_depth_files = true;  // false: ignore the manifest's depth maps and trace the proxy
+  bool use_cache = true;        // read <stem>_proxydepth.exr beside a probe when the manifest names none
+  bool write_cache = true;      // write depth maps that had to be traced beside their probes
+  bool force_depth = false;     // trace every depth map again (and rewrite the cache)
+  ProgressFn progress;          // stages "load", "depth"
 };
 
 // Reads an iblkit.probes/1 manifest, its proxy (any mesh file geometry::read_mesh reads) and its

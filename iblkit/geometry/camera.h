@@ -27,11 +27,11 @@ inline Mat4f mul(const Mat4f& a, const Mat4f& b) {
 }
 
 struct Camera {
-  Vec3 eye{0, 0.3, 1.2};      // centre of projection, world metres
-  Vec3 target{0, 0, 0};       // the point seen at the frame's centre
-  Vec3 up{0, 1, 0};           // world direction that appears upwards (not parallel to target − eye)
-  double fov_y_deg = 40.0;    // vertical field of view, degrees
-  int width = 1024, height = 768;  // frame size, pixels
+  Vec3 eye{0, 0.3, 1.2};              // centre of projection, world metres
+  Vec3 target{0, 0, 0};               // the point seen at the frame's centre
+  Vec3 up{0, 1, 0};                   // world direction that appears upwards (not parallel to target − eye)
+  double fov_y_deg = 40.0;            // vertical field of view, degrees
+  int width = 1024, height = 768;     // frame size, pixels
   double znear = 0.01, zfar = 100.0;  // clip distances of projection(), metres
 
   // Unit world direction through the continuous pixel position (px, py): x to the right, y down, (0, 0)
@@ -48,9 +48,9 @@ struct Camera {
   // World → eye space (right-handed, looking along −Z, +Y up), as GL's lookAt.
   Mat4f view() const {
     Vec3 f = normalize(target - eye), r = normalize(cross(f, up)), u = cross(r, f);
-    return {static_cast<float>(r.x), static_cast<float>(u.x), static_cast<float>(-f.x), 0,
-            static_cast<float>(r.y), static_cast<float>(u.y), static_cast<float>(-f.y), 0,
-            static_cast<float>(r.z), static_cast<float>(u.z), static_cast<float>(-f.z), 0,
+    return {static_cast<float>(r.x),          static_cast<float>(u.x),          static_cast<float>(-f.x),        0,
+            static_cast<float>(r.y),          static_cast<float>(u.y),          static_cast<float>(-f.y),        0,
+            static_cast<float>(r.z),          static_cast<float>(u.z),          static_cast<float>(-f.z),        0,
             static_cast<float>(-dot(r, eye)), static_cast<float>(-dot(u, eye)), static_cast<float>(dot(f, eye)), 1};
   }
   // Eye → clip space: GL's perspective (depth −1 at znear, +1 at zfar).
@@ -78,7 +78,8 @@ inline void require_camera(const Camera& c) {
   Vec3 up = require_direction("camera up", c.up);
   if (length(cross(normalize(f), up)) < 1e-9)
     fail(ErrorKind::Value, "camera: up ({}, {}, {}) is parallel to the view direction", c.up.x, c.up.y, c.up.z);
-  if (!(c.fov_y_deg > 0 && c.fov_y_deg < 180)) fail(ErrorKind::Value, "camera: field of view {}° outside (0°, 180°)", c.fov_y_deg);
+  if (!(c.fov_y_deg > 0 && c.fov_y_deg < 180))
+    fail(ErrorKind::Value, "camera: field of view {}° outside (0°, 180°)", c.fov_y_deg);
 }
 
 }  // namespace ibl::geometry

@@ -10,8 +10,8 @@
 namespace ibl::geometry {
 namespace {
 
-constexpr double kAreaTol = 1e-9;    // rectangles: exact up to rounding
-constexpr double kFloatTol = 2e-5;   // Embree works in float: distances of a few metres
+constexpr double kAreaTol = 1e-9;   // rectangles: exact up to rounding
+constexpr double kFloatTol = 2e-5;  // Embree works in float: distances of a few metres
 
 TEST(GeometryMesh, RoomFacesInwardWithExactArea) {
   RoomDesc d;
@@ -34,8 +34,8 @@ TEST(GeometryMesh, OpeningsAndOmittedWallsRemoveTheirArea) {
   d.lo = {0, 0, 0};
   d.hi = {4, 3, 5};
   double full = make_room(d).total_area();
-  d.openings.push_back({2, true, {1, 0}, {2.5, 2}});   // a door 1.5 × 2 in the +z wall (x, y)
-  d.openings.push_back({0, false, {1, 1}, {2, 3}});    // a window 1 × 2 in the −x wall (y, z)
+  d.openings.push_back({2, true, {1, 0}, {2.5, 2}});  // a door 1.5 × 2 in the +z wall (x, y)
+  d.openings.push_back({0, false, {1, 1}, {2, 3}});   // a window 1 × 2 in the −x wall (y, z)
   EXPECT_NEAR(make_room(d).total_area(), full - 3 - 2, kAreaTol);
   d.omit[3] = true;  // no ceiling
   EXPECT_NEAR(make_room(d).total_area(), full - 5 - 20, kAreaTol);
@@ -65,7 +65,8 @@ TEST(GeometryMesh, PrimitivesHaveTheirAreasAndOrientation) {
 TEST(GeometryMesh, WithNormalsSplitsCornersAtCreases) {
   TriMesh cube;
   for (int i = 0; i < 8; ++i) cube.positions.push_back({i & 1 ? 1.0 : -1.0, i & 2 ? 1.0 : -1.0, i & 4 ? 1.0 : -1.0});
-  const int faces[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};  // outward
+  const int faces[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4},
+                           {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};  // outward
   for (const auto& f : faces) {
     cube.triangles.push_back({static_cast<uint32_t>(f[0]), static_cast<uint32_t>(f[1]), static_cast<uint32_t>(f[2])});
     cube.triangles.push_back({static_cast<uint32_t>(f[0]), static_cast<uint32_t>(f[2]), static_cast<uint32_t>(f[3])});
@@ -75,7 +76,8 @@ TEST(GeometryMesh, WithNormalsSplitsCornersAtCreases) {
   EXPECT_EQ(hard.vertex_count(), 24u);
   EXPECT_EQ(hard.triangle_count(), 12u);
   for (size_t t = 0; t < hard.triangle_count(); ++t)
-    for (uint32_t v : hard.triangles[t]) EXPECT_NEAR(length(hard.normals[v] - hard.normal(t)), 0, 1e-12) << "triangle " << t;
+    for (uint32_t v : hard.triangles[t])
+      EXPECT_NEAR(length(hard.normals[v] - hard.normal(t)), 0, 1e-12) << "triangle " << t;
   TriMesh smooth = with_normals(cube, 100);
   EXPECT_EQ(smooth.vertex_count(), 8u);
   for (size_t v = 0; v < 8; ++v) {
@@ -90,13 +92,15 @@ TEST(GeometryMesh, WithNormalsSplitsCornersAtCreases) {
 TEST(GeometryMesh, RenderObjectsCarryTheirNormals) {
   TriMesh sph = make_sphere({1, 0, 0}, 0.5, 16, 32);
   ASSERT_TRUE(sph.has_normals());
-  for (size_t i = 0; i < sph.vertex_count(); ++i) ASSERT_NEAR(length(sph.normals[i] - (sph.positions[i] - Vec3{1, 0, 0}) * 2.0), 0, 1e-12);
+  for (size_t i = 0; i < sph.vertex_count(); ++i)
+    ASSERT_NEAR(length(sph.normals[i] - (sph.positions[i] - Vec3{1, 0, 0}) * 2.0), 0, 1e-12);
   EXPECT_THROW(make_sphere({0, 0, 0}, 1, 1, 8), Error);
   TriMesh blob = make_blob(4000, 0.8);
   ASSERT_TRUE(blob.has_normals());
   EXPECT_NEAR(blob.triangle_count(), 4000, 400);
   int outward = 0;
-  for (size_t t = 0; t < blob.triangle_count(); ++t) outward += dot(blob.normal(t), blob.positions[blob.triangles[t][0]]) > 0;
+  for (size_t t = 0; t < blob.triangle_count(); ++t)
+    outward += dot(blob.normal(t), blob.positions[blob.triangles[t][0]]) > 0;
   EXPECT_GT(outward, 0.99 * blob.triangle_count());
   for (const auto& t : blob.triangles)  // (one vertex at each pole belongs to no triangle)
     for (uint32_t v : t) ASSERT_NEAR(length(blob.normals[v]), 1, 1e-12);

@@ -199,8 +199,10 @@ TriMesh make_disc(Vec3 center, Vec3 normal, double radius, int segments) {
 
 TriMesh make_sphere(Vec3 center, double radius, int rings, int segments, bool inward) {
   check_positive(radius, "sphere radius");
-  if (rings < 2 || segments < 3) fail(ErrorKind::Value, "sphere needs ≥ 2 rings and ≥ 3 segments ({} and {} given)", rings, segments);
-  check_triangles(2.0 * rings * segments, fmt::format("a sphere of {} rings and {} segments", rings, segments), "choose fewer rings or segments");
+  if (rings < 2 || segments < 3)
+    fail(ErrorKind::Value, "sphere needs ≥ 2 rings and ≥ 3 segments ({} and {} given)", rings, segments);
+  check_triangles(2.0 * rings * segments, fmt::format("a sphere of {} rings and {} segments", rings, segments),
+                  "choose fewer rings or segments");
   TriMesh m;
   for (int r = 0; r <= rings; ++r) {
     double th = kPi * r / rings;

@@ -1,8 +1,8 @@
 // Triangle meshes (positions, optional shading normals and UVs, counter-clockwise triangles seen from
 // the front): the one mesh type of the library (lab scenes, fusion proxies, the renderers), and the
 // primitives the lab builds scenes from: quads, discs, spheres, cylinders, boxes and box rooms with
-// rectangular openings, and the renderers' test objects (the blob, a floor). The front side of a triangle is the side its normal cross(p1−p0, p2−p0)
-// points to (the OBJ / glTF convention); emitters emit from the front side only.
+// rectangular openings, and the renderers' test objects (the blob, a floor). The front side of a triangle is the side
+// its normal cross(p1−p0, p2−p0) points to (the OBJ / glTF convention); emitters emit from the front side only.
 #pragma once
 #include <array>
 #include <cstdint>
@@ -14,11 +14,11 @@
 namespace ibl::geometry {
 
 struct TriMesh {
-  std::vector<Vec3> positions;                  // one per vertex, metres
-  std::vector<Vec3> normals;                    // one unit shading normal per vertex, or empty (the
-                                                // renderers need them: with_normals() gives them)
-  std::vector<Vec2> uvs;                        // one per vertex (OBJ/GL convention: v = 0 is the
-                                                // image's bottom row), or empty
+  std::vector<Vec3> positions;                     // one per vertex, metres
+  std::vector<Vec3> normals;                       // one unit shading normal per vertex, or empty (the
+                                                   // renderers need them: with_normals() gives them)
+  std::vector<Vec2> uvs;                           // one per vertex (OBJ/GL convention: v = 0 is the
+                                                   // image's bottom row), or empty
   std::vector<std::array<uint32_t, 3>> triangles;  // vertex indices, counter-clockwise from the front
 
   size_t vertex_count() const { return positions.size(); }
@@ -78,15 +78,15 @@ TriMesh make_floor(double size, double height);
 
 // A rectangular hole in one wall of a room.
 struct Opening {
-  int axis = 2;        // 0,1,2: the wall is perpendicular to x, y or z
-  bool at_max = false; // the wall at max[axis] (true) or min[axis] (false)
-  Vec2 lo, hi;         // the hole's extent in the wall's two other world axes, in x<y<z order (metres)
+  int axis = 2;         // 0,1,2: the wall is perpendicular to x, y or z
+  bool at_max = false;  // the wall at max[axis] (true) or min[axis] (false)
+  Vec2 lo, hi;          // the hole's extent in the wall's two other world axes, in x<y<z order (metres)
 };
 
 struct RoomDesc {
-  Vec3 lo{-2, 0, -2}, hi{2, 3, 2};   // inner bounds of the room, metres
-  std::vector<Opening> openings;      // holes in the walls (doors, windows, corridor joints)
-  std::array<bool, 6> omit{};        // drop whole walls: −x, +x, −y, +y, −z, +z
+  Vec3 lo{-2, 0, -2}, hi{2, 3, 2};  // inner bounds of the room, metres
+  std::vector<Opening> openings;    // holes in the walls (doors, windows, corridor joints)
+  std::array<bool, 6> omit{};       // drop whole walls: −x, +x, −y, +y, −z, +z
 };
 // The six walls of a box room, front faces inwards, each wall's UVs spanning [0,1]², with the
 // openings cut out (each wall is split on the openings' edges into cells; cells inside a hole go).

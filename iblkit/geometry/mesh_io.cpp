@@ -10,8 +10,8 @@
 #include <memory>
 #include <string>
 
-#include "iblkit/core/error.h"
 #include "iblkit/core/atomic_file.h"
+#include "iblkit/core/error.h"
 
 namespace ibl::geometry {
 
@@ -54,7 +54,8 @@ void check_ply_header(const std::string& path) {
       break;
     }
   }
-  if (end == std::string::npos) fail(ErrorKind::Format, "{}: PLY header has no \"end_header\" line (within the first 64 KiB)", path);
+  if (end == std::string::npos)
+    fail(ErrorKind::Format, "{}: PLY header has no \"end_header\" line (within the first 64 KiB)", path);
   // assimp allocates what an "element NAME COUNT" line declares before reading a byte of it (a header
   // declaring 4294967295 elements asked for 103 GB; found by fuzz/mesh_fuzz.cpp): every element takes at
   // least a byte, so no number on an element line may exceed the file's size.
@@ -77,8 +78,8 @@ void check_ply_header(const std::string& path) {
           big = big || n > bytes;
         }
         if (big)
-          fail(ErrorKind::Format, "{}: PLY header line \"{}\" declares more elements than the file's {} bytes can hold", path,
-               head.substr(line, std::min<size_t>(eol - line, 60)), bytes);
+          fail(ErrorKind::Format, "{}: PLY header line \"{}\" declares more elements than the file's {} bytes can hold",
+               path, head.substr(line, std::min<size_t>(eol - line, 60)), bytes);
       }
     line = eol + 1;
   }

@@ -20,7 +20,9 @@ struct RayTracer::Impl {
 
 RayTracer::RayTracer() : impl_(std::make_unique<Impl>()) {
   impl_->device = rtcNewDevice(nullptr);
-  if (!impl_->device) fail(ErrorKind::Internal, "Embree: cannot create a device (error {})", static_cast<int>(rtcGetDeviceError(nullptr)));
+  if (!impl_->device)
+    fail(ErrorKind::Internal, "Embree: cannot create a device (error {})",
+         static_cast<int>(rtcGetDeviceError(nullptr)));
   impl_->scene = rtcNewScene(impl_->device);
   rtcSetSceneBuildQuality(impl_->scene, RTC_BUILD_QUALITY_HIGH);
   rtcSetSceneFlags(impl_->scene, RTC_SCENE_FLAG_ROBUST);  // watertight: rays through shared edges hit
@@ -63,8 +65,9 @@ namespace {
 void fill_ray(RTCRay& r, Vec3 o, Vec3 d, double tnear, double tfar) {
   constexpr double kEmbreeLarge = 1e18;
   if (!in_range(o, kEmbreeLarge) || !in_range(d, kEmbreeLarge) || !(tnear >= 0 && tnear < 3.0e38) || !(tfar >= tnear))
-    fail(ErrorKind::Value, "ray tracer: ray from ({}, {}, {}) along ({}, {}, {}), t in ({}, {}), is not finite or out of range",
-         o.x, o.y, o.z, d.x, d.y, d.z, tnear, tfar);
+    fail(ErrorKind::Value,
+         "ray tracer: ray from ({}, {}, {}) along ({}, {}, {}), t in ({}, {}), is not finite or out of range", o.x, o.y,
+         o.z, d.x, d.y, d.z, tnear, tfar);
   r.org_x = static_cast<float>(o.x);
   r.org_y = static_cast<float>(o.y);
   r.org_z = static_cast<float>(o.z);

@@ -11,9 +11,9 @@
 namespace ibl::geometry {
 
 struct Hit {
-  bool hit = false;     // false: the ray left the scene
-  double t = 0;         // distance along the (unit) ray direction
-  uint32_t mesh = 0;    // index of the mesh, in the order add() was called
+  bool hit = false;       // false: the ray left the scene
+  double t = 0;           // distance along the (unit) ray direction
+  uint32_t mesh = 0;      // index of the mesh, in the order add() was called
   uint32_t triangle = 0;  // triangle index inside that mesh
   double b1 = 0, b2 = 0;  // barycentric weights of the triangle's vertices 1 and 2
 };

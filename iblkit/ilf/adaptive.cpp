@@ -21,10 +21,12 @@ inline int level_coord(int i, int s, int n) { return int(std::min<int64_t>(int64
 AdaptiveGrid::AdaptiveGrid(const GridDesc& grid, int bands, int brick) : grid_(grid), bands_(bands), brick_(brick) {
   if (bands < 1 || bands > 16) fail(ErrorKind::Value, "adaptive SH grid: bands = {} outside [1, 16]", bands);
   require_box("adaptive SH grid: volume", grid.volume.min, grid.volume.max, true);
-  if (brick < kMinBrick || brick > kMaxBrick) fail(ErrorKind::Value, "adaptive SH grid: brick {} outside [{}, {}]", brick, kMinBrick, kMaxBrick);
+  if (brick < kMinBrick || brick > kMaxBrick)
+    fail(ErrorKind::Value, "adaptive SH grid: brick {} outside [{}, {}]", brick, kMinBrick, kMaxBrick);
   const int n[3] = {grid.nx, grid.ny, grid.nz};
   for (int a = 0; a < 3; ++a)
-    if (n[a] < 2 || n[a] > (1 << 20)) fail(ErrorKind::Value, "adaptive SH grid: {} points on axis {} outside [2, 2^20]", n[a], "xyz"[a]);
+    if (n[a] < 2 || n[a] > (1 << 20))
+      fail(ErrorKind::Value, "adaptive SH grid: {} points on axis {} outside [2, 2^20]", n[a], "xyz"[a]);
   for (int step = 1;; step *= 2) {
     Level L;
     L.step = step;
@@ -34,7 +36,8 @@ AdaptiveGrid::AdaptiveGrid(const GridDesc& grid, int bands, int brick) : grid_(g
       L.nb[a] = (L.n[a] + brick - 1) / brick;
       cells *= L.nb[a];
     }
-    require_allocation("adaptive SH grid: brick map", double(cells), sizeof(int32_t), "choose a coarser grid or larger bricks");
+    require_allocation("adaptive SH grid: brick map", double(cells), sizeof(int32_t),
+                       "choose a coarser grid or larger bricks");
     L.map.assign(size_t(cells), -1);
     levels_.push_back(std::move(L));
     const auto& last = levels_.back();
@@ -48,7 +51,8 @@ float* AdaptiveGrid::add_brick(int l, int bx, int by, int bz) {
   const int b[3] = {bx, by, bz};
   for (int a = 0; a < 3; ++a)
     if (b[a] < 0 || b[a] >= L.nb[a])
-      fail(ErrorKind::Value, "adaptive SH grid: brick ({}, {}, {}) lies outside level {}'s {}x{}x{} bricks", bx, by, bz, l, L.nb[0], L.nb[1], L.nb[2]);
+      fail(ErrorKind::Value, "adaptive SH grid: brick ({}, {}, {}) lies outside level {}'s {}x{}x{} bricks", bx, by, bz,
+           l, L.nb[0], L.nb[1], L.nb[2]);
   int32_t& slot = L.map[size_t((int64_t(bz) * L.nb[1] + by) * L.nb[0] + bx)];
   if (slot >= 0) fail(ErrorKind::Value, "adaptive SH grid: brick ({}, {}, {}) of level {} given twice", bx, by, bz, l);
   Brick br{};
@@ -91,7 +95,8 @@ CellAxes cell_of(const AdaptiveGrid::Level& L, int B, const double f[3]) {
 }
 
 size_t slot_of(const AdaptiveGrid::Level& L, const CellAxes& c, int corner) {
-  return size_t((int64_t(c.brick[corner >> 2][2]) * L.nb[1] + c.brick[(corner >> 1) & 1][1]) * L.nb[0] + c.brick[corner & 1][0]);
+  return size_t((int64_t(c.brick[corner >> 2][2]) * L.nb[1] + c.brick[(corner >> 1) & 1][1]) * L.nb[0] +
+                c.brick[corner & 1][0]);
 }
 
 void clamp_index(const GridDesc& g, const double in[3], double out[3]) {
@@ -150,7 +155,8 @@ int AdaptiveGrid::lookup_in(const double cell_in[3], const double f_in[3], doubl
 }
 
 Vec3 AdaptiveGrid::fine_index(Vec3 p) const {
-  if (!is_finite(p)) fail(ErrorKind::Value, "adaptive SH grid lookup: the point ({}, {}, {}) is not finite", p.x, p.y, p.z);
+  if (!is_finite(p))
+    fail(ErrorKind::Value, "adaptive SH grid lookup: the point ({}, {}, {}) is not finite", p.x, p.y, p.z);
   Vec3 s = grid_.volume.size();
   return {(p.x - grid_.volume.min.x) / s.x * (grid_.nx - 1), (p.y - grid_.volume.min.y) / s.y * (grid_.ny - 1),
           (p.z - grid_.volume.min.z) / s.z * (grid_.nz - 1)};
@@ -164,7 +170,8 @@ sh::Coeffs AdaptiveGrid::coeffs_at(Vec3 p) const {
   sh::Coeffs out;
   out.bands = bands_;
   out.c.resize(size_t(coeff_count()));
-  for (int k = 0; k < coeff_count(); ++k) out.c[size_t(k)] = {v[3 * size_t(k)], v[3 * size_t(k) + 1], v[3 * size_t(k) + 2]};
+  for (int k = 0; k < coeff_count(); ++k)
+    out.c[size_t(k)] = {v[3 * size_t(k)], v[3 * size_t(k) + 1], v[3 * size_t(k) + 2]};
   return out;
 }
 
@@ -192,7 +199,8 @@ SHGrid AdaptiveGrid::to_dense(int nx, int ny, int nz) const {
     for (int i = 0; i < nx; ++i) {
       const int ijk[3] = {i, j, k};
       double f[3];
-      for (int a = 0; a < 3; ++a) f[a] = double(ijk[a]) * (n[a] - 1) / (N[a] - 1);  // = i exactly at the fine resolution
+      for (int a = 0; a < 3; ++a)
+        f[a] = double(ijk[a]) * (n[a] - 1) / (N[a] - 1);  // = i exactly at the fine resolution
       lookup(f, v.data());
       float* dst = out.at(i, j, k);
       for (int q = 0; q < KC; ++q) dst[q] = float(v[size_t(q)]);
@@ -202,7 +210,8 @@ SHGrid AdaptiveGrid::to_dense(int nx, int ny, int nz) const {
 }
 
 AdaptiveGrid make_adaptive(const SHGrid& fine, const AdaptDesc& desc) {
-  if (!fine.content().empty()) fail(ErrorKind::Value, "adaptive SH grid: the grid holds \"{}\", not radiance SH", fine.content());
+  if (!fine.content().empty())
+    fail(ErrorKind::Value, "adaptive SH grid: the grid holds \"{}\", not radiance SH", fine.content());
   if (fine.data().empty()) fail(ErrorKind::Value, "adaptive SH grid: the fine grid is empty");
   require_number("adaptive SH grid: tolerance", desc.tolerance, 0, 1e6);
   const GridDesc& gd = fine.grid();
@@ -221,7 +230,8 @@ AdaptiveGrid make_adaptive(const SHGrid& fine, const AdaptDesc& desc) {
     for (int z = 0; z < br.extent[2]; ++z)
       for (int y = 0; y < br.extent[1]; ++y)
         for (int x = 0; x < br.extent[0]; ++x) {
-          const float* src = fine.at(level_coord(b[0] * desc.brick + x, L.step, n[0]), level_coord(b[1] * desc.brick + y, L.step, n[1]),
+          const float* src = fine.at(level_coord(b[0] * desc.brick + x, L.step, n[0]),
+                                     level_coord(b[1] * desc.brick + y, L.step, n[1]),
                                      level_coord(b[2] * desc.brick + z, L.step, n[2]));
           std::copy(src, src + KC, dst + size_t((int64_t(z) * br.extent[1] + y) * br.extent[0] + x) * KC);
         }

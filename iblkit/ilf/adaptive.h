@@ -39,10 +39,10 @@ class AdaptiveGrid {
     size_t offset;  // of its first value in data(); values at ((z·ey + y)·ex + x)·K·3 + k·3 + c
   };
   struct Level {
-    int step = 1;                // fine points between this level's points (the last cell may be shorter)
-    int n[3] = {2, 2, 2};        // points per axis: ⌈(fine − 1)/step⌉ + 1
-    int nb[3] = {1, 1, 1};       // bricks per axis: ⌈n/brick⌉
-    std::vector<int32_t> map;    // brick index per brick-grid cell (x fastest), −1 where pruned
+    int step = 1;              // fine points between this level's points (the last cell may be shorter)
+    int n[3] = {2, 2, 2};      // points per axis: ⌈(fine − 1)/step⌉ + 1
+    int nb[3] = {1, 1, 1};     // bricks per axis: ⌈n/brick⌉
+    std::vector<int32_t> map;  // brick index per brick-grid cell (x fastest), −1 where pruned
     std::vector<Brick> bricks;
   };
 
@@ -63,7 +63,10 @@ class AdaptiveGrid {
   // What make_adaptive was asked for and measured (header fields "tolerance", "rms"; 0 when unknown).
   double tolerance() const { return tolerance_; }
   double rms() const { return rms_; }
-  void set_tolerance(double tolerance, double rms) { tolerance_ = tolerance; rms_ = rms; }
+  void set_tolerance(double tolerance, double rms) {
+    tolerance_ = tolerance;
+    rms_ = rms;
+  }
 
   // Adds brick (bx, by, bz) of level l and returns its values to fill (zeros); fails where it exists
   // or lies outside the level.

@@ -8,8 +8,8 @@
 #include "iblkit/core/atomic_file.h"
 #include "iblkit/core/check.h"
 #include "iblkit/core/error.h"
-#include "iblkit/ilf/grid_header.h"
 #include "iblkit/ilf/adaptive.h"
+#include "iblkit/ilf/grid_header.h"
 
 namespace ibl::ilf {
 using nlohmann::json;
@@ -17,7 +17,8 @@ using nlohmann::json;
 namespace {
 
 constexpr const char* kMagic = "IBLKIT-SHTREE 1";
-constexpr const char* kLayout = "levels top first; per level: bricks int32 x,y,z, then each brick's values z,y,x,coefficient,channel";
+constexpr const char* kLayout =
+    "levels top first; per level: bricks int32 x,y,z, then each brick's values z,y,x,coefficient,channel";
 
 // Lines 1 and 2, line 2 padded with spaces so that the data starts at a multiple of 64 bytes.
 std::string header_of(const AdaptiveGrid& g) {
@@ -67,7 +68,8 @@ void write_adaptive(const std::string& path, const AdaptiveGrid& g) {
     for (const auto& b : L.bricks) table.insert(table.end(), {b.b[0], b.b[1], b.b[2]});
     out.write(reinterpret_cast<const char*>(table.data()), std::streamsize(table.size() * 4));
     for (const auto& b : L.bricks)
-      out.write(reinterpret_cast<const char*>(g.data().data() + b.offset), std::streamsize(size_t(brick_points(b)) * KC * 4));
+      out.write(reinterpret_cast<const char*>(g.data().data() + b.offset),
+                std::streamsize(size_t(brick_points(b)) * KC * 4));
   }
   out.close();
   if (!out) fail(ErrorKind::Io, "{}: write failed", path);
@@ -100,10 +102,14 @@ AdaptiveGrid read_adaptive(const std::string& path) {
     tolerance = need("tolerance").get<double>();
     rms = need("rms").get<double>();
     std::vector<int> r;
-    for (int64_t n : grid_header_integers(need("resolution"), path, "resolution", 0, 1 << 30)) r.push_back(static_cast<int>(n));
+    for (int64_t n : grid_header_integers(need("resolution"), path, "resolution", 0, 1 << 30))
+      r.push_back(static_cast<int>(n));
     auto mn = need("min").get<std::vector<double>>(), mx = need("max").get<std::vector<double>>();
-    if (r.size() != 3 || mn.size() != 3 || mx.size() != 3) fail(ErrorKind::Format, "{}: \"resolution\", \"min\", \"max\" need 3 values", path);
-    gd.nx = r[0]; gd.ny = r[1]; gd.nz = r[2];
+    if (r.size() != 3 || mn.size() != 3 || mx.size() != 3)
+      fail(ErrorKind::Format, "{}: \"resolution\", \"min\", \"max\" need 3 values", path);
+    gd.nx = r[0];
+    gd.ny = r[1];
+    gd.nz = r[2];
     gd.volume = {{mn[0], mn[1], mn[2]}, {mx[0], mx[1], mx[2]}};
   } catch (const json::exception& e) {
     fail(ErrorKind::Format, "{}: header field of the wrong type ({})", path, e.what());
@@ -111,35 +117,48 @@ AdaptiveGrid read_adaptive(const std::string& path) {
   if (off % 64 != 0) fail(ErrorKind::Format, "{}: data does not start at a multiple of 64 bytes", path);
   for (int a = 0; a < 3; ++a) {
     int n = a == 0 ? gd.nx : a == 1 ? gd.ny : gd.nz;
-    if (n < 2 || n > 65536) fail(ErrorKind::Format, "{}: header field \"resolution\" {}x{}x{}: each axis must be in [2, 65536]", path, gd.nx, gd.ny, gd.nz);
+    if (n < 2 || n > 65536)
+      fail(ErrorKind::Format, "{}: header field \"resolution\" {}x{}x{}: each axis must be in [2, 65536]", path, gd.nx,
+           gd.ny, gd.nz);
   }
   if (bands < 1 || bands > 16) fail(ErrorKind::Format, "{}: header field \"bands\" = {} outside [1, 16]", path, bands);
-  if (brick < kMinBrick || brick > kMaxBrick) fail(ErrorKind::Format, "{}: header field \"brick\" = {} outside [{}, {}]", path, brick, kMinBrick, kMaxBrick);
-  if (!std::isfinite(tolerance) || tolerance < 0) fail(ErrorKind::Format, "{}: header field \"tolerance\" = {} is not a finite number ≥ 0", path, tolerance);
-  if (!std::isfinite(rms) || rms < 0) fail(ErrorKind::Format, "{}: header field \"rms\" = {} is not a finite number ≥ 0", path, rms);
+  if (brick < kMinBrick || brick > kMaxBrick)
+    fail(ErrorKind::Format, "{}: header field \"brick\" = {} outside [{}, {}]", path, brick, kMinBrick, kMaxBrick);
+  if (!std::isfinite(tolerance) || tolerance < 0)
+    fail(ErrorKind::Format, "{}: header field \"tolerance\" = {} is not a finite number ≥ 0", path, tolerance);
+  if (!std::isfinite(rms) || rms < 0)
+    fail(ErrorKind::Format, "{}: header field \"rms\" = {} is not a finite number ≥ 0", path, rms);
   if (!is_finite(gd.volume.min) || !is_finite(gd.volume.max) || !in_range(gd.volume.min) || !in_range(gd.volume.max))
-    fail(ErrorKind::Format, "{}: header fields \"min\", \"max\" must be finite and within ±{:g} m", path, kMaxCoordinate);
+    fail(ErrorKind::Format, "{}: header fields \"min\", \"max\" must be finite and within ±{:g} m", path,
+         kMaxCoordinate);
   for (int a = 0; a < 3; ++a)
-    if (!(gd.volume.max[a] > gd.volume.min[a])) fail(ErrorKind::Format, "{}: header fields \"min\", \"max\": max must exceed min on axis {}", path, "xyz"[a]);
+    if (!(gd.volume.max[a] > gd.volume.min[a]))
+      fail(ErrorKind::Format, "{}: header fields \"min\", \"max\": max must exceed min on axis {}", path, "xyz"[a]);
   std::error_code ec;
   const double file_bytes = double(std::filesystem::file_size(path, ec));
   if (ec) fail(ErrorKind::Io, "{}: cannot stat ({})", path, ec.message());
   // The brick maps are a fraction 1/brick³ of the fine points: bound them by the file's size too (a
   // hostile resolution must not allocate).
   if (double(gd.count()) / (double(brick) * brick * brick) > std::max(64 * file_bytes, double(1 << 24)))
-    fail(ErrorKind::Format, "{}: header field \"resolution\" {}x{}x{} is implausibly large for a file of {:.0f} bytes", path, gd.nx, gd.ny,
-         gd.nz, file_bytes);
+    fail(ErrorKind::Format, "{}: header field \"resolution\" {}x{}x{} is implausibly large for a file of {:.0f} bytes",
+         path, gd.nx, gd.ny, gd.nz, file_bytes);
   AdaptiveGrid g(gd, bands, brick);
   g.set_tolerance(tolerance, rms);
   if (levels != g.levels())
-    fail(ErrorKind::Format, "{}: header field \"levels\" = {}, but a {}x{}x{} grid has {} levels", path, levels, gd.nx, gd.ny, gd.nz, g.levels());
-  if (counts.size() != size_t(levels)) fail(ErrorKind::Format, "{}: header field \"bricks\" has {} entries, not one per level ({})", path, counts.size(), levels);
+    fail(ErrorKind::Format, "{}: header field \"levels\" = {}, but a {}x{}x{} grid has {} levels", path, levels, gd.nx,
+         gd.ny, gd.nz, g.levels());
+  if (counts.size() != size_t(levels))
+    fail(ErrorKind::Format, "{}: header field \"bricks\" has {} entries, not one per level ({})", path, counts.size(),
+         levels);
   for (int l = 0; l < levels; ++l) {
     const auto& L = g.level(l);
     if (counts[size_t(l)] < 0 || counts[size_t(l)] > int64_t(L.map.size()))
-      fail(ErrorKind::Format, "{}: header field \"bricks\": level {} has {} bricks, outside [0, {}]", path, l, counts[size_t(l)], L.map.size());
+      fail(ErrorKind::Format, "{}: header field \"bricks\": level {} has {} bricks, outside [0, {}]", path, l,
+           counts[size_t(l)], L.map.size());
   }
-  if (counts.back() != 1) fail(ErrorKind::Format, "{}: header field \"bricks\": the top level needs its one brick, not {}", path, counts.back());
+  if (counts.back() != 1)
+    fail(ErrorKind::Format, "{}: header field \"bricks\": the top level needs its one brick, not {}", path,
+         counts.back());
   const int KC = bands * bands * 3;
   double pos = double(off);
   in.seekg(std::streamoff(off));
@@ -147,10 +166,12 @@ AdaptiveGrid read_adaptive(const std::string& path) {
     const auto& L = g.level(l);
     const int64_t count = counts[size_t(l)];
     if (double(count) * (12 + 4.0 * KC) > file_bytes - pos)  // each brick: its entry and at least one point
-      fail(ErrorKind::Format, "{}: truncated: level {}'s {} bricks need more than the {:.0f} bytes left", path, l, count, std::max(0.0, file_bytes - pos));
+      fail(ErrorKind::Format, "{}: truncated: level {}'s {} bricks need more than the {:.0f} bytes left", path, l,
+           count, std::max(0.0, file_bytes - pos));
     std::vector<int32_t> table(size_t(count) * 3);
     in.read(reinterpret_cast<char*>(table.data()), std::streamsize(table.size() * 4));
-    if (size_t(in.gcount()) != table.size() * 4) fail(ErrorKind::Format, "{}: truncated in level {}'s brick table", path, l);
+    if (size_t(in.gcount()) != table.size() * 4)
+      fail(ErrorKind::Format, "{}: truncated in level {}'s brick table", path, l);
     pos += double(table.size()) * 4;
     double values = 0;
     std::vector<char> seen(L.map.size(), 0);
@@ -159,8 +180,8 @@ AdaptiveGrid read_adaptive(const std::string& path) {
       double pts = 1;
       for (int a = 0; a < 3; ++a) {
         if (b[a] < 0 || b[a] >= L.nb[a])
-          fail(ErrorKind::Format, "{}: level {} brick {}: coordinates ({}, {}, {}) outside its {}x{}x{} bricks", path, l, i, b[0], b[1], b[2],
-               L.nb[0], L.nb[1], L.nb[2]);
+          fail(ErrorKind::Format, "{}: level {} brick {}: coordinates ({}, {}, {}) outside its {}x{}x{} bricks", path,
+               l, i, b[0], b[1], b[2], L.nb[0], L.nb[1], L.nb[2]);
         pts *= std::min(brick, L.n[a] - b[a] * brick);
       }
       char& s = seen[size_t((int64_t(b[2]) * L.nb[1] + b[1]) * L.nb[0] + b[0])];
@@ -169,8 +190,8 @@ AdaptiveGrid read_adaptive(const std::string& path) {
       values += pts * KC;
     }
     if (values * 4 > file_bytes - pos)
-      fail(ErrorKind::Format, "{}: truncated: level {}'s bricks declare {:.0f} data bytes, the file holds {:.0f} more", path, l, values * 4,
-           std::max(0.0, file_bytes - pos));
+      fail(ErrorKind::Format, "{}: truncated: level {}'s bricks declare {:.0f} data bytes, the file holds {:.0f} more",
+           path, l, values * 4, std::max(0.0, file_bytes - pos));
     for (int64_t i = 0; i < count; ++i) {
       const int32_t* b = &table[size_t(i) * 3];
       float* dst = g.add_brick(l, b[0], b[1], b[2]);
@@ -179,13 +200,16 @@ AdaptiveGrid read_adaptive(const std::string& path) {
       in.read(reinterpret_cast<char*>(dst), std::streamsize(n * 4));
       if (size_t(in.gcount()) != n * 4) fail(ErrorKind::Format, "{}: truncated in level {} brick {}", path, l, i);
       for (size_t q = 0; q < n; ++q)
-        if (!std::isfinite(dst[q])) fail(ErrorKind::Value, "{}: level {} brick {}: value {} is not finite", path, l, i, q);
+        if (!std::isfinite(dst[q]))
+          fail(ErrorKind::Value, "{}: level {} brick {}: value {} is not finite", path, l, i, q);
       pos += double(n) * 4;
     }
   }
   return g;
 }
 
-SHGrid read_dense(const std::string& path) { return is_adaptive_file(path) ? read_adaptive(path).to_dense() : read_shgrid(path); }
+SHGrid read_dense(const std::string& path) {
+  return is_adaptive_file(path) ? read_adaptive(path).to_dense() : read_shgrid(path);
+}
 
 }  // namespace ibl::ilf

@@ -122,7 +122,8 @@ TEST(Adaptive, ToleranceBoundHoldsEverywhereAndTheBumpIsRefined) {
         double e = 0;
         for (int k = 0; k < 4; ++k)
           for (int ch = 0; ch < 3; ++ch) e += std::pow(a.c[size_t(k)][ch] - b.c[size_t(k)][ch], 2);
-        ASSERT_LE(std::sqrt(e), tol * rms * (1 + 1e-6) + 1e-6) << "brick " << brick << " tolerance " << tol << " point " << i;
+        ASSERT_LE(std::sqrt(e), tol * rms * (1 + 1e-6) + 1e-6)
+            << "brick " << brick << " tolerance " << tol << " point " << i;
       }
       // The bump's centre is answered at full resolution, a far corner of the smooth part is not.
       EXPECT_EQ(t.level_at({0.3, 0.2, 0.6}), 0) << "brick " << brick << " tolerance " << tol;
@@ -201,23 +202,31 @@ TEST(Adaptive, HostileFilesGiveOneLineErrorsNamingTheFileAndField) {
   // Counts that lie: more level-0 bricks than the file holds; a top level without its brick.
   const auto& L0 = t.level(0);
   std::string counts = "\"bricks\":[" + std::to_string(L0.bricks.size());
-  expect(with_header(bytes, replace(hdr, counts, "\"bricks\":[" + std::to_string(L0.map.size()))), {bad, "level 0"});  // truncated, or values read as coordinates
-  expect(with_header(bytes, replace(hdr, counts, "\"bricks\":[" + std::to_string(L0.map.size() + 1))), {bad, "\"bricks\"", "level 0"});
+  expect(with_header(bytes, replace(hdr, counts, "\"bricks\":[" + std::to_string(L0.map.size()))),
+         {bad, "level 0"});  // truncated, or values read as coordinates
+  expect(with_header(bytes, replace(hdr, counts, "\"bricks\":[" + std::to_string(L0.map.size() + 1))),
+         {bad, "\"bricks\"", "level 0"});
   expect(with_header(bytes, replace(hdr, counts, "\"bricks\":[-1")), {bad, "\"bricks\""});
-  expect(with_header(bytes, replace(hdr, "\"levels\":" + std::to_string(t.levels()), "\"levels\":2")), {bad, "\"levels\" = 2"});
-  expect(with_header(bytes, replace(hdr, "\"resolution\":[33,17,25]", "\"resolution\":[65536,65536,65536]")), {bad, "\"resolution\"", "implausibly large"});
-  expect(with_header(bytes, replace(hdr, "\"resolution\":[33,17,25]", "\"resolution\":[1,17,25]")), {bad, "\"resolution\""});
+  expect(with_header(bytes, replace(hdr, "\"levels\":" + std::to_string(t.levels()), "\"levels\":2")),
+         {bad, "\"levels\" = 2"});
+  expect(with_header(bytes, replace(hdr, "\"resolution\":[33,17,25]", "\"resolution\":[65536,65536,65536]")),
+         {bad, "\"resolution\"", "implausibly large"});
+  expect(with_header(bytes, replace(hdr, "\"resolution\":[33,17,25]", "\"resolution\":[1,17,25]")),
+         {bad, "\"resolution\""});
   expect(with_header(bytes, replace(hdr, "\"brick\":4", "\"brick\":99")), {bad, "\"brick\" = 99"});
   expect(with_header(bytes, replace(hdr, "\"bands\":2", "\"bands\":0")), {bad, "\"bands\" = 0"});
-  expect(with_header(bytes, replace(hdr, "\"min\":[0.0,0.0,0.0]", "\"min\":[-1e308,0.0,0.0]")), {bad, "\"min\", \"max\""});
-  expect(with_header(bytes, replace(hdr, "\"min\":[0.0,0.0,0.0]", "\"min\":[5.0,0.0,0.0]")), {bad, "max must exceed min"});
+  expect(with_header(bytes, replace(hdr, "\"min\":[0.0,0.0,0.0]", "\"min\":[-1e308,0.0,0.0]")),
+         {bad, "\"min\", \"max\""});
+  expect(with_header(bytes, replace(hdr, "\"min\":[0.0,0.0,0.0]", "\"min\":[5.0,0.0,0.0]")),
+         {bad, "max must exceed min"});
   expect(with_header(bytes, replace(hdr, "\"tolerance\":0.01", "\"tolerance\":-1")), {bad, "\"tolerance\""});
   // Numbers that are not integers, or too large for one, are refused before any conversion (fuzz_shtree
   // found "bricks" holding 8.9e61, which reached a float-to-integer cast: undefined behaviour).
   expect(with_header(bytes, replace(hdr, counts, "\"bricks\":[8.9e61")), {bad, "\"bricks\"", "not an integer"});
   expect(with_header(bytes, replace(hdr, "\"bands\":2", "\"bands\":1e30")), {bad, "\"bands\"", "not an integer"});
   expect(with_header(bytes, replace(hdr, "\"brick\":4", "\"brick\":4.5")), {bad, "\"brick\"", "not an integer"});
-  expect(with_header(bytes, replace(hdr, "\"resolution\":[33,17,25]", "\"resolution\":[33,1e40,25]")), {bad, "\"resolution\"", "not an integer"});
+  expect(with_header(bytes, replace(hdr, "\"resolution\":[33,17,25]", "\"resolution\":[33,1e40,25]")),
+         {bad, "\"resolution\"", "not an integer"});
   // The top level's brick at coordinates outside its one-brick grid.
   std::string moved = bytes;
   int32_t five = 5;
@@ -248,7 +257,12 @@ TEST(Adaptive, ArgumentsAreChecked) {
   expect_error([&] { make_adaptive(err, {}); }, "cv-error");
   AdaptiveGrid t = make_adaptive(fine, {});
   expect_error([&] { t.coeffs_at({NAN, 0, 0}); }, "not finite");
-  expect_error([&] { t.add_brick(0, 0, 0, 0); t.add_brick(0, 0, 0, 0); }, "given twice");
+  expect_error(
+      [&] {
+        t.add_brick(0, 0, 0, 0);
+        t.add_brick(0, 0, 0, 0);
+      },
+      "given twice");
   AdaptiveGrid empty(fine.grid(), 2, 4);  // levels but no bricks: a lookup has nothing to answer from
   expect_error([&] { empty.coeffs_at({0.5, 0.25, 0.5}); }, "top level has no brick");
   expect_error([&] { AdaptiveGrid(GridDesc{4, 4, 4, {{0, 0, 0}, {1, 0, 1}}}, 2, 4); }, "max must exceed min");

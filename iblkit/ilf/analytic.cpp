@@ -41,7 +41,10 @@ Vec3 AnalyticField::radiance(Vec3 x, Vec3 w) const {
     double b = dot(oc, w), cc = dot(oc, oc) - s.radius * s.radius, disc = b * b - cc;
     if (disc < 0) continue;
     double t = -b - std::sqrt(disc);
-    if (t > 0 && t < best) { best = t; out = s.radiance; }
+    if (t > 0 && t < best) {
+      best = t;
+      out = s.radiance;
+    }
   }
   if (best < 1e300) return out;
   if (w.y >= 0) return sky_horizon + (sky_zenith - sky_horizon) * w.y;
@@ -68,7 +71,7 @@ Image AnalyticField::render_probe(const Sequence& seq, int width, int height, Ve
 }
 
 std::vector<sh::Coeffs> AnalyticField::exact_sh(const std::vector<Vec3>& xs, int bands, const Sequence& seq, int n,
-                                                 int ss) const {
+                                                int ss) const {
   int K = bands * bands;
   double cos_dead = std::cos(seq.dead_angle_deg * kPi / 180);
   bool dead = seq.mapping == sphere::MappingKind::MirrorBall && seq.dead_angle_deg > 0;

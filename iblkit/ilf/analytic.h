@@ -42,13 +42,13 @@ struct AnalyticField {
 };
 
 struct SynthDesc {
-  std::string out_dir;           // folder for frames/ and sequence.json (created)
-  int probes = 200;              // number of probes
-  int size = 64;                 // frame width = height (mirror ball)
-  int supersample = 3;           // ss × ss sub-samples per pixel (a camera integrates over its pixels)
-  double dead_angle_deg = 4.2;   // mirror-ball dead angle
-  uint64_t seed = 1;             // random positions
-  bool half = true;              // frames as half-float EXR (else float PFM)
+  std::string out_dir;          // folder for frames/ and sequence.json (created)
+  int probes = 200;             // number of probes
+  int size = 64;                // frame width = height (mirror ball)
+  int supersample = 3;          // ss × ss sub-samples per pixel (a camera integrates over its pixels)
+  double dead_angle_deg = 4.2;  // mirror-ball dead angle
+  uint64_t seed = 1;            // random positions
+  bool half = true;             // frames as half-float EXR (else float PFM)
   Box volume{{-0.5, -0.5, -0.5}, {0.5, 0.5, 0.5}};  // positions are uniform random in it
 };
 

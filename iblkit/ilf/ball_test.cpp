@@ -103,8 +103,9 @@ TEST(IlfBall, ManifestFieldsAndDirectionTable) {
   auto d = temp_dir("manifest");
   auto m = d + "/s.json";
   auto write = [&](const std::string& extra) {
-    std::ofstream(m) << R"({"format":"iblkit.sequence/1","mapping":"mirrorball",)" << extra
-                     << R"("volume":{"min":[0,0,0],"max":[1,1,1]},"probes":[{"image":"a.exr","position":[0.5,0.5,0.5]}]})";
+    std::ofstream(m)
+        << R"({"format":"iblkit.sequence/1","mapping":"mirrorball",)" << extra
+        << R"("volume":{"min":[0,0,0],"max":[1,1,1]},"probes":[{"image":"a.exr","position":[0.5,0.5,0.5]}]})";
   };
   write(R"("ball_radius":-1,)");
   expect_error([&] { read_sequence(m); }, {"\"ball_radius\"", "outside"});
@@ -114,7 +115,8 @@ TEST(IlfBall, ManifestFieldsAndDirectionTable) {
   expect_error([&] { read_sequence(m); }, {"\"ball_distance\"", "below it"});
   write(R"("ball_distance":0.5,)");
   expect_error([&] { read_sequence(m); }, {"\"ball_distance\""});
-  std::ofstream(m) << R"({"format":"iblkit.sequence/1","mapping":"latlong","ball_radius":0.05,"volume":{"min":[0,0,0],"max":[1,1,1]},"probes":[{"image":"a.exr","position":[0.5,0.5,0.5]}]})";
+  std::ofstream(m)
+      << R"({"format":"iblkit.sequence/1","mapping":"latlong","ball_radius":0.05,"volume":{"min":[0,0,0],"max":[1,1,1]},"probes":[{"image":"a.exr","position":[0.5,0.5,0.5]}]})";
   expect_error([&] { read_sequence(m); }, {"mirrorball"});
   write(R"("ball_radius":0.05,"ball_distance":0.6,)");
   Sequence seq = read_sequence(m);

@@ -1,7 +1,7 @@
 #include "iblkit/ilf/buckets.h"
 
-#include <algorithm>
 #include <Imath/half.h>
+#include <algorithm>
 
 #include <atomic>
 #include <chrono>
@@ -40,7 +40,13 @@ DirectionTable make_direction_table(const Sequence& seq, int width, int height, 
   int n = desc.octahedral;
   if (n < 0 || n > 4096) fail(ErrorKind::Value, "direction buckets: octahedral resolution {} outside [0, 4096]", n);
   sphere::Mapping oct(sphere::MappingKind::Octahedral, std::max(n, 1), std::max(n, 1));
-  struct Slot { int64_t bucket; int32_t pixel; Vec3 d; double w; Vec3 s; };
+  struct Slot {
+    int64_t bucket;
+    int32_t pixel;
+    Vec3 d;
+    double w;
+    Vec3 s;
+  };
   std::vector<Slot> slots;
   bool ball = seq.mapping == sphere::MappingKind::MirrorBall && (seq.ball.radius > 0 || seq.ball.distance > 0);
   bool perspective = ball && seq.ball.distance > seq.ball.radius && seq.ball.radius > 0;
@@ -68,7 +74,9 @@ DirectionTable make_direction_table(const Sequence& seq, int width, int height, 
       }
       slots.push_back({b, int32_t(int64_t(y) * width + x), d, w, s});
     }
-  if (slots.empty()) fail(ErrorKind::Value, "{}: frames of {}x{} in mapping {} carry no directions", seq.manifest, width, height, sphere::mapping_name(seq.mapping));
+  if (slots.empty())
+    fail(ErrorKind::Value, "{}: frames of {}x{} in mapping {} carry no directions", seq.manifest, width, height,
+         sphere::mapping_name(seq.mapping));
   std::stable_sort(slots.begin(), slots.end(), [](const Slot& a, const Slot& b) { return a.bucket < b.bucket; });
   DirectionTable t;
   t.width = width;
@@ -115,12 +123,16 @@ bool is_cache_file(const fs::path& p) {
 std::string bucket_cache_key(const Sequence& seq, const BucketDesc& desc, int w, int h) {
   uint64_t hsh = 1469598103934665603ull;
   auto mix = [&](const std::string& s) {
-    for (unsigned char c : s) { hsh ^= c; hsh *= 1099511628211ull; }
+    for (unsigned char c : s) {
+      hsh ^= c;
+      hsh *= 1099511628211ull;
+    }
   };
   mix(fmt::format("v1 {} {} {} {} {} {} {} {} {}", sphere::mapping_name(seq.mapping), seq.dead_angle_deg, w, h,
                   desc.octahedral, desc.max_block_buckets, desc.memory_bytes, desc.skip_bad, desc.sanitize));
   if (seq.ball.radius > 0 || seq.ball.distance > 0) mix(fmt::format("ball {} {}", seq.ball.radius, seq.ball.distance));
-  for (int a = 0; a < 3; ++a) mix(fmt::format("{} {} {}", seq.rotation.m[a][0], seq.rotation.m[a][1], seq.rotation.m[a][2]));
+  for (int a = 0; a < 3; ++a)
+    mix(fmt::format("{} {} {}", seq.rotation.m[a][0], seq.rotation.m[a][1], seq.rotation.m[a][2]));
   for (const auto& p : seq.probes) {
     std::error_code ec;
     auto sz = fs::file_size(p.image, ec);
@@ -154,7 +166,8 @@ std::string read_probe_samples(const Sequence& seq, int p, const DirectionTable&
   try {
     img = io::read_image(pe.image, {desc.sanitize, 3});
     if (img.width() != t.width || img.height() != t.height)
-      bad = fmt::format("field \"image\": {} is {}x{}, the sequence's frames are {}x{}", pe.image, img.width(), img.height(), t.width, t.height);
+      bad = fmt::format("field \"image\": {} is {}x{}, the sequence's frames are {}x{}", pe.image, img.width(),
+                        img.height(), t.width, t.height);
   } catch (const Error& e) {
     bad = fmt::format("field \"image\": {}", e.what());
   }
@@ -183,7 +196,8 @@ void scatter_probe_samples(const DirectionTable& t, const float* rgb, int pc, in
 BucketStore BucketStore::open(const std::string& dir, DirectionTable table, int probe_count, int chunk,
                               std::vector<uint8_t> valid) {
   if (probe_count < 1 || chunk < 1 || int(valid.size()) != probe_count)
-    fail(ErrorKind::Internal, "{}: bucket store of {} probes in chunks of {} with {} flags", dir, probe_count, chunk, valid.size());
+    fail(ErrorKind::Internal, "{}: bucket store of {} probes in chunks of {} with {} flags", dir, probe_count, chunk,
+         valid.size());
   BucketStore st;
   st.dir_ = dir;
   st.table_ = std::move(table);
@@ -239,7 +253,8 @@ BucketStore BucketStore::sort(const Sequence& seq, const BucketDesc& desc, const
       json j = json::parse(in);
       bool ok = j.value("key", "") == key && j.value("chunk", 0) == st.chunk_;
       for (int k = 0; ok && k < t.blocks(); ++k) {
-        size_t expect = size_t(t.bucket_begin[t.block_begin[k + 1]] - t.bucket_begin[t.block_begin[k]]) * st.probe_count_ * 6;
+        size_t expect =
+            size_t(t.bucket_begin[t.block_begin[k + 1]] - t.bucket_begin[t.block_begin[k]]) * st.probe_count_ * 6;
         ok = fs::exists(block_path(desc.dir, k)) && fs::file_size(block_path(desc.dir, k)) == expect;
       }
       if (ok) {
@@ -298,8 +313,9 @@ BucketStore BucketStore::sort(const Sequence& seq, const BucketDesc& desc, const
   }
   rep.read_seconds = read_s;
   if (rep.skipped == st.probe_count_) fail(ErrorKind::Value, "{}: every probe was skipped", seq.manifest);
-  json j = {{"key", key}, {"chunk", st.chunk_}, {"valid", st.valid_}, {"skipped", rep.skipped}, {"reasons", rep.reasons},
-            {"width", w}, {"height", h}, {"buckets", t.buckets()}, {"blocks", t.blocks()}};
+  json j = {
+      {"key", key}, {"chunk", st.chunk_}, {"valid", st.valid_},     {"skipped", rep.skipped}, {"reasons", rep.reasons},
+      {"width", w}, {"height", h},        {"buckets", t.buckets()}, {"blocks", t.blocks()}};
   write_json_file(index.string(), j, -1);
   ibl::report(progress, "sort", 1.0);
   return st;

@@ -19,26 +19,26 @@
 namespace ibl::ilf {
 
 struct BucketDesc {
-  std::string dir;                  // folder for the block files and index.json (created if missing)
-  int octahedral = 0;               // 0: one bucket per probe pixel; n > 0: n×n octahedral direction cells
-  int max_block_buckets = 64;       // most buckets in one block (the unit later stages process at once)
+  std::string dir;                        // folder for the block files and index.json (created if missing)
+  int octahedral = 0;                     // 0: one bucket per probe pixel; n > 0: n×n octahedral direction cells
+  int max_block_buckets = 64;             // most buckets in one block (the unit later stages process at once)
   size_t memory_bytes = size_t(2) << 30;  // peak memory budget of the whole build, bytes
-  bool skip_bad = false;            // frames that fail (unreadable, wrong size, NaN/Inf, all black) are skipped
-  bool sanitize = false;            // replace NaN/Inf/negative pixels by 0 instead of failing
-  bool reuse = true;                // reuse the block files of an identical earlier run
+  bool skip_bad = false;                  // frames that fail (unreadable, wrong size, NaN/Inf, all black) are skipped
+  bool sanitize = false;                  // replace NaN/Inf/negative pixels by 0 instead of failing
+  bool reuse = true;                      // reuse the block files of an identical earlier run
 };
 
 // Which probe pixels feed which bucket, their world directions and exact solid angles.
 struct DirectionTable {
-  int width = 0, height = 0;        // frame size every probe must have
-  std::vector<int32_t> pixel;       // per sample slot: pixel index y·width + x, ordered by bucket
-  std::vector<float> dir;           // per sample slot: world direction, 3 floats
-  std::vector<double> weight;       // per sample slot: exact solid angle of the pixel (sr)
-  std::vector<float> start;         // per sample slot: world offset of the ray's start from the probe
-                                    // position (its reflection point on the ball), 3 floats; empty for a
-                                    // single viewpoint (Sequence::ball.radius 0)
+  int width = 0, height = 0;          // frame size every probe must have
+  std::vector<int32_t> pixel;         // per sample slot: pixel index y·width + x, ordered by bucket
+  std::vector<float> dir;             // per sample slot: world direction, 3 floats
+  std::vector<double> weight;         // per sample slot: exact solid angle of the pixel (sr)
+  std::vector<float> start;           // per sample slot: world offset of the ray's start from the probe
+                                      // position (its reflection point on the ball), 3 floats; empty for a
+                                      // single viewpoint (Sequence::ball.radius 0)
   std::vector<int64_t> bucket_begin;  // bucket b owns slots [bucket_begin[b], bucket_begin[b+1])
-  std::vector<int> block_begin;     // block k owns buckets [block_begin[k], block_begin[k+1])
+  std::vector<int> block_begin;       // block k owns buckets [block_begin[k], block_begin[k+1])
   int buckets() const { return int(bucket_begin.size()) - 1; }
   int blocks() const { return int(block_begin.size()) - 1; }
   int64_t slots() const { return int64_t(pixel.size()); }
@@ -52,11 +52,11 @@ DirectionTable make_direction_table(const Sequence& seq, int width, int height, 
                                     int64_t probe_count);
 
 struct BucketReport {
-  int skipped = 0;                  // frames skipped (skip_bad)
-  std::vector<std::string> reasons; // one line per skipped frame
-  bool reused = false;              // block files of an earlier identical run were reused
-  double read_seconds = 0;          // time spent decoding frames
-  int64_t bytes_written = 0;        // size of the block files
+  int skipped = 0;                   // frames skipped (skip_bad)
+  std::vector<std::string> reasons;  // one line per skipped frame
+  bool reused = false;               // block files of an earlier identical run were reused
+  double read_seconds = 0;           // time spent decoding frames
+  int64_t bytes_written = 0;         // size of the block files
 };
 
 // The sorted samples on disk.

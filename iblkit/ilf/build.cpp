@@ -1,7 +1,7 @@
 #include "iblkit/ilf/build.h"
 
-#include <Eigen/Core>
 #include <tbb/enumerable_thread_specific.h>
+#include <Eigen/Core>
 
 #include <atomic>
 #include <chrono>
@@ -58,17 +58,19 @@ GridDesc build_grid(const Sequence& seq, const BuildDesc& desc) {
   if (desc.bands < kMinBuildBands || desc.bands > kMaxBuildBands)
     fail(ErrorKind::Value, "bands {} outside [{}, {}]", desc.bands, kMinBuildBands, kMaxBuildBands);
   if (!(desc.project.kernel_cells > 0))
-    fail(ErrorKind::Value, "kernel_cells {} must be > 0 (the kernel's support in grid cells)", desc.project.kernel_cells);
+    fail(ErrorKind::Value, "kernel_cells {} must be > 0 (the kernel's support in grid cells)",
+         desc.project.kernel_cells);
   if (!std::isfinite(desc.project.kernel_cells))
     fail(ErrorKind::Value, "kernel_cells {} must be a finite number of grid cells", desc.project.kernel_cells);
   GridDesc grid{desc.nx, desc.ny, desc.nz, desc.volume ? *desc.volume : seq.volume};
   SHGrid check(grid, 1);  // validates resolution and volume
   {  // project_bucket's raster per thread: the projected volume plus the kernel's support, at Δ = raster_cells·h
     Vec3 sp = grid.spacing();
-    double h = std::max({sp.x, sp.y, sp.z}), R = desc.project.kernel_cells * h / 2, delta = std::max(desc.project.raster_cells, 0.05) * h;
+    double h = std::max({sp.x, sp.y, sp.z}), R = desc.project.kernel_cells * h / 2,
+           delta = std::max(desc.project.raster_cells, 0.05) * h;
     double side = (length(grid.volume.size()) + 2 * (R + delta)) / delta + 1;
-    require_allocation(fmt::format("a kernel of {:g} grid cells (kernel_cells)", desc.project.kernel_cells), side * side, 16,
-                       "choose a smaller kernel_cells");
+    require_allocation(fmt::format("a kernel of {:g} grid cells (kernel_cells)", desc.project.kernel_cells),
+                       side * side, 16, "choose a smaller kernel_cells");
   }
   return grid;
 }
@@ -118,9 +120,9 @@ BlockStats project_block(const BucketStore& store, int k, const std::vector<uint
   return bs;
 }
 
-BlockWork resample_block(const BucketStore& store, int k, const GridDesc& grid, const ProjectDesc& desc, const std::vector<Vec3>& origins,
-                         int bands, bool ball_parallax, std::vector<uint16_t>& buf, std::vector<float>& R, BlockScratch& scratch,
-                         double* C) {
+BlockWork resample_block(const BucketStore& store, int k, const GridDesc& grid, const ProjectDesc& desc,
+                         const std::vector<Vec3>& origins, int bands, bool ball_parallax, std::vector<uint16_t>& buf,
+                         std::vector<float>& R, BlockScratch& scratch, double* C) {
   const DirectionTable& t = store.table();
   int64_t rows = 3 * grid.count();
   int K = bands * bands;
@@ -138,24 +140,36 @@ BlockWork resample_block(const BucketStore& store, int k, const GridDesc& grid, 
   return w;
 }
 
-void cross_validate_build(const BucketStore& store, const std::vector<Vec3>& origins, const BuildDesc& desc, GridDesc& grid,
-                          ProjectDesc& pd, BuildReport& rep, const CvShare& share) {
+void cross_validate_build(const BucketStore& store, const std::vector<Vec3>& origins, const BuildDesc& desc,
+                          GridDesc& grid, ProjectDesc& pd, BuildReport& rep, const CvShare& share) {
   if (desc.auto_kernel || desc.auto_grid) {  // cross-validated choice (ilf/crossval.h)
-    ResampleSearch rs{.kernel = desc.auto_kernel, .grid = desc.auto_grid, .volume = grid.volume, .nx = grid.nx, .ny = grid.ny,
-                      .nz = grid.nz, .kernel_cells = pd.kernel_cells, .bands = desc.bands, .memory_bytes = desc.buckets.memory_bytes,
+    ResampleSearch rs{.kernel = desc.auto_kernel,
+                      .grid = desc.auto_grid,
+                      .volume = grid.volume,
+                      .nx = grid.nx,
+                      .ny = grid.ny,
+                      .nz = grid.nz,
+                      .kernel_cells = pd.kernel_cells,
+                      .bands = desc.bands,
+                      .memory_bytes = desc.buckets.memory_bytes,
                       .max_buckets = desc.auto_max_buckets};
     rep.choice = choose_resampling(store, origins, pd, rs, desc.crossval, desc.ball_parallax, share);
     rep.t_choose = rep.choice->seconds;
     pd.kernel_cells = rep.choice->kernel;
-    grid.nx = rep.choice->nx; grid.ny = rep.choice->ny; grid.nz = rep.choice->nz;
+    grid.nx = rep.choice->nx;
+    grid.ny = rep.choice->ny;
+    grid.nz = rep.choice->nz;
   }
-  rep.nx = grid.nx; rep.ny = grid.ny; rep.nz = grid.nz;
+  rep.nx = grid.nx;
+  rep.ny = grid.ny;
+  rep.nz = grid.nz;
   rep.kernel_cells = pd.kernel_cells;
-  if (rep.choice && desc.crossval.folds >= 2) rep.crossval = rep.choice->best;  // the chosen trial's
+  if (rep.choice && desc.crossval.folds >= 2)
+    rep.crossval = rep.choice->best;  // the chosen trial's
   else if (desc.crossval.folds >= 2) {
     auto tc = Clock::now();
-    rep.crossval = cross_validate(store, origins, grid, pd, desc.bands, desc.crossval, desc.auto_max_buckets, desc.ball_parallax,
-                                  &rep.crossval_buckets, share);
+    rep.crossval = cross_validate(store, origins, grid, pd, desc.bands, desc.crossval, desc.auto_max_buckets,
+                                  desc.ball_parallax, &rep.crossval_buckets, share);
     rep.t_crossval = since(tc);
   }
   if (rep.choice) rep.crossval_buckets = rep.choice->buckets_used;
@@ -166,10 +180,14 @@ void store_coefficients(const double* C, SHGrid& out) {
   int K = out.coeff_count();
   int64_t G = out.grid().count(), rows = 3 * G;
   auto& data = out.data();
-  parallel_for(0, G, [&](int64_t g) {
-    for (int kk = 0; kk < K; ++kk)
-      for (int c = 0; c < 3; ++c) data[(size_t(g) * K + kk) * 3 + c] = float(C[size_t(kk) * rows + size_t(c) * G + g]);
-  }, 1024);
+  parallel_for(
+      0, G,
+      [&](int64_t g) {
+        for (int kk = 0; kk < K; ++kk)
+          for (int c = 0; c < 3; ++c)
+            data[(size_t(g) * K + kk) * 3 + c] = float(C[size_t(kk) * rows + size_t(c) * G + g]);
+      },
+      1024);
 }
 
 SHGrid build_shgrid(const Sequence& seq_in, const BuildDesc& desc, const ProgressFn& progress, BuildReport* report) {

@@ -22,22 +22,22 @@ namespace ibl::ilf {
 inline constexpr int kMinBuildBands = 1, kMaxBuildBands = 10;
 
 struct BuildDesc {
-  int nx = 16, ny = 16, nz = 16;      // grid resolution (points per axis)
-  std::optional<Box> volume;          // grid volume; default the sequence's volume
-  int bands = 5;                      // SH bands (5 = 25 coefficients), in [kMinBuildBands, kMaxBuildBands]
-  ProjectDesc project;                // kernel, raster, repair
-  BucketDesc buckets{.octahedral = -1};  // bucket folder, memory budget, skip-bad; octahedral −1: auto (below)
-  int auto_pixel_buckets = 1 << 20;   // auto: one bucket per pixel when a frame has at most this many pixels
-  int auto_octahedral = 256;          // auto: otherwise n×n octahedral buckets with this n
+  int nx = 16, ny = 16, nz = 16;           // grid resolution (points per axis)
+  std::optional<Box> volume;               // grid volume; default the sequence's volume
+  int bands = 5;                           // SH bands (5 = 25 coefficients), in [kMinBuildBands, kMaxBuildBands]
+  ProjectDesc project;                     // kernel, raster, repair
+  BucketDesc buckets{.octahedral = -1};    // bucket folder, memory budget, skip-bad; octahedral −1: auto (below)
+  int auto_pixel_buckets = 1 << 20;        // auto: one bucket per pixel when a frame has at most this many pixels
+  int auto_octahedral = 256;               // auto: otherwise n×n octahedral buckets with this n
   std::optional<SubsampleDesc> subsample;  // sub-sample first when set
-  bool auto_kernel = false;           // choose project.kernel_cells by cross-validation (kAutoKernels)
-  bool auto_grid = false;             // choose the resolution by cross-validation (kAutoGrids; nx, ny, nz
-                                      // give the aspect; builds over half of buckets.memory_bytes not tried)
-  CrossValDesc crossval{.folds = 0};  // folds ≥ 2: report the cross-validated error (BuildReport::crossval)
-  int auto_max_buckets = 2048;        // cross-validation and the automatic choice use at most this many
-                                      // buckets (every s-th; all when there are fewer)
-  bool ball_parallax = true;          // start each ray at its reflection point on the ball (Sequence::ball);
-                                      // false: every ray through the probe position (single viewpoint)
+  bool auto_kernel = false;                // choose project.kernel_cells by cross-validation (kAutoKernels)
+  bool auto_grid = false;                  // choose the resolution by cross-validation (kAutoGrids; nx, ny, nz
+                                           // give the aspect; builds over half of buckets.memory_bytes not tried)
+  CrossValDesc crossval{.folds = 0};       // folds ≥ 2: report the cross-validated error (BuildReport::crossval)
+  int auto_max_buckets = 2048;             // cross-validation and the automatic choice use at most this many
+                                           // buckets (every s-th; all when there are fewer)
+  bool ball_parallax = true;               // start each ray at its reflection point on the ball (Sequence::ball);
+                                           // false: every ray through the probe position (single viewpoint)
 };
 
 struct BuildReport {
@@ -45,23 +45,23 @@ struct BuildReport {
   int skipped = 0;                     // probes skipped as bad (--skip-bad)
   int subsampled_out = 0;              // probes dropped by sub-sampling
   std::vector<std::string> skip_reasons;
-  int buckets = 0, blocks = 0;         // direction buckets and blocks
-  int octahedral = 0;                  // 0 = pixel buckets
-  int64_t samples = 0;                 // radiance samples (rays) used
-  int64_t uncovered = 0;               // (grid point, bucket) pairs filled by the repair
-  double fraction_uncovered = 0;       // uncovered / (grid points · buckets)
-  bool buckets_reused = false;         // an earlier run's bucket files were reused
+  int buckets = 0, blocks = 0;    // direction buckets and blocks
+  int octahedral = 0;             // 0 = pixel buckets
+  int64_t samples = 0;            // radiance samples (rays) used
+  int64_t uncovered = 0;          // (grid point, bucket) pairs filled by the repair
+  double fraction_uncovered = 0;  // uncovered / (grid points · buckets)
+  bool buckets_reused = false;    // an earlier run's bucket files were reused
   double t_subsample = 0, t_sort = 0, t_project = 0, t_accumulate = 0, t_total = 0;  // seconds
-  double t_repair = 0;                 // the repair's share of t_project (its share of the buckets' thread time)
-  double gemm_flops = 0;               // floating-point operations of the SH matrix products
-  int nx = 0, ny = 0, nz = 0;          // the resolution built (chosen with auto_grid)
-  double kernel_cells = 0;             // the kernel used (chosen with auto_kernel)
-  double ball_radius = 0;              // rays started on a ball of this radius (0: single viewpoint)
-  std::optional<ResampleChoice> choice;  // the automatic choice, when made
+  double t_repair = 0;                     // the repair's share of t_project (its share of the buckets' thread time)
+  double gemm_flops = 0;                   // floating-point operations of the SH matrix products
+  int nx = 0, ny = 0, nz = 0;              // the resolution built (chosen with auto_grid)
+  double kernel_cells = 0;                 // the kernel used (chosen with auto_kernel)
+  double ball_radius = 0;                  // rays started on a ball of this radius (0: single viewpoint)
+  std::optional<ResampleChoice> choice;    // the automatic choice, when made
   std::optional<CrossValResult> crossval;  // the cross-validated error, when asked for
-  int crossval_buckets = 0;            // buckets the cross-validation used
-  double t_choose = 0, t_crossval = 0;  // seconds of the automatic choice, of a separate cross-validation
-                                        // (fixed kernel and grid); both part of t_total
+  int crossval_buckets = 0;                // buckets the cross-validation used
+  double t_choose = 0, t_crossval = 0;     // seconds of the automatic choice, of a separate cross-validation
+                                           // (fixed kernel and grid); both part of t_total
 };
 
 // SH accumulation of one block: C (rows × K, column-major) += R (rows × D, column-major) · B (D × K,
@@ -97,16 +97,16 @@ struct BlockWork {
   BlockStats stats;
   double project_seconds = 0, accumulate_seconds = 0, gemm_flops = 0;
 };
-BlockWork resample_block(const BucketStore& store, int k, const GridDesc& grid, const ProjectDesc& desc, const std::vector<Vec3>& origins,
-                         int bands, bool ball_parallax, std::vector<uint16_t>& buf, std::vector<float>& R, BlockScratch& scratch,
-                         double* C);
+BlockWork resample_block(const BucketStore& store, int k, const GridDesc& grid, const ProjectDesc& desc,
+                         const std::vector<Vec3>& origins, int bands, bool ball_parallax, std::vector<uint16_t>& buf,
+                         std::vector<float>& R, BlockScratch& scratch, double* C);
 // The cross-validated choice of kernel and resolution (desc.auto_kernel, desc.auto_grid) and the
 // cross-validated error (desc.crossval), as the serial and the distributed build both make them, on
 // the sorted store: sets rep.choice, crossval, crossval_buckets, t_choose, t_crossval, nx/ny/nz and
 // kernel_cells, and moves grid and pd to the choice. Distributed: every rank calls it with its share
 // of the blocks (crossval.h, CvShare) and gets the job's choice and error.
-void cross_validate_build(const BucketStore& store, const std::vector<Vec3>& origins, const BuildDesc& desc, GridDesc& grid,
-                          ProjectDesc& pd, BuildReport& rep, const CvShare& share = {});
+void cross_validate_build(const BucketStore& store, const std::vector<Vec3>& origins, const BuildDesc& desc,
+                          GridDesc& grid, ProjectDesc& pd, BuildReport& rep, const CvShare& share = {});
 // C (3·G × K, column-major, as accumulate_block leaves it) into the grid's coefficient layout.
 void store_coefficients(const double* C, SHGrid& out);
 

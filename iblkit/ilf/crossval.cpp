@@ -25,8 +25,8 @@ std::vector<uint8_t> assign_folds(int n, int folds, uint64_t seed) {
   return fold;
 }
 
-CrossValidator::CrossValidator(const GridDesc& grid, const std::vector<Vec3>& origins, const std::vector<uint8_t>& valid,
-                               int bands, const CrossValDesc& desc)
+CrossValidator::CrossValidator(const GridDesc& grid, const std::vector<Vec3>& origins,
+                               const std::vector<uint8_t>& valid, int bands, const CrossValDesc& desc)
     : grid_(grid), desc_(desc), K_(bands * bands) {
   int P = int(origins.size());
   fold_ = assign_folds(P, desc.folds, desc.seed);
@@ -145,37 +145,42 @@ CrossValResult CrossValidator::result() const {
 }
 
 SHGrid error_volume(const CrossValResult& r, const GridDesc& grid, int max_res) {
-  GridDesc g{std::clamp(grid.nx, 2, max_res), std::clamp(grid.ny, 2, max_res), std::clamp(grid.nz, 2, max_res), grid.volume};
+  GridDesc g{std::clamp(grid.nx, 2, max_res), std::clamp(grid.ny, 2, max_res), std::clamp(grid.nz, 2, max_res),
+             grid.volume};
   SHGrid out(g, 1);
   out.set_content("cv-error");
   Vec3 s = grid.volume.size(), sp = g.spacing();
   int P = int(r.positions.size());
   double sigma = std::max({std::cbrt(s.x * s.y * s.z / std::max(P, 1)), sp.x, sp.y, sp.z});
   double inv2s2 = 1 / (2 * sigma * sigma), cut2 = 9 * sigma * sigma;
-  parallel_for(0, g.count(), [&](int64_t i) {
-    Vec3 x = g.point(i);
-    double we = 0, wn = 0, w = 0;
-    for (int p = 0; p < P; ++p) {
-      Vec3 d = r.positions[p] - x;
-      double d2 = dot(d, d);
-      if (d2 > cut2) continue;
-      double k = std::exp(-d2 * inv2s2);
-      we += k * r.sq_error[p];
-      wn += k * r.sq_norm[p];
-      w += k;
-    }
-    float* v = out.data().data() + size_t(i) * 3;
-    v[0] = wn > 0 ? float(std::sqrt(we / wn)) : 0.0f;
-    v[1] = w > 0 ? float(std::sqrt(we / w)) : 0.0f;
-    v[2] = float(w);
-  }, 64);
+  parallel_for(
+      0, g.count(),
+      [&](int64_t i) {
+        Vec3 x = g.point(i);
+        double we = 0, wn = 0, w = 0;
+        for (int p = 0; p < P; ++p) {
+          Vec3 d = r.positions[p] - x;
+          double d2 = dot(d, d);
+          if (d2 > cut2) continue;
+          double k = std::exp(-d2 * inv2s2);
+          we += k * r.sq_error[p];
+          wn += k * r.sq_norm[p];
+          w += k;
+        }
+        float* v = out.data().data() + size_t(i) * 3;
+        v[0] = wn > 0 ? float(std::sqrt(we / wn)) : 0.0f;
+        v[1] = w > 0 ? float(std::sqrt(we / w)) : 0.0f;
+        v[2] = float(w);
+      },
+      64);
   return out;
 }
 
 Image error_slice(const SHGrid& g, int axis, double value, int size) {
   if (axis < 0 || axis > 2 || size < 1 || size > 16384)
     fail(ErrorKind::Value, "error slice: axis {} must be 0..2 and the width {} 1..16384 pixels", axis, size);
-  if (g.content() != "cv-error") fail(ErrorKind::Value, "error slice: the grid holds \"{}\", not cv-error", g.content());
+  if (g.content() != "cv-error")
+    fail(ErrorKind::Value, "error slice: the grid holds \"{}\", not cv-error", g.content());
   const auto& v = g.grid().volume;
   int a1 = axis == 0 ? 2 : 0, a2 = axis == 1 ? 2 : 1;
   Vec3 ext = v.size();
@@ -193,7 +198,8 @@ Image error_slice(const SHGrid& g, int axis, double value, int size) {
 }
 
 Image error_colours(const Image& e, double max_error) {
-  if (!(max_error > 0) || !std::isfinite(max_error)) fail(ErrorKind::Value, "error colours: max_error {} must be > 0", max_error);
+  if (!(max_error > 0) || !std::isfinite(max_error))
+    fail(ErrorKind::Value, "error colours: max_error {} must be > 0", max_error);
   static const Vec3 stops[] = {{0, 0, 0}, {0.1, 0.2, 0.9}, {0.1, 0.8, 0.3}, {0.95, 0.9, 0.1}, {0.9, 0.1, 0.1}};
   Image img(e.width(), e.height(), 3);
   const double grey = std::pow(0.45, 2.2);
@@ -217,14 +223,15 @@ double build_grid_bytes(int nx, int ny, int nz, int bands, int block_buckets) {
   return G * K * 3 * 4 * 2 + G * 3 * block_buckets * 4;
 }
 
-BucketRays bucket_rays(const BucketStore& store, const std::vector<uint16_t>& buf, int k, int b, const std::vector<Vec3>& origins,
-                       bool use_starts, BucketRadiance& rad) {
+BucketRays bucket_rays(const BucketStore& store, const std::vector<uint16_t>& buf, int k, int b,
+                       const std::vector<Vec3>& origins, bool use_starts, BucketRadiance& rad) {
   const DirectionTable& t = store.table();
   int P = store.probe_count();
   int nb = int(t.bucket_begin[b + 1] - t.bucket_begin[b]);
   rad.rgb.resize(size_t(P) * nb * 3);
   rad.stride = int64_t(nb) * 3;
-  for (int p = 0; p < P; ++p) halves_to_floats(store.samples(buf, k, b, p), rad.rgb.data() + size_t(p) * nb * 3, size_t(nb) * 3);
+  for (int p = 0; p < P; ++p)
+    halves_to_floats(store.samples(buf, k, b, p), rad.rgb.data() + size_t(p) * nb * 3, size_t(nb) * 3);
   BucketRays rays;
   rays.dirs = t.dir.data() + t.bucket_begin[b] * 3;
   rays.weights = t.weight.data() + t.bucket_begin[b];
@@ -266,8 +273,8 @@ int sample_stride(const DirectionTable& t, int max_buckets) {
 // Cross-validated errors of the candidates on every stride-th bucket (one read of the block files),
 // over this process's share of the blocks; then the partial sums of every process are added, so the
 // candidates' result() is the job's. *used: the buckets the whole job evaluates.
-void evaluate(const BucketStore& store, const std::vector<Vec3>& origins, std::vector<Candidate>& cands, int bands, int stride,
-              bool use_starts, int* used, const CvShare& share) {
+void evaluate(const BucketStore& store, const std::vector<Vec3>& origins, std::vector<Candidate>& cands, int bands,
+              int stride, bool use_starts, int* used, const CvShare& share) {
   const DirectionTable& t = store.table();
   *used = 0;
   for (int b = 0; b < t.buckets(); b += stride) ++*used;
@@ -300,8 +307,10 @@ void evaluate(const BucketStore& store, const std::vector<Vec3>& origins, std::v
       for (auto& c : cands) c.cv->end_block(B.data(), D);
     }
   };
-  if (share.agree) share.agree(local);
-  else local();
+  if (share.agree)
+    share.agree(local);
+  else
+    local();
   if (share.sum)
     for (auto& c : cands) {
       auto& C = c.cv->partial_sums();
@@ -312,8 +321,8 @@ void evaluate(const BucketStore& store, const std::vector<Vec3>& origins, std::v
 }  // namespace
 
 CrossValResult cross_validate(const BucketStore& store, const std::vector<Vec3>& origins, const GridDesc& grid,
-                              const ProjectDesc& project, int bands, const CrossValDesc& cv, int max_buckets, bool use_starts,
-                              int* buckets_used, const CvShare& share) {
+                              const ProjectDesc& project, int bands, const CrossValDesc& cv, int max_buckets,
+                              bool use_starts, int* buckets_used, const CvShare& share) {
   int stride = sample_stride(store.table(), max_buckets);
   std::vector<Candidate> c(1);
   c[0].grid = grid;
@@ -326,7 +335,8 @@ CrossValResult cross_validate(const BucketStore& store, const std::vector<Vec3>&
 }
 
 ResampleChoice choose_resampling(const BucketStore& store, const std::vector<Vec3>& origins, const ProjectDesc& project,
-                                 const ResampleSearch& s, const CrossValDesc& cvd, bool use_starts, const CvShare& share) {
+                                 const ResampleSearch& s, const CrossValDesc& cvd, bool use_starts,
+                                 const CvShare& share) {
   auto t0 = std::chrono::steady_clock::now();
   ResampleChoice ch;
   int stride = sample_stride(store.table(), s.max_buckets);
@@ -346,7 +356,8 @@ ResampleChoice choose_resampling(const BucketStore& store, const std::vector<Vec
     for (size_t i = 0; i < cands.size(); ++i) {
       CrossValResult r = cands[i].cv->result();
       bool better = ch.trials.empty() || r.rel_error < ch.best.rel_error;
-      ch.trials.push_back({std::max({cands[i].grid.nx, cands[i].grid.ny, cands[i].grid.nz}), pairs[i].second, r.rel_error});
+      ch.trials.push_back(
+          {std::max({cands[i].grid.nx, cands[i].grid.ny, cands[i].grid.nz}), pairs[i].second, r.rel_error});
       if (better) ch.best = std::move(r);
     }
   };
@@ -363,10 +374,12 @@ ResampleChoice choose_resampling(const BucketStore& store, const std::vector<Vec
       GridDesc g = grid_of(s, n);
       if (build_grid_bytes(g.nx, g.ny, g.nz, s.bands, 64) <= 0.5 * double(s.memory_bytes)) ns.push_back(n);
     }
-    if (ns.empty()) fail(ErrorKind::Value, "--grid auto: not even an {}-point grid fits in half of the memory budget", kAutoGrids[0]);
+    if (ns.empty())
+      fail(ErrorKind::Value, "--grid auto: not even an {}-point grid fits in half of the memory budget", kAutoGrids[0]);
     // Each resolution with two kernels, then the best resolution with every kernel.
     for (int n : ns)
-      for (double kern : s.kernel ? std::vector<double>{2.0, 3.0} : std::vector<double>{s.kernel_cells}) pairs.push_back({n, kern});
+      for (double kern : s.kernel ? std::vector<double>{2.0, 3.0} : std::vector<double>{s.kernel_cells})
+        pairs.push_back({n, kern});
     run(pairs);
     ResampleTrial b = best(0);
     if (s.kernel) {
@@ -377,13 +390,17 @@ ResampleChoice choose_resampling(const BucketStore& store, const std::vector<Vec
     }
     ResampleTrial w = best(0);
     GridDesc g = grid_of(s, w.n);
-    ch.nx = g.nx; ch.ny = g.ny; ch.nz = g.nz;
+    ch.nx = g.nx;
+    ch.ny = g.ny;
+    ch.nz = g.nz;
     ch.kernel = w.kernel;
   } else {
     for (double kern : kAutoKernels) pairs.push_back({0, kern});
     run(pairs);
     ResampleTrial w = best(0);
-    ch.nx = s.nx; ch.ny = s.ny; ch.nz = s.nz;
+    ch.nx = s.nx;
+    ch.ny = s.ny;
+    ch.nz = s.nz;
     ch.kernel = w.kernel;
   }
   ch.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -19,21 +19,21 @@
 namespace ibl::ilf {
 
 struct CrossValDesc {
-  int folds = 5;            // k ≥ 2; 0: no cross-validation
-  uint64_t seed = 1;        // fold assignment and evaluated subset
-  int max_evaluated = 8192; // at most this many held-out probes are predicted (a random subset beyond)
-  int regions = 2;          // per axis: the volume's regions for per-region errors (2 = octants)
+  int folds = 5;             // k ≥ 2; 0: no cross-validation
+  uint64_t seed = 1;         // fold assignment and evaluated subset
+  int max_evaluated = 8192;  // at most this many held-out probes are predicted (a random subset beyond)
+  int regions = 2;           // per axis: the volume's regions for per-region errors (2 = octants)
 };
 
 struct CrossValResult {
   int folds = 0;
-  int evaluated = 0;                    // probes predicted
-  double rel_error = 0;                 // √(Σ_p ‖Ĉ_p − C_p‖² / Σ_p ‖C_p‖²) over the evaluated probes
-  double median_probe_error = 0;        // median over probes of ‖Ĉ_p − C_p‖ / ‖C_p‖
-  int regions = 0;                      // per axis
-  std::vector<double> region_error;     // regions³, x fastest; NaN where no probe fell
+  int evaluated = 0;                 // probes predicted
+  double rel_error = 0;              // √(Σ_p ‖Ĉ_p − C_p‖² / Σ_p ‖C_p‖²) over the evaluated probes
+  double median_probe_error = 0;     // median over probes of ‖Ĉ_p − C_p‖ / ‖C_p‖
+  int regions = 0;                   // per axis
+  std::vector<double> region_error;  // regions³, x fastest; NaN where no probe fell
   std::vector<int> region_probes;
-  std::vector<Vec3> positions;          // evaluated probes
+  std::vector<Vec3> positions;            // evaluated probes
   std::vector<double> sq_error, sq_norm;  // per evaluated probe: ‖Ĉ_p − C_p‖², ‖C_p‖²
 };
 
@@ -45,9 +45,9 @@ class CrossValidator {
  public:
   CrossValidator(const GridDesc& grid, const std::vector<Vec3>& origins, const std::vector<uint8_t>& valid, int bands,
                  const CrossValDesc& desc);
-  void begin_block(int D);                 // D buckets in the coming block
-  CvBucket bucket(int j);                  // column j of the block (thread-safe for distinct j)
-  void end_block(const float* B, int D);   // B: the block's basis rows (D × K, column-major, as bucket_basis)
+  void begin_block(int D);                // D buckets in the coming block
+  CvBucket bucket(int j);                 // column j of the block (thread-safe for distinct j)
+  void end_block(const float* B, int D);  // B: the block's basis rows (D × K, column-major, as bucket_basis)
   CrossValResult result() const;
   // The sums so far (Σ over blocks of the predictions' and the probes' own SH products), as
   // 2·3·E·K doubles. They are additive over blocks: a distributed job sums every process's
@@ -57,11 +57,11 @@ class CrossValidator {
  private:
   GridDesc grid_;
   CrossValDesc desc_;
-  int K_ = 0, E_ = 0;                      // coefficients, evaluated probes
+  int K_ = 0, E_ = 0;  // coefficients, evaluated probes
   std::vector<uint8_t> fold_;
   std::vector<int32_t> cell_;
   std::vector<float> frac_;
-  std::vector<int> eval_;                  // evaluated probe ids
+  std::vector<int> eval_;  // evaluated probe ids
   std::vector<Vec3> pos_;
   std::vector<float> pred_, own_;
   std::vector<double> C_;  // Cpred then Cown (3·E × K each): accumulate_block sums over blocks in double
@@ -101,12 +101,16 @@ Image error_colours(const Image& slice, double max_error);
 
 // The automatic choice of kernel width and resolution: cross-validated error of each candidate on a
 // subset of the buckets (every s-th, at most max_buckets), the least wins.
-struct ResampleTrial { int n = 0; double kernel = 0; double cv_error = 0; };
+struct ResampleTrial {
+  int n = 0;
+  double kernel = 0;
+  double cv_error = 0;
+};
 struct ResampleChoice {
   int nx = 0, ny = 0, nz = 0;
   double kernel = 0;
   std::vector<ResampleTrial> trials;
-  CrossValResult best;                // the chosen candidate's cross-validation
+  CrossValResult best;  // the chosen candidate's cross-validation
   int buckets_used = 0;
   double seconds = 0;
 };
@@ -116,9 +120,9 @@ inline constexpr int kAutoGrids[] = {8, 12, 16, 24, 32, 48, 64};
 struct ResampleSearch {
   bool kernel = false, grid = false;  // what to choose
   Box volume;
-  int nx = 16, ny = 16, nz = 16;      // the resolution when not chosen (or the aspect when chosen: the
-                                      // chosen n is the longest axis)
-  double kernel_cells = 3;            // the kernel when not chosen
+  int nx = 16, ny = 16, nz = 16;  // the resolution when not chosen (or the aspect when chosen: the
+                                  // chosen n is the longest axis)
+  double kernel_cells = 3;        // the kernel when not chosen
   int bands = 5;
   size_t memory_bytes = size_t(2) << 30;  // grids whose build needs more are not tried
   int max_buckets = 2048;
@@ -137,13 +141,16 @@ ResampleChoice choose_resampling(const BucketStore& store, const std::vector<Vec
 // (all when there are fewer): one read of the block files. buckets_used: the job's count. Distributed
 // as choose_resampling: every process gets the job's result.
 CrossValResult cross_validate(const BucketStore& store, const std::vector<Vec3>& origins, const GridDesc& grid,
-                              const ProjectDesc& project, int bands, const CrossValDesc& cv, int max_buckets, bool use_starts,
-                              int* buckets_used = nullptr, const CvShare& share = {});
+                              const ProjectDesc& project, int bands, const CrossValDesc& cv, int max_buckets,
+                              bool use_starts, int* buckets_used = nullptr, const CvShare& share = {});
 
 // The rays of bucket b of block k (loaded into buf); their radiance is converted into `rad`, which
 // the returned rays point into.
-struct BucketRadiance { std::vector<float> rgb; int64_t stride = 0; };
-BucketRays bucket_rays(const BucketStore& store, const std::vector<uint16_t>& buf, int k, int b, const std::vector<Vec3>& origins,
-                       bool use_starts, BucketRadiance& rad);
+struct BucketRadiance {
+  std::vector<float> rgb;
+  int64_t stride = 0;
+};
+BucketRays bucket_rays(const BucketStore& store, const std::vector<uint16_t>& buf, int k, int b,
+                       const std::vector<Vec3>& origins, bool use_starts, BucketRadiance& rad);
 
 }  // namespace ibl::ilf

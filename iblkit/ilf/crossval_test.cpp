@@ -111,7 +111,8 @@ TEST(IlfCrossVal, OnePassEqualsSeparateBuilds) {
     }
   }
   double brute = std::sqrt(num / den);
-  std::printf("[ilf] three spheres, 120 probes, 4^3: cv error one pass %.5f, five separate builds %.5f\n", rep.crossval->rel_error, brute);
+  std::printf("[ilf] three spheres, 120 probes, 4^3: cv error one pass %.5f, five separate builds %.5f\n",
+              rep.crossval->rel_error, brute);
   EXPECT_GT(brute, 0.01);  // a field with parallax: not trivially zero
   EXPECT_NEAR(rep.crossval->rel_error, brute, 1e-3 * brute);
 }
@@ -198,13 +199,13 @@ TEST(IlfCrossVal, ErrorVolumeShowsAGapAsNoFigure) {
   ASSERT_EQ(e.height(), 16);
   EXPECT_NEAR(e.at(1, 14, 0), 0.2, 1e-5);  // image x along x, image y down y: (x, y) ≈ (0.09, 0.09)
   EXPECT_GT(e.at(1, 14, 2), 1.0);
-  EXPECT_EQ(e.at(14, 1, 2), 0.0f);         // (0.91, 0.91): beyond 3σ of every probe
+  EXPECT_EQ(e.at(14, 1, 2), 0.0f);  // (0.91, 0.91): beyond 3σ of every probe
   EXPECT_EQ(e.at(14, 1, 0), 0.0f);
   Image c = error_colours(e, 0.5);
   const float grey = float(std::pow(0.45, 2.2));
   EXPECT_NEAR(c.at(14, 1, 0), grey, 1e-6);
   EXPECT_NEAR(c.at(14, 1, 1), grey, 1e-6);
-  EXPECT_GT(c.at(1, 14, 1), 0.2f);         // 0.2 of 0.5: between blue and green (green 0.56 before encoding)
+  EXPECT_GT(c.at(1, 14, 1), 0.2f);  // 0.2 of 0.5: between blue and green (green 0.56 before encoding)
   EXPECT_LT(c.at(1, 14, 0), 0.05f);
 }
 
@@ -282,8 +283,8 @@ TEST(IlfCrossVal, SharesOfTheBlocksAddUpToTheWhole) {
   }
   // Every rank holds the same bits (the ranks must make the same choice).
   for (int r = 1; r < N; ++r) EXPECT_EQ(res[r].rel_error, res[0].rel_error);
-  std::printf("[ilf] cv over %d shares of %d blocks, %d of %d buckets: %.9f (one process %.9f), kernel %g\n", N, blocks, used,
-              store.table().buckets(), res[0].rel_error, whole.rel_error, choice[0].kernel);
+  std::printf("[ilf] cv over %d shares of %d blocks, %d of %d buckets: %.9f (one process %.9f), kernel %g\n", N, blocks,
+              used, store.table().buckets(), res[0].rel_error, whole.rel_error, choice[0].kernel);
 }
 
 }  // namespace

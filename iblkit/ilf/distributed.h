@@ -4,8 +4,8 @@
 // slice of the probe frames, sends every block's samples to its owner (MPI_Alltoallv), cross-validates
 // (and chooses kernel and grid) on the sampled buckets of its own blocks, those sums meeting on every
 // rank, projects, repairs and accumulates its own blocks, and the partial SH sums meet on rank 0
-// (MPI_Reduce), which returns the grid. MPI itself lives in the "mpi" plugin (ilf/mpi/, built with IBLKIT_WITH_MPI); this
-// header is what the rest of iblkit sees of it.
+// (MPI_Reduce), which returns the grid. MPI itself lives in the "mpi" plugin (ilf/mpi/, built with IBLKIT_WITH_MPI);
+// this header is what the rest of iblkit sees of it.
 #pragma once
 #include <cstdint>
 #include <functional>
@@ -21,21 +21,21 @@ namespace ibl::ilf {
 // ranks wait for the slowest at each exchange), counts are the whole job's.
 struct DistributedReport {
   int ranks = 1;
-  double t_subsample = 0;   // neighbour energies (each rank its pairs) and their all-gather
-  double t_read = 0;        // decoding this rank's frames and scattering them into blocks
-  double t_exchange = 0;    // MPI_Alltoallv of the samples to the blocks' owners, and writing them
-  double t_project = 0;     // projection of the own blocks (repair included)
-  double t_repair = 0;      // the repair's share of t_project
-  double t_accumulate = 0;  // SH products of the own blocks
-  double t_reduce = 0;      // MPI_Reduce of the partial SH sums onto rank 0
-  double t_crossval = 0;    // the cross-validated choice and error (own blocks' sampled buckets, their sums' reduce)
-  int64_t bytes_sent = 0;       // samples this rank sent to other ranks (half floats), largest rank
-  int64_t bytes_received = 0;   // samples this rank received from other ranks, largest rank
-  int64_t bytes_reduced = 0;    // partial SH sums a rank sends in the reduce (8 bytes per value)
-  int64_t bytes_crossval = 0;   // partial cross-validation sums a rank sends in their reduce (8 bytes per value)
-  int64_t peak_rss_bytes = 0;   // the largest rank's peak resident memory (VmHWM)
+  double t_subsample = 0;      // neighbour energies (each rank its pairs) and their all-gather
+  double t_read = 0;           // decoding this rank's frames and scattering them into blocks
+  double t_exchange = 0;       // MPI_Alltoallv of the samples to the blocks' owners, and writing them
+  double t_project = 0;        // projection of the own blocks (repair included)
+  double t_repair = 0;         // the repair's share of t_project
+  double t_accumulate = 0;     // SH products of the own blocks
+  double t_reduce = 0;         // MPI_Reduce of the partial SH sums onto rank 0
+  double t_crossval = 0;       // the cross-validated choice and error (own blocks' sampled buckets, their sums' reduce)
+  int64_t bytes_sent = 0;      // samples this rank sent to other ranks (half floats), largest rank
+  int64_t bytes_received = 0;  // samples this rank received from other ranks, largest rank
+  int64_t bytes_reduced = 0;   // partial SH sums a rank sends in the reduce (8 bytes per value)
+  int64_t bytes_crossval = 0;  // partial cross-validation sums a rank sends in their reduce (8 bytes per value)
+  int64_t peak_rss_bytes = 0;  // the largest rank's peak resident memory (VmHWM)
   int blocks_min = 0, blocks_max = 0;  // direction blocks per rank
-  int chunk = 0;                // probes per read-and-exchange round of one rank
+  int chunk = 0;                       // probes per read-and-exchange round of one rank
 };
 
 // An error that every rank of the job raised together (the same message on each): rank 0 reports it,

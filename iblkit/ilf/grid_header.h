@@ -17,8 +17,8 @@ namespace ibl::ilf {
 
 // Reads line 1 (must equal magic; else "PATH: not an KIND file …") and parses line 2 as JSON;
 // *data_offset is the byte after line 2's newline.
-inline nlohmann::json read_grid_header(std::istream& in, const std::string& path, std::string_view magic, std::string_view kind,
-                                       size_t* data_offset) {
+inline nlohmann::json read_grid_header(std::istream& in, const std::string& path, std::string_view magic,
+                                       std::string_view kind, size_t* data_offset) {
   std::string line1, line2;
   std::getline(in, line1);
   if (line1 != magic) fail(ErrorKind::Format, "{}: not an {} file (line 1 is not \"{}\")", path, kind, magic);
@@ -40,7 +40,8 @@ inline const nlohmann::json& grid_header_field(const nlohmann::json& h, const st
 // An integer field's value, checked before it is converted: a JSON integer, or a number with an integral
 // value, within [lo, hi] (a float such as 8.9e61 must never reach a cast to an integer type); else
 // "PATH: header field "f" = V is not an integer in [lo, hi]". Found by fuzz_shtree (fuzz/crashes/shtree/).
-inline int64_t grid_header_integer(const nlohmann::json& v, const std::string& path, const char* f, int64_t lo, int64_t hi) {
+inline int64_t grid_header_integer(const nlohmann::json& v, const std::string& path, const char* f, int64_t lo,
+                                   int64_t hi) {
   if (v.is_number_integer() && !v.is_number_unsigned()) {
     const int64_t i = v.get<int64_t>();
     if (i >= lo && i <= hi) return i;
@@ -49,11 +50,13 @@ inline int64_t grid_header_integer(const nlohmann::json& v, const std::string& p
     if (hi >= 0 && u <= static_cast<uint64_t>(hi) && static_cast<int64_t>(u) >= lo) return static_cast<int64_t>(u);
   } else if (v.is_number_float()) {
     const double d = v.get<double>();
-    if (std::isfinite(d) && d == std::floor(d) && d >= static_cast<double>(lo) && d <= static_cast<double>(hi)) return static_cast<int64_t>(d);
+    if (std::isfinite(d) && d == std::floor(d) && d >= static_cast<double>(lo) && d <= static_cast<double>(hi))
+      return static_cast<int64_t>(d);
   }
   fail(ErrorKind::Format, "{}: header field \"{}\" = {} is not an integer in [{}, {}]", path, f, v.dump(), lo, hi);
 }
-inline std::vector<int64_t> grid_header_integers(const nlohmann::json& v, const std::string& path, const char* f, int64_t lo, int64_t hi) {
+inline std::vector<int64_t> grid_header_integers(const nlohmann::json& v, const std::string& path, const char* f,
+                                                 int64_t lo, int64_t hi) {
   if (!v.is_array()) fail(ErrorKind::Format, "{}: header field \"{}\" must be an array of integers", path, f);
   std::vector<int64_t> out;
   out.reserve(v.size());

@@ -48,7 +48,9 @@ TEST(IlfSequence, BadManifests) {
   expect_error([&] { read_sequence(m); }, {"\"mapping\"", "fisheye"});
   write_text(m, R"({"format":"iblkit.sequence/1","probes":[{"image":"a.exr","position":[0,0,0]},{"image":"b.exr"}]})");
   expect_error([&] { read_sequence(m); }, {"probe 1", "\"position\""});
-  write_text(m, R"({"format":"iblkit.sequence/1","probes":[{"image":"a.exr","position":[0,0,0]},{"image":"b.exr","position":[0,"x",0]}]})");
+  write_text(
+      m,
+      R"({"format":"iblkit.sequence/1","probes":[{"image":"a.exr","position":[0,0,0]},{"image":"b.exr","position":[0,"x",0]}]})");
   expect_error([&] { read_sequence(m); }, {"probe 1", "\"position\""});
   // Outside the volume and duplicates: errors, or skipped with skip_bad.
   write_text(m, R"({"format":"iblkit.sequence/1","volume":{"min":[0,0,0],"max":[1,1,1]},"probes":[
@@ -63,7 +65,9 @@ TEST(IlfSequence, BadManifests) {
   ASSERT_EQ(seq.probes.size(), 2u);
   EXPECT_EQ(fs::path(seq.probes[1].image).filename(), "d.exr");
   EXPECT_EQ(fs::path(seq.probes[1].image).parent_path(), fs::path(d));  // relative to the manifest
-  write_text(m, R"({"format":"iblkit.sequence/1","probes":[{"image":"a.exr","position":[0,0,0]},{"image":"a.exr","position":[0,0,0]}]})");
+  write_text(
+      m,
+      R"({"format":"iblkit.sequence/1","probes":[{"image":"a.exr","position":[0,0,0]},{"image":"a.exr","position":[0,0,0]}]})");
   expect_error([&] { read_sequence(m); }, {"probe 1", "duplicates probe 0"});
 }
 
@@ -136,7 +140,7 @@ TEST(IlfBuckets, BadFramesNameTheProbe) {
   auto seq = read_sequence(tiny_sequence(d, 6));
   io::write_image(seq.probes[2].image, Image(20, 20, 3, 1.0f), {true});  // wrong size
   io::write_image(seq.probes[4].image, Image(16, 16, 3, 0.0f), {true});  // all black
-  fs::remove(seq.probes[5].image);                                        // missing
+  fs::remove(seq.probes[5].image);                                       // missing
   BucketDesc bd;
   bd.dir = d + "/b";
   expect_error([&] { BucketStore::sort(seq, bd); }, {"probe ", "\"image\""});
@@ -172,7 +176,9 @@ TEST(IlfProject, ParallelRaysAndRepairs) {
     }
   float dir[3] = {0, 0, 1};
   double w = 1.0;
-  struct Ctx { const float* r; } ctx{rad.data()};
+  struct Ctx {
+    const float* r;
+  } ctx{rad.data()};
   BucketRays rays;
   rays.dirs = dir;
   rays.weights = &w;
@@ -199,8 +205,10 @@ TEST(IlfProject, ParallelRaysAndRepairs) {
       EXPECT_NEAR(out[grid.nx * 2 + 7 + size_t(k) * 81], 4.0, kTol);
     }
     float centre = out[size_t(4) * 81 + 4 * 9 + 4];  // (0.5, 0.5, 0.5): in the hole
-    if (r == Repair::None) EXPECT_EQ(centre, 0.0f);
-    else EXPECT_TRUE(centre > 2.0f - kTol && centre < 4.0f + kTol) << repair_name(r) << " " << centre;
+    if (r == Repair::None)
+      EXPECT_EQ(centre, 0.0f);
+    else
+      EXPECT_TRUE(centre > 2.0f - kTol && centre < 4.0f + kTol) << repair_name(r) << " " << centre;
   }
 }
 

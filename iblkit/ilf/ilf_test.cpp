@@ -36,7 +36,7 @@ std::string small_sequence(const AnalyticField& f, const std::string& name) {
 }
 
 struct GridError {
-  double rel_l2 = 0;     // ‖c − c*‖ / ‖c*‖ over every point, coefficient and channel
+  double rel_l2 = 0;       // ‖c − c*‖ / ‖c*‖ over every point, coefficient and channel
   double worst_point = 0;  // max over points of ‖c − c*‖ / ‖c*‖ at that point
 };
 
@@ -104,9 +104,9 @@ TEST(IlfAnalytic, DistantFieldMatchesExactSH) {
       for (int ch = 0; ch < 3; ++ch) n += std::pow(g.data()[(p * direct.size() + k) * 3 + ch] - direct[k][ch], 2);
     worst_vs_direct = std::max(worst_vs_direct, std::sqrt(n / dn));
   }
-  std::printf("[ilf] distant field: rel L2 %.4f, worst point %.4f; worst point vs one probe's projection %.5f\n", e.rel_l2,
-              e.worst_point, worst_vs_direct);
-  constexpr double kProbeTol = 0.04;    // one 32×32 mirror ball (3×3 supersampled) vs exact: ≈ 0.03 measured
+  std::printf("[ilf] distant field: rel L2 %.4f, worst point %.4f; worst point vs one probe's projection %.5f\n",
+              e.rel_l2, e.worst_point, worst_vs_direct);
+  constexpr double kProbeTol = 0.04;      // one 32×32 mirror ball (3×3 supersampled) vs exact: ≈ 0.03 measured
   constexpr double kPipelineTol = 0.005;  // half-float frames and the field's residual parallax (spheres 1.3–2 km away)
   EXPECT_LT(e.rel_l2, kProbeTol);
   EXPECT_LT(e.worst_point, kProbeTol);
@@ -136,8 +136,8 @@ TEST(IlfAnalytic, GridMatchesExactSH) {
       }
       blind = compare_with_exact(mean, exact);
     }
-    std::printf("[ilf] repair %-8s rel L2 %.4f  worst point %.4f  uncovered %.4f  (position-blind %.4f)\n", repair_name(r),
-                e.rel_l2, e.worst_point, rep.fraction_uncovered, blind.rel_l2);
+    std::printf("[ilf] repair %-8s rel L2 %.4f  worst point %.4f  uncovered %.4f  (position-blind %.4f)\n",
+                repair_name(r), e.rel_l2, e.worst_point, rep.fraction_uncovered, blind.rel_l2);
     // 200 probes, kernel 3 cells of 1/7 m: the estimate blurs the light field over ≈ 0.1 m (σ), which
     // at 1.3–2 m moves the sphere edges by ≈ 4°; measured ≈ 0.12 overall, ≈ 0.31 at the worst point.
     constexpr double kRelL2Tol = 0.15;       // whole grid

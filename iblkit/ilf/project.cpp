@@ -1,8 +1,8 @@
 #include "iblkit/ilf/project.h"
 
 #include <algorithm>
-#include <chrono>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <string>
 
@@ -25,7 +25,10 @@ namespace {
 // §3.4): pull builds coarser levels as coverage-weighted box averages with weight min(1, Σw); push
 // replaces each value by w·v + (1 − w)·(bilinear of the coarser level). Pixels with data keep theirs.
 void pull_push(std::vector<float>& v, std::vector<float>& w, int W, int H, std::vector<float>& tmp) {
-  struct Level { size_t off; int w, h; };
+  struct Level {
+    size_t off;
+    int w, h;
+  };
   std::vector<Level> lv{{0, W, H}};
   size_t total = size_t(W) * H;
   while (lv.back().w > 1 || lv.back().h > 1) {
@@ -64,12 +67,14 @@ void pull_push(std::vector<float>& v, std::vector<float>& w, int W, int H, std::
       for (int x = 0; x < f.w; ++x) {
         float* p = &tmp[(f.off + size_t(y) * f.w + x) * 4];
         if (p[3] >= 1.0f) continue;
-        double cx = std::clamp((x + 0.5) / 2 - 0.5, 0.0, double(c.w - 1)), cy = std::clamp((y + 0.5) / 2 - 0.5, 0.0, double(c.h - 1));
+        double cx = std::clamp((x + 0.5) / 2 - 0.5, 0.0, double(c.w - 1)),
+               cy = std::clamp((y + 0.5) / 2 - 0.5, 0.0, double(c.h - 1));
         int x0 = int(cx), y0 = int(cy), x1 = std::min(x0 + 1, c.w - 1), y1 = std::min(y0 + 1, c.h - 1);
         float fx = float(cx - x0), fy = float(cy - y0);
         for (int ch = 0; ch < 3; ++ch) {
           auto at = [&](int xx, int yy) { return tmp[(c.off + size_t(yy) * c.w + xx) * 4 + ch]; };
-          float up = (1 - fy) * ((1 - fx) * at(x0, y0) + fx * at(x1, y0)) + fy * ((1 - fx) * at(x0, y1) + fx * at(x1, y1));
+          float up =
+              (1 - fy) * ((1 - fx) * at(x0, y0) + fx * at(x1, y0)) + fy * ((1 - fx) * at(x0, y1) + fx * at(x1, y1));
           p[ch] = p[3] * p[ch] + (1 - p[3]) * up;
         }
         p[3] = 1.0f;
@@ -89,7 +94,7 @@ void cross_validate(const CvBucket& cv, const BucketRays& rays, const GridDesc& 
                     std::array<double, 4> a, std::array<double, 4> b) {
   size_t npx = size_t(W) * H;
   std::vector<int> pyr_of(size_t(cv.n_folds), -1);  // offset index into sc.pyr per fold, built on demand
-  std::vector<std::array<int, 3>> levels;            // per level: w, h, offset (in 4-float pixels)
+  std::vector<std::array<int, 3>> levels;           // per level: w, h, offset (in 4-float pixels)
   int pyr_total = 0;
   {
     int w = W, h = H;
@@ -104,8 +109,8 @@ void cross_validate(const CvBucket& cv, const BucketRays& rays, const GridDesc& 
   }
   int built = 0;
   auto bil = [&](const float* r, int ch, int nch, size_t i00, float fx, float fy) {
-    return (1 - fx) * (1 - fy) * r[i00 * nch + ch] + fx * (1 - fy) * r[(i00 + 1) * nch + ch] + (1 - fx) * fy * r[(i00 + W) * nch + ch] +
-           fx * fy * r[(i00 + W + 1) * nch + ch];
+    return (1 - fx) * (1 - fy) * r[i00 * nch + ch] + fx * (1 - fy) * r[(i00 + 1) * nch + ch] +
+           (1 - fx) * fy * r[(i00 + W) * nch + ch] + fx * fy * r[(i00 + W + 1) * nch + ch];
   };
   for (int p = 0; p < rays.n_probes; ++p) {
     if (rays.valid && !rays.valid[p]) continue;
@@ -126,7 +131,8 @@ void cross_validate(const CvBucket& cv, const BucketRays& rays, const GridDesc& 
       size_t i00 = size_t(y0) * W + x0;
       float da = bil(sc.den.data(), 0, 1, i00, fx, fy), dm = da - bil(fd, 0, 1, i00, fx, fy);
       if (!(dm > 1e-4f * da + 1e-6f)) continue;
-      for (int ch = 0; ch < 3; ++ch) acc[ch] += w * (bil(sc.num.data(), ch, 3, i00, fx, fy) - bil(fn, ch, 3, i00, fx, fy)) / dm;
+      for (int ch = 0; ch < 3; ++ch)
+        acc[ch] += w * (bil(sc.num.data(), ch, 3, i00, fx, fy) - bil(fn, ch, 3, i00, fx, fy)) / dm;
       ws += w;
     }
     if (ws > 0) {
@@ -181,9 +187,9 @@ void cross_validate(const CvBucket& cv, const BucketRays& rays, const GridDesc& 
 
 // Derivation (radiance projection of one bucket, [1] §3.2 done on a plane):
 //   A bucket holds rays R_pq(s) = x_p + s·ω_q (x_p + o_q + s·ω_q when the rays start on a mirror ball, o_q
-//   the reflection point of direction q relative to the ball's centre: everything below with x_p + o_q), q over the bucket's directions (one in pixel buckets),
-//   p over the probes. Let ω_b be the solid-angle-weighted mean of the ω_q and Π the plane through the
-//   volume centre c perpendicular to ω_b, with orthonormal axes (t, u). Ray pq meets Π at
+//   the reflection point of direction q relative to the ball's centre: everything below with x_p + o_q), q over the
+//   bucket's directions (one in pixel buckets), p over the probes. Let ω_b be the solid-angle-weighted mean of the ω_q
+//   and Π the plane through the volume centre c perpendicular to ω_b, with orthonormal axes (t, u). Ray pq meets Π at
 //     y_pq = x_p + λ·ω_q,  λ = (c − x_p)·ω_b / (ω_q·ω_b),
 //   and a grid point g projects (along ω_b) to (g − c)·(t, u). For parallel rays (ω_q = ω_b) the 2D
 //   distance between the two is exactly the distance from g to the ray, for either sign of s: the
@@ -214,10 +220,15 @@ ProjectStats project_bucket(const GridDesc& grid, const BucketRays& rays, const 
     Vec3 p{(k & 1) ? grid.volume.max.x : grid.volume.min.x, (k & 2) ? grid.volume.max.y : grid.volume.min.y,
            (k & 4) ? grid.volume.max.z : grid.volume.min.z};
     double a = dot(p - c, fr.t), b = dot(p - c, fr.b);
-    lo[0] = std::min(lo[0], a); hi[0] = std::max(hi[0], a);
-    lo[1] = std::min(lo[1], b); hi[1] = std::max(hi[1], b);
+    lo[0] = std::min(lo[0], a);
+    hi[0] = std::max(hi[0], a);
+    lo[1] = std::min(lo[1], b);
+    hi[1] = std::max(hi[1], b);
   }
-  lo[0] -= R + delta; lo[1] -= R + delta; hi[0] += R + delta; hi[1] += R + delta;
+  lo[0] -= R + delta;
+  lo[1] -= R + delta;
+  hi[0] += R + delta;
+  hi[1] += R + delta;
   int W = int(std::ceil((hi[0] - lo[0]) / delta)) + 1, H = int(std::ceil((hi[1] - lo[1]) / delta)) + 1;
   size_t npx = size_t(W) * H;
   sc.num.assign(npx * 3, 0.0f);
@@ -319,8 +330,9 @@ ProjectStats project_bucket(const GridDesc& grid, const BucketRays& rays, const 
   const float* num = sc.num.data();
   const float* den_r = sc.den.data();
   const float* fill = plane_fill ? sc.rad.data() : nullptr;
-  if (cv) cross_validate(*cv, rays, grid, sc, W, H, {ax0 + dot(ob, fr.t) / delta, axi, axj, axk},
-                         {ay0 + dot(ob, fr.b) / delta, ayi, ayj, ayk});
+  if (cv)
+    cross_validate(*cv, rays, grid, sc, W, H, {ax0 + dot(ob, fr.t) / delta, axi, axj, axk},
+                   {ay0 + dot(ob, fr.b) / delta, ayi, ayj, ayk});
   if (cv) return st;
   int64_t gi = 0;
   for (int k = 0; k < grid.nz; ++k)
@@ -337,13 +349,15 @@ ProjectStats project_bucket(const GridDesc& grid, const BucketRays& rays, const 
           sc.covered[gi] = 1;
           float inv = 1.0f / den;
           for (int ch = 0; ch < 3; ++ch)
-            out[ch * out_stride + gi] =
-                (w00 * num[i00 * 3 + ch] + w10 * num[i10 * 3 + ch] + w01 * num[i01 * 3 + ch] + w11 * num[i11 * 3 + ch]) * inv;
+            out[ch * out_stride + gi] = (w00 * num[i00 * 3 + ch] + w10 * num[i10 * 3 + ch] + w01 * num[i01 * 3 + ch] +
+                                         w11 * num[i11 * 3 + ch]) *
+                                        inv;
         } else {
           ++st.uncovered;
           for (int ch = 0; ch < 3; ++ch)
-            out[ch * out_stride + gi] =
-                fill ? w00 * fill[i00 * 3 + ch] + w10 * fill[i10 * 3 + ch] + w01 * fill[i01 * 3 + ch] + w11 * fill[i11 * 3 + ch] : 0.0f;
+            out[ch * out_stride + gi] = fill ? w00 * fill[i00 * 3 + ch] + w10 * fill[i10 * 3 + ch] +
+                                                   w01 * fill[i01 * 3 + ch] + w11 * fill[i11 * 3 + ch]
+                                             : 0.0f;
         }
       }
     }
@@ -356,7 +370,11 @@ ProjectStats project_bucket(const GridDesc& grid, const BucketRays& rays, const 
 }
 
 int64_t repair_mip(const GridDesc& grid, float* values, int64_t stride, const uint8_t* covered) {
-  struct Level { int nx, ny, nz; std::vector<float> v; std::vector<float> w; };  // v: rgb, w: data count
+  struct Level {
+    int nx, ny, nz;
+    std::vector<float> v;
+    std::vector<float> w;
+  };  // v: rgb, w: data count
   std::vector<Level> lv;
   Level l0{grid.nx, grid.ny, grid.nz, {}, {}};
   int64_t G = grid.count(), filled = 0;
@@ -368,11 +386,14 @@ int64_t repair_mip(const GridDesc& grid, float* values, int64_t stride, const ui
   }
   lv.push_back(std::move(l0));
   auto lookup = [&](const Level& L, double x, double y, double z, float* rgb) {
-    x = std::clamp(x, 0.0, double(L.nx - 1)); y = std::clamp(y, 0.0, double(L.ny - 1)); z = std::clamp(z, 0.0, double(L.nz - 1));
+    x = std::clamp(x, 0.0, double(L.nx - 1));
+    y = std::clamp(y, 0.0, double(L.ny - 1));
+    z = std::clamp(z, 0.0, double(L.nz - 1));
     int x0 = int(x), y0 = int(y), z0 = int(z);
     double fx = x - x0, fy = y - y0, fz = z - z0, ws = 0, acc[3] = {0, 0, 0};
     for (int c = 0; c < 8; ++c) {
-      int xi = std::min(x0 + (c & 1), L.nx - 1), yi = std::min(y0 + ((c >> 1) & 1), L.ny - 1), zi = std::min(z0 + (c >> 2), L.nz - 1);
+      int xi = std::min(x0 + (c & 1), L.nx - 1), yi = std::min(y0 + ((c >> 1) & 1), L.ny - 1),
+          zi = std::min(z0 + (c >> 2), L.nz - 1);
       size_t i = (size_t(zi) * L.ny + yi) * L.nx + xi;
       if (L.w[i] <= 0) continue;
       double w = ((c & 1) ? fx : 1 - fx) * ((c & 2) ? fy : 1 - fy) * ((c & 4) ? fz : 1 - fz);

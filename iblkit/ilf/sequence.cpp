@@ -54,7 +54,8 @@ Sequence read_sequence(const std::string& path, const SequenceReadDesc& desc, Se
     (std::string(key) == "ball_radius" ? seq.ball.radius : seq.ball.distance) = v;
   }
   if ((seq.ball.radius > 0 || seq.ball.distance > 0) && seq.mapping != sphere::MappingKind::MirrorBall)
-    fail(ErrorKind::Value, "{}: fields \"ball_radius\"/\"ball_distance\" need the mirrorball mapping, not {}", path, mapping);
+    fail(ErrorKind::Value, "{}: fields \"ball_radius\"/\"ball_distance\" need the mirrorball mapping, not {}", path,
+         mapping);
   if (seq.ball.distance > 0 && !(seq.ball.distance > seq.ball.radius && seq.ball.radius > 0))
     fail(ErrorKind::Value, "{}: field \"ball_distance\" = {} needs a \"ball_radius\" > 0 below it (got {})", path,
          seq.ball.distance, seq.ball.radius);
@@ -76,7 +77,8 @@ Sequence read_sequence(const std::string& path, const SequenceReadDesc& desc, Se
     const auto& p = j["probes"][i];
     std::string where = fmt::format("{}: probe {}", path, i);
     if (!p.is_object()) fail(ErrorKind::Format, "{}: not an object", where);
-    if (!p.contains("image") || !p["image"].is_string()) fail(ErrorKind::Format, "{}: field \"image\" is missing", where);
+    if (!p.contains("image") || !p["image"].is_string())
+      fail(ErrorKind::Format, "{}: field \"image\" is missing", where);
     if (!p.contains("position")) fail(ErrorKind::Format, "{}: field \"position\" is missing", where);
     ProbeEntry e;
     fs::path img = p["image"].get<std::string>();
@@ -89,7 +91,10 @@ Sequence read_sequence(const std::string& path, const SequenceReadDesc& desc, Se
       e.position = vec3_field(p["position"], where + ": field \"position\"");
     } catch (const Error&) {
       if (!desc.skip_bad) throw;
-      if (report) { ++report->skipped; report->reasons.push_back(where + ": bad \"position\""); }
+      if (report) {
+        ++report->skipped;
+        report->reasons.push_back(where + ": bad \"position\"");
+      }
       continue;
     }
     seq.probes.push_back(e);
@@ -110,7 +115,8 @@ Sequence read_sequence(const std::string& path, const SequenceReadDesc& desc, Se
     const auto& e = seq.probes[i];
     std::string problem;
     if (seq.volume_given && !seq.volume.contains(e.position, desc.position_slack))
-      problem = fmt::format("field \"position\" ({}, {}, {}) lies outside the volume", e.position.x, e.position.y, e.position.z);
+      problem = fmt::format("field \"position\" ({}, {}, {}) lies outside the volume", e.position.x, e.position.y,
+                            e.position.z);
     auto key = std::make_tuple(e.position.x, e.position.y, e.position.z);
     if (problem.empty()) {
       auto it = seen.find(key);
@@ -119,7 +125,10 @@ Sequence read_sequence(const std::string& path, const SequenceReadDesc& desc, Se
     if (!problem.empty()) {
       std::string msg = fmt::format("{}: probe {} ({}): {}", path, i, e.image, problem);
       if (!desc.skip_bad) fail(ErrorKind::Value, "{} (skip_bad drops such probes)", msg);
-      if (report) { ++report->skipped; report->reasons.push_back(msg); }
+      if (report) {
+        ++report->skipped;
+        report->reasons.push_back(msg);
+      }
       continue;
     }
     seen.emplace(key, i);
@@ -135,7 +144,8 @@ Sequence read_sequence(const std::string& path, const SequenceReadDesc& desc, Se
         b.max[a] = std::max(b.max[a], e.position[a]);
       }
     for (int a = 0; a < 3; ++a)
-      if (b.max[a] - b.min[a] <= 0) fail(ErrorKind::Value, "{}: the probe positions are flat on axis {}; give a \"volume\"", path, "xyz"[a]);
+      if (b.max[a] - b.min[a] <= 0)
+        fail(ErrorKind::Value, "{}: the probe positions are flat on axis {}; give a \"volume\"", path, "xyz"[a]);
     seq.volume = b;
   }
   return seq;
@@ -160,8 +170,9 @@ void write_sequence(const std::string& path, const Sequence& seq) {
             {"mapping", sphere::mapping_name(seq.mapping)},
             {"dead_angle_deg", seq.dead_angle_deg},
             {"rotation", rot},
-            {"volume", {{"min", {seq.volume.min.x, seq.volume.min.y, seq.volume.min.z}},
-                        {"max", {seq.volume.max.x, seq.volume.max.y, seq.volume.max.z}}}},
+            {"volume",
+             {{"min", {seq.volume.min.x, seq.volume.min.y, seq.volume.min.z}},
+              {"max", {seq.volume.max.x, seq.volume.max.y, seq.volume.max.z}}}},
             {"probes", probes}};
   if (!seq.scene.empty()) j["scene"] = seq.scene;
   if (seq.ball.radius > 0) j["ball_radius"] = seq.ball.radius;

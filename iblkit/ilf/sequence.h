@@ -30,19 +30,19 @@ struct ProbeEntry {
 };
 
 struct Sequence {
-  std::string manifest;             // path the sequence was read from ("" when built in memory)
+  std::string manifest;  // path the sequence was read from ("" when built in memory)
   sphere::MappingKind mapping = sphere::MappingKind::MirrorBall;  // mapping of every frame
-  double dead_angle_deg = 0.0;      // mirror ball: unusable cone behind the ball
-  BallOptics ball;                  // mirror ball: radius and camera distance (0, 0: a single viewpoint)
-  Mat3 rotation = Mat3::identity(); // probe frame -> world
-  Box volume;                       // capture volume (bounding box of the positions by default)
-  bool volume_given = false;        // true when the manifest names the volume
-  std::vector<ProbeEntry> probes;   // in capture order
-  std::string scene;                // optional: the lab scene the frames show ("" for real captures)
+  double dead_angle_deg = 0.0;                                    // mirror ball: unusable cone behind the ball
+  BallOptics ball;                   // mirror ball: radius and camera distance (0, 0: a single viewpoint)
+  Mat3 rotation = Mat3::identity();  // probe frame -> world
+  Box volume;                        // capture volume (bounding box of the positions by default)
+  bool volume_given = false;         // true when the manifest names the volume
+  std::vector<ProbeEntry> probes;    // in capture order
+  std::string scene;                 // optional: the lab scene the frames show ("" for real captures)
 };
 
 struct SequenceReadDesc {
-  bool skip_bad = false;       // drop probes with bad fields (outside volume, duplicates) instead of failing
+  bool skip_bad = false;         // drop probes with bad fields (outside volume, duplicates) instead of failing
   double position_slack = 1e-6;  // metres a probe may sit outside the volume before it counts as outside
 };
 

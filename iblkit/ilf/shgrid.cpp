@@ -7,10 +7,10 @@
 
 #include <nlohmann/json.hpp>
 
+#include "iblkit/core/atomic_file.h"
 #include "iblkit/core/check.h"
 #include "iblkit/core/error.h"
 #include "iblkit/ilf/grid_header.h"
-#include "iblkit/core/atomic_file.h"
 #include "iblkit/sh/basis.h"
 #include "iblkit/sh/convolve.h"
 
@@ -18,10 +18,12 @@ namespace ibl::ilf {
 using nlohmann::json;
 
 SHGrid::SHGrid(const GridDesc& grid, int bands) : grid_(grid), bands_(bands) {
-  if (grid.nx < 2 || grid.ny < 2 || grid.nz < 2) fail(ErrorKind::Value, "SH grid: resolution {}x{}x{} must be at least 2 per axis", grid.nx, grid.ny, grid.nz);
+  if (grid.nx < 2 || grid.ny < 2 || grid.nz < 2)
+    fail(ErrorKind::Value, "SH grid: resolution {}x{}x{} must be at least 2 per axis", grid.nx, grid.ny, grid.nz);
   if (bands < 1 || bands > 16) fail(ErrorKind::Value, "SH grid: bands = {} outside [1, 16]", bands);
   for (int a = 0; a < 3; ++a)
-    if (!(grid.volume.max[a] > grid.volume.min[a])) fail(ErrorKind::Value, "SH grid: volume max must exceed min on axis {}", "xyz"[a]);
+    if (!(grid.volume.max[a] > grid.volume.min[a]))
+      fail(ErrorKind::Value, "SH grid: volume max must exceed min on axis {}", "xyz"[a]);
   require_box("SH grid: volume", grid.volume.min, grid.volume.max, true);
   require_allocation(fmt::format("SH grid: {}x{}x{} points of {} bands", grid.nx, grid.ny, grid.nz, bands),
                      double(grid.count()) * bands * bands * 3, sizeof(float), "choose a coarser grid or fewer bands");
@@ -105,7 +107,8 @@ void write_shgrid(const std::string& path, const SHGrid& g) {
   if (!out) fail(ErrorKind::Io, "{}: cannot write", path);
   out.write(head.data(), std::streamsize(head.size()));
   static_assert(sizeof(float) == 4);
-  out.write(reinterpret_cast<const char*>(g.data().data()), std::streamsize(g.data().size() * 4));  // x86: little-endian
+  out.write(reinterpret_cast<const char*>(g.data().data()),
+            std::streamsize(g.data().size() * 4));  // x86: little-endian
   out.close();
   if (!out) fail(ErrorKind::Io, "{}: write failed", path);
   file.commit();
@@ -118,33 +121,42 @@ SHGrid read_shgrid(const std::string& path, bool any_content) {
   json h = read_grid_header(in, path, "IBLKIT-SHGRID 1", ".shgrid", &off);
   auto need = [&](const char* f) { return grid_header_field(h, path, f); };
   if (need("dtype") != "float32") fail(ErrorKind::Format, "{}: header field \"dtype\" must be \"float32\"", path);
-  if (need("layout") != "z,y,x,coefficient,channel") fail(ErrorKind::Format, "{}: header field \"layout\" is not \"z,y,x,coefficient,channel\"", path);
+  if (need("layout") != "z,y,x,coefficient,channel")
+    fail(ErrorKind::Format, "{}: header field \"layout\" is not \"z,y,x,coefficient,channel\"", path);
   GridDesc gd;
   int bands = 0;
   try {
     bands = static_cast<int>(grid_header_integer(need("bands"), path, "bands", 1, 16));
     std::vector<int> r;
-    for (int64_t n : grid_header_integers(need("resolution"), path, "resolution", 0, 1 << 30)) r.push_back(static_cast<int>(n));
+    for (int64_t n : grid_header_integers(need("resolution"), path, "resolution", 0, 1 << 30))
+      r.push_back(static_cast<int>(n));
     auto mn = need("min").get<std::vector<double>>(), mx = need("max").get<std::vector<double>>();
-    if (r.size() != 3 || mn.size() != 3 || mx.size() != 3) fail(ErrorKind::Format, "{}: \"resolution\", \"min\", \"max\" need 3 values", path);
-    gd.nx = r[0]; gd.ny = r[1]; gd.nz = r[2];
+    if (r.size() != 3 || mn.size() != 3 || mx.size() != 3)
+      fail(ErrorKind::Format, "{}: \"resolution\", \"min\", \"max\" need 3 values", path);
+    gd.nx = r[0];
+    gd.ny = r[1];
+    gd.nz = r[2];
     gd.volume = {{mn[0], mn[1], mn[2]}, {mx[0], mx[1], mx[2]}};
   } catch (const json::exception& e) {
     fail(ErrorKind::Format, "{}: header field of the wrong type ({})", path, e.what());
   }
   if (off % 64 != 0) fail(ErrorKind::Format, "{}: data does not start at a multiple of 64 bytes", path);
   if (gd.nx < 2 || gd.ny < 2 || gd.nz < 2)
-    fail(ErrorKind::Format, "{}: header field \"resolution\" {}x{}x{} must be at least 2 per axis", path, gd.nx, gd.ny, gd.nz);
+    fail(ErrorKind::Format, "{}: header field \"resolution\" {}x{}x{} must be at least 2 per axis", path, gd.nx, gd.ny,
+         gd.nz);
   if (bands < 1 || bands > 16) fail(ErrorKind::Format, "{}: header field \"bands\" = {} outside [1, 16]", path, bands);
   if (!is_finite(gd.volume.min) || !is_finite(gd.volume.max) || !in_range(gd.volume.min) || !in_range(gd.volume.max))
-    fail(ErrorKind::Format, "{}: header fields \"min\", \"max\" ({}, {}, {})–({}, {}, {}) must be finite and within ±{:g} m", path,
-         gd.volume.min.x, gd.volume.min.y, gd.volume.min.z, gd.volume.max.x, gd.volume.max.y, gd.volume.max.z, kMaxCoordinate);
+    fail(ErrorKind::Format,
+         "{}: header fields \"min\", \"max\" ({}, {}, {})–({}, {}, {}) must be finite and within ±{:g} m", path,
+         gd.volume.min.x, gd.volume.min.y, gd.volume.min.z, gd.volume.max.x, gd.volume.max.y, gd.volume.max.z,
+         kMaxCoordinate);
   {  // the declared size against the file's, before anything is allocated
     std::error_code ec;
     const double file_bytes = double(std::filesystem::file_size(path, ec));
     const double want = double(gd.count()) * bands * bands * 3 * 4;
     if (!ec && want > file_bytes - double(off))
-      fail(ErrorKind::Format, "{}: truncated: the header declares {}x{}x{} points of {} bands ({:.0f} data bytes), the file holds {:.0f}",
+      fail(ErrorKind::Format,
+           "{}: truncated: the header declares {}x{}x{} points of {} bands ({:.0f} data bytes), the file holds {:.0f}",
            path, gd.nx, gd.ny, gd.nz, bands, want, std::max(0.0, file_bytes - double(off)));
   }
   SHGrid g(gd, bands);
@@ -152,11 +164,13 @@ SHGrid read_shgrid(const std::string& path, bool any_content) {
     if (!h["content"].is_string()) fail(ErrorKind::Format, "{}: header field \"content\" is not a string", path);
     g.set_content(h["content"].get<std::string>());
     if (!any_content && !g.content().empty())
-      fail(ErrorKind::Format, "{}: holds \"{}\", not radiance SH (an error volume: `iblkit ilf slice` shows it)", path, g.content());
+      fail(ErrorKind::Format, "{}: holds \"{}\", not radiance SH (an error volume: `iblkit ilf slice` shows it)", path,
+           g.content());
   }
   size_t n = g.data().size();
   in.read(reinterpret_cast<char*>(g.data().data()), std::streamsize(n * 4));
-  if (size_t(in.gcount()) != n * 4) fail(ErrorKind::Format, "{}: truncated: {} of {} data bytes", path, in.gcount(), n * 4);
+  if (size_t(in.gcount()) != n * 4)
+    fail(ErrorKind::Format, "{}: truncated: {} of {} data bytes", path, in.gcount(), n * 4);
   for (size_t i = 0; i < n; ++i)
     if (!std::isfinite(g.data()[i])) fail(ErrorKind::Value, "{}: value {} is not finite", path, i);
   return g;

@@ -26,7 +26,9 @@ class SHGrid {
   std::vector<float>& data() { return data_; }
   const std::vector<float>& data() const { return data_; }
   // Pointer to the K·3 floats of grid point (i, j, k).
-  float* at(int i, int j, int k) { return data_.data() + size_t((int64_t(k) * grid_.ny + j) * grid_.nx + i) * coeff_count() * 3; }
+  float* at(int i, int j, int k) {
+    return data_.data() + size_t((int64_t(k) * grid_.ny + j) * grid_.nx + i) * coeff_count() * 3;
+  }
   const float* at(int i, int j, int k) const {
     return data_.data() + size_t((int64_t(k) * grid_.ny + j) * grid_.nx + i) * coeff_count() * 3;
   }

@@ -98,7 +98,10 @@ TEST(SHGrid, FileRoundTripAndLayout) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("truncated"), std::string::npos) << e.what();
   }
-  { std::ofstream o(path); o << "P6\n"; }
+  {
+    std::ofstream o(path);
+    o << "P6\n";
+  }
   EXPECT_THROW(read_shgrid(path), Error);
   fs::remove(path);
 }
@@ -197,11 +200,16 @@ TEST(SHGrid, HeaderSizesAndVolumesAreCheckedBeforeAllocating) {
   };
   // 200³ points of 5 bands declared (2.4 GB), 100 bytes present: refused from the file's length.
   write_header(path, R"({"bands": 5, "resolution": [200, 200, 200], "min": [0, 0, 0], "max": [1, 1, 1])" + tail, 100);
-  EXPECT_NE(message().find("truncated: the header declares 200x200x200 points of 5 bands (2400000000 data bytes), the file holds 100"),
-            std::string::npos) << message();
+  EXPECT_NE(
+      message().find(
+          "truncated: the header declares 200x200x200 points of 5 bands (2400000000 data bytes), the file holds 100"),
+      std::string::npos)
+      << message();
   // min/max ±1e308: the volume's size overflows; refused.
-  write_header(path, R"({"bands": 1, "resolution": [2, 2, 2], "min": [-1e308, -1e308, -1e308], "max": [1e308, 1e308, 1e308])" + tail,
-               8 * 3 * 4);
+  write_header(
+      path,
+      R"({"bands": 1, "resolution": [2, 2, 2], "min": [-1e308, -1e308, -1e308], "max": [1e308, 1e308, 1e308])" + tail,
+      8 * 3 * 4);
   EXPECT_NE(message().find("\"min\", \"max\""), std::string::npos) << message();
   write_header(path, R"({"bands": 0, "resolution": [2, 2, 2], "min": [0, 0, 0], "max": [1, 1, 1])" + tail, 0);
   EXPECT_NE(message().find("\"bands\" = 0"), std::string::npos) << message();

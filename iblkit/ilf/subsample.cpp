@@ -11,7 +11,8 @@ namespace ibl::ilf {
 
 double difference_energy(const Image& a, const Image& b, const sphere::Mapping& m) {
   if (a.width() != b.width() || a.height() != b.height())
-    fail(ErrorKind::Value, "difference energy: frames of {}x{} and {}x{}", a.width(), a.height(), b.width(), b.height());
+    fail(ErrorKind::Value, "difference energy: frames of {}x{} and {}x{}", a.width(), a.height(), b.width(),
+         b.height());
   double diff = 0, sum = 0;
   for (int y = 0; y < a.height(); ++y)
     for (int x = 0; x < a.width(); ++x) {
@@ -53,8 +54,8 @@ std::vector<double> neighbour_energies(const Sequence& seq, const SubsampleDesc&
         fail(err.kind(), "{}: probe {}: field \"image\": {}", seq.manifest, i + 1, err.what());
       }
       if (a.width() != b.width() || a.height() != b.height())
-        fail(ErrorKind::Value, "{}: probe {}: field \"image\": {}x{} differs from probe {}'s {}x{}", seq.manifest, i + 1,
-             b.width(), b.height(), i, a.width(), a.height());
+        fail(ErrorKind::Value, "{}: probe {}: field \"image\": {}x{} differs from probe {}'s {}x{}", seq.manifest,
+             i + 1, b.width(), b.height(), i, a.width(), a.height());
       sphere::Mapping m(seq.mapping, a.width(), a.height(), seq.dead_angle_deg);
       e[i - i0] = difference_energy(a, b, m);
     }

@@ -17,7 +17,7 @@ struct SubsampleDesc {
 };
 
 struct SubsampleReport {
-  int kept = 0, dropped = 0;   // probe counts
+  int kept = 0, dropped = 0;  // probe counts
 };
 
 // Relative difference energy of two frames of the same mapping:

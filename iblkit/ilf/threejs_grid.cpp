@@ -15,7 +15,8 @@ namespace ibl::ilf {
 ThreeGrid to_threejs_grid(const SHGrid& g) {
   const GridDesc& gd = g.grid();
   if (g.bands() < 1 || g.data().empty()) fail(ErrorKind::Value, "three.js grid export: the grid has no coefficients");
-  if (gd.nx < 2 || gd.ny < 2 || gd.nz < 2) fail(ErrorKind::Value, "three.js grid export: the grid needs at least 2 points per axis");
+  if (gd.nx < 2 || gd.ny < 2 || gd.nz < 2)
+    fail(ErrorKind::Value, "three.js grid export: the grid needs at least 2 points per axis");
   ThreeGrid t;
   t.nx = gd.nx;
   t.ny = gd.ny;
@@ -33,7 +34,9 @@ ThreeGrid to_threejs_grid(const SHGrid& g) {
         std::memset(flat, 0, sizeof flat);
         std::memcpy(flat, g.at(i, j, k), sizeof(float) * 3 * K3);  // coefficient-major, then channel
         for (int v = 0; v < kThreeAtlasVolumes; ++v) {
-          auto put = [&](int slice) { std::memcpy(&t.atlas[((size_t(slice) * t.ny + j) * t.nx + i) * 4], flat + 4 * v, 4 * sizeof(float)); };
+          auto put = [&](int slice) {
+            std::memcpy(&t.atlas[((size_t(slice) * t.ny + j) * t.nx + i) * 4], flat + 4 * v, 4 * sizeof(float));
+          };
           int base = v * padded;
           put(base + kThreeAtlasPadding + k);
           if (k == 0) put(base);
@@ -45,13 +48,20 @@ ThreeGrid to_threejs_grid(const SHGrid& g) {
 
 nlohmann::json threejs_grid_header(const ThreeGrid& t, const SHGrid& g, const std::string& atlas_file) {
   const auto& v = g.grid().volume;
-  return {{"format", "iblkit.threejs-grid/1"},
-          {"three", "LightProbeGridWebGL (three r187): assign the atlas to .texture"},
-          {"resolution", {t.nx, t.ny, t.nz}},
-          {"center", {t.center.x, t.center.y, t.center.z}},
-          {"size", {t.size.x, t.size.y, t.size.z}},
-          {"atlas", {{"file", atlas_file}, {"width", t.nx}, {"height", t.ny}, {"depth", t.depth()}, {"type", "float32"}, {"channels", 4}}},
-          {"source", {{"min", {v.min.x, v.min.y, v.min.z}}, {"max", {v.max.x, v.max.y, v.max.z}}, {"bands", g.bands()}}}};
+  return {
+      {"format", "iblkit.threejs-grid/1"},
+      {"three", "LightProbeGridWebGL (three r187): assign the atlas to .texture"},
+      {"resolution", {t.nx, t.ny, t.nz}},
+      {"center", {t.center.x, t.center.y, t.center.z}},
+      {"size", {t.size.x, t.size.y, t.size.z}},
+      {"atlas",
+       {{"file", atlas_file},
+        {"width", t.nx},
+        {"height", t.ny},
+        {"depth", t.depth()},
+        {"type", "float32"},
+        {"channels", 4}}},
+      {"source", {{"min", {v.min.x, v.min.y, v.min.z}}, {"max", {v.max.x, v.max.y, v.max.z}}, {"bands", g.bands()}}}};
 }
 
 std::string write_threejs_grid(const SHGrid& g, const std::string& dir, const std::string& name) {
@@ -62,8 +72,9 @@ std::string write_threejs_grid(const SHGrid& g, const std::string& dir, const st
   fs::create_directories(dir, ec);
   if (ec) fail(ErrorKind::Io, "{}: cannot create the folder ({})", dir, ec.message());
   std::string atlas = name + "_atlas.bin";
-  write_file_atomically((fs::path(dir) / atlas).string(),
-                        std::string_view(reinterpret_cast<const char*>(t.atlas.data()), t.atlas.size() * sizeof(float)));
+  write_file_atomically(
+      (fs::path(dir) / atlas).string(),
+      std::string_view(reinterpret_cast<const char*>(t.atlas.data()), t.atlas.size() * sizeof(float)));
   std::string json = (fs::path(dir) / (name + ".json")).string();
   write_json_file(json, threejs_grid_header(t, g, atlas), 2);
   return json;

@@ -27,14 +27,14 @@
 
 namespace ibl::ilf {
 
-constexpr int kThreeAtlasPadding = 1;   // ATLAS_PADDING in LightProbeGridWebGL.js
-constexpr int kThreeAtlasVolumes = 7;   // 27 coefficients in RGBA texels
+constexpr int kThreeAtlasPadding = 1;  // ATLAS_PADDING in LightProbeGridWebGL.js
+constexpr int kThreeAtlasVolumes = 7;  // 27 coefficients in RGBA texels
 
 struct ThreeGrid {
-  int nx = 0, ny = 0, nz = 0;        // probes per axis (three's `resolution`)
-  Vec3 center, size;                 // three's position and (width, height, depth)
+  int nx = 0, ny = 0, nz = 0;  // probes per axis (three's `resolution`)
+  Vec3 center, size;           // three's position and (width, height, depth)
   int depth() const { return kThreeAtlasVolumes * (nz + 2 * kThreeAtlasPadding); }
-  std::vector<float> atlas;          // nx·ny·depth()·4 floats
+  std::vector<float> atlas;  // nx·ny·depth()·4 floats
 };
 
 ThreeGrid to_threejs_grid(const SHGrid& g);

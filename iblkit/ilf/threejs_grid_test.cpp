@@ -30,7 +30,9 @@ SHGrid coded_grid(int bands) {
 
 // Texel component of atlas slice z as three's shader unpacks it: coefficient k channel c is flat
 // value f = 3k + c, in sub-volume f / 4, component f % 4.
-float atlas(const ThreeGrid& t, int x, int y, int z, int comp) { return t.atlas[((size_t(z) * t.ny + y) * t.nx + x) * 4 + comp]; }
+float atlas(const ThreeGrid& t, int x, int y, int z, int comp) {
+  return t.atlas[((size_t(z) * t.ny + y) * t.nx + x) * 4 + comp];
+}
 
 TEST(ThreeGrid, EveryCoefficientInItsTexelAndPaddingCopiesTheEdges) {
   for (int bands : {3, 5}) {
@@ -67,7 +69,8 @@ TEST(ThreeGrid, ProbePositionsAreTheGridPoints) {
     for (int j = 0; j < t.ny; ++j)
       for (int i = 0; i < t.nx; ++i) {
         // LightProbeGridWebGL.getProbePosition: position − size/2 + (index + ½)·size/resolution.
-        Vec3 three{t.center.x - t.size.x / 2 + (i + 0.5) * t.size.x / t.nx, t.center.y - t.size.y / 2 + (j + 0.5) * t.size.y / t.ny,
+        Vec3 three{t.center.x - t.size.x / 2 + (i + 0.5) * t.size.x / t.nx,
+                   t.center.y - t.size.y / 2 + (j + 0.5) * t.size.y / t.ny,
                    t.center.z - t.size.z / 2 + (l + 0.5) * t.size.z / t.nz};
         Vec3 p = g.grid().point(i, j, l);
         EXPECT_NEAR(three.x, p.x, kPosTol);

@@ -18,7 +18,8 @@ bool have_vdb() { return false; }
 
 void write_vdb(const std::string& path, const SHGrid& g) {
   if (!have_vdb())
-    fail(ErrorKind::Unsupported, "{}: this build has no OpenVDB (configure with OpenVDB found to write .vdb grids)", path);
+    fail(ErrorKind::Unsupported, "{}: this build has no OpenVDB (configure with OpenVDB found to write .vdb grids)",
+         path);
   detail::vdb_writer.get().write(path, g);
 }
 

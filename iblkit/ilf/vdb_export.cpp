@@ -45,10 +45,13 @@ void write_vdb(const std::string& path, const SHGrid& g) {
   meta.insertMeta("iblkit_format", openvdb::StringMetadata("iblkit.shgrid/1"));
   meta.insertMeta("iblkit_bands", openvdb::Int32Metadata(g.bands()));
   meta.insertMeta("iblkit_coefficients", openvdb::Int32Metadata(K));
-  meta.insertMeta("iblkit_min", openvdb::Vec3DMetadata(openvdb::Vec3d(gd.volume.min.x, gd.volume.min.y, gd.volume.min.z)));
-  meta.insertMeta("iblkit_max", openvdb::Vec3DMetadata(openvdb::Vec3d(gd.volume.max.x, gd.volume.max.y, gd.volume.max.z)));
+  meta.insertMeta("iblkit_min",
+                  openvdb::Vec3DMetadata(openvdb::Vec3d(gd.volume.min.x, gd.volume.min.y, gd.volume.min.z)));
+  meta.insertMeta("iblkit_max",
+                  openvdb::Vec3DMetadata(openvdb::Vec3d(gd.volume.max.x, gd.volume.max.y, gd.volume.max.z)));
   meta.insertMeta("iblkit_resolution", openvdb::Vec3IMetadata(openvdb::Vec3i(gd.nx, gd.ny, gd.nz)));
-  meta.insertMeta("iblkit_sh_convention", openvdb::StringMetadata("real orthonormal, no Condon-Shortley phase, k = l(l+1)+m"));
+  meta.insertMeta("iblkit_sh_convention",
+                  openvdb::StringMetadata("real orthonormal, no Condon-Shortley phase, k = l(l+1)+m"));
   AtomicFile out(path);
   try {
     openvdb::io::File file(out.temp_path());

@@ -31,7 +31,8 @@ namespace {
 // OpenImageIO decodes with a thread per core; so do we (the pool starts on the first EXR).
 void use_all_cores() {
   static std::once_flag once;
-  std::call_once(once, [] { Imf::setGlobalThreadCount(static_cast<int>(std::max(1u, std::thread::hardware_concurrency()))); });
+  std::call_once(
+      once, [] { Imf::setGlobalThreadCount(static_cast<int>(std::max(1u, std::thread::hardware_concurrency()))); });
 }
 
 // Position of a channel name in the order OpenImageIO gives, or -1 for a name we leave to it.
@@ -71,7 +72,7 @@ void check_header(const std::string& path) {
   for (;;) {  // headers
     bool empty = true;
     int64_t width = 0, height = 0, channels = 0, tile_w = 0, tile_h = 0;
-    for (;;) {  // attributes
+    for (;;) {                        // attributes
       if (!read_name(&name)) return;  // OpenEXR reports the broken header itself
       if (name.empty()) break;        // the end of this header
       empty = false;
@@ -79,8 +80,9 @@ void check_header(const std::string& path) {
       if (!read_name(&type) || !in.read(reinterpret_cast<char*>(&size), 4)) return;
       const std::streamoff left = file_size - in.tellg();
       if (size < 0 || size > left)
-        fail(ErrorKind::Format, "{}: corrupt or truncated: the header's attribute '{}' ({}) declares {} bytes, {} are left in the file", path,
-             name, type, size, static_cast<int64_t>(left));
+        fail(ErrorKind::Format,
+             "{}: corrupt or truncated: the header's attribute '{}' ({}) declares {} bytes, {} are left in the file",
+             path, name, type, size, static_cast<int64_t>(left));
       const bool window = name == "dataWindow" && type == "box2i" && size == 16;
       const bool tiles = name == "tiles" && type == "tiledesc" && size == 9;
       const bool chlist = name == "channels" && type == "chlist";
@@ -113,8 +115,10 @@ void check_header(const std::string& path) {
     // A tile larger than the window is legal, but OpenEXR allocates its buffer whole.
     if (tile_w > 0 && tile_h > 0 && tile_w * tile_h > std::max<int64_t>(width * height, 1)) {
       const int64_t bytes = tile_w * tile_h * std::max<int64_t>(channels, 1) * int64_t(sizeof(float));
-      if (tile_w * tile_h > (int64_t(1) << 30) || (bytes > kAnyFileMayDecodeTo && bytes / kMaxCompression > static_cast<int64_t>(file_size)))
-        fail(ErrorKind::Format, "{}: corrupt: its header declares {}x{} tiles for a {}x{} image, which its {} bytes cannot hold", path,
+      if (tile_w * tile_h > (int64_t(1) << 30) ||
+          (bytes > kAnyFileMayDecodeTo && bytes / kMaxCompression > static_cast<int64_t>(file_size)))
+        fail(ErrorKind::Format,
+             "{}: corrupt: its header declares {}x{} tiles for a {}x{} image, which its {} bytes cannot hold", path,
              tile_w, tile_h, width, height, static_cast<int64_t>(file_size));
     }
     if (!multipart || empty) return;  // one header, or the empty one that ends a multi-part list
@@ -177,7 +181,8 @@ std::optional<Decoded> read_exr(const std::string& path) {
     Imf::InputFile file(path.c_str());
     auto l = layout_of(file.header());
     if (!l) return std::nullopt;
-    if (l->width <= 0 || l->height <= 0) fail(ErrorKind::Format, "{}: image has no pixels ({}x{})", path, l->width, l->height);
+    if (l->width <= 0 || l->height <= 0)
+      fail(ErrorKind::Format, "{}: image has no pixels ({}x{})", path, l->width, l->height);
     const int nc = static_cast<int>(l->channels.size());
     check_decoded_size(path, l->width, l->height, nc);
     Decoded d;
@@ -188,7 +193,8 @@ std::optional<Decoded> read_exr(const std::string& path) {
     const size_t xs = sizeof(float) * nc, ys = xs * l->width;
     char* base = reinterpret_cast<char*>(d.image.data());
     Imf::FrameBuffer fb;
-    for (int c = 0; c < nc; ++c) fb.insert(l->channels[c], Imf::Slice::Make(Imf::FLOAT, base + c * sizeof(float), l->window, xs, ys));
+    for (int c = 0; c < nc; ++c)
+      fb.insert(l->channels[c], Imf::Slice::Make(Imf::FLOAT, base + c * sizeof(float), l->window, xs, ys));
     file.setFrameBuffer(fb);
     try {
       file.readPixels(l->window.min.y, l->window.max.y);

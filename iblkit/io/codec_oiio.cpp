@@ -62,7 +62,8 @@ void oiio_write(const std::string& path, const Image& img, bool ldr, bool half) 
   if (ldr) spec.attribute("oiio:ColorSpace", "sRGB");
   if (exr) spec.attribute("compression", "zip");
   if (!out->open(path, spec)) fail(ErrorKind::Io, "{}: cannot write ({})", path, out->geterror());
-  if (!out->write_image(OIIO::TypeDesc::FLOAT, img.data())) fail(ErrorKind::Io, "{}: write failed ({})", path, out->geterror());
+  if (!out->write_image(OIIO::TypeDesc::FLOAT, img.data()))
+    fail(ErrorKind::Io, "{}: write failed ({})", path, out->geterror());
   if (!out->close()) fail(ErrorKind::Io, "{}: close failed ({})", path, out->geterror());
 }
 
@@ -70,7 +71,8 @@ bool oiio_draw_text(Image& img, int x, int y, const std::string& text, int size,
   OIIO::ImageSpec spec(img.width(), img.height(), img.channels(), OIIO::TypeDesc::FLOAT);
   OIIO::ImageBuf buf(spec, img.data());  // wraps our pixels
   float col[4] = {static_cast<float>(rgb.x), static_cast<float>(rgb.y), static_cast<float>(rgb.z), 1.0f};
-  return OIIO::ImageBufAlgo::render_text(buf, x, y, text, size, font, OIIO::cspan<float>(col, img.channels() >= 4 ? 4 : 3));
+  return OIIO::ImageBufAlgo::render_text(buf, x, y, text, size, font,
+                                         OIIO::cspan<float>(col, img.channels() >= 4 ? 4 : 3));
 }
 
 const OiioCodec kCodec{oiio_read, oiio_read_header, oiio_write, oiio_draw_text};

@@ -42,9 +42,12 @@ PfmHeader parse_header(std::istream& in, const std::string& path) {
   };
   PfmHeader h;
   std::string magic = token(in);
-  if (magic == "PF") h.channels = 3;
-  else if (magic == "Pf") h.channels = 1;
-  else return bad("no PF/Pf magic");
+  if (magic == "PF")
+    h.channels = 3;
+  else if (magic == "Pf")
+    h.channels = 1;
+  else
+    return bad("no PF/Pf magic");
   try {
     size_t used = 0;
     std::string w = token(in), ht = token(in), s = token(in);
@@ -89,8 +92,9 @@ Decoded read_pfm(const std::string& path) {
     in.seekg(here);
     const int64_t need = int64_t(h.width) * h.height * h.channels * int64_t(sizeof(float));
     if (left < need)
-      fail(ErrorKind::Format, "{}: corrupt or truncated image data (the header declares {}x{}x{}: {} bytes, the file holds {})",
-           path, h.width, h.height, h.channels, need, static_cast<int64_t>(left));
+      fail(ErrorKind::Format,
+           "{}: corrupt or truncated image data (the header declares {}x{}x{}: {} bytes, the file holds {})", path,
+           h.width, h.height, h.channels, need, static_cast<int64_t>(left));
   }
   Decoded d;
   d.format = "pnm";

@@ -67,7 +67,8 @@ void write_png(const std::string& path, const Image& img, bool srgb) {
   std::FILE* f = std::fopen(path.c_str(), "wb");
   if (!f) fail(ErrorKind::Io, "{}: cannot write ({})", path, std::strerror(errno));
   std::string why;
-  static constexpr int kColorType[4] = {PNG_COLOR_TYPE_GRAY, PNG_COLOR_TYPE_GRAY_ALPHA, PNG_COLOR_TYPE_RGB, PNG_COLOR_TYPE_RGB_ALPHA};
+  static constexpr int kColorType[4] = {PNG_COLOR_TYPE_GRAY, PNG_COLOR_TYPE_GRAY_ALPHA, PNG_COLOR_TYPE_RGB,
+                                        PNG_COLOR_TYPE_RGB_ALPHA};
   bool ok = encode(f, w, h, kColorType[nc - 1], rows.data(), srgb, &why);
   ok = (std::fclose(f) == 0) && ok;
   if (!ok) fail(ErrorKind::Io, "{}: write failed ({})", path, why.empty() ? "libpng" : why);

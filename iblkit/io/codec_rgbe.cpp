@@ -52,11 +52,13 @@ bool read_header(std::FILE* f, const std::string& path, int& w, int& h) {
     fail(ErrorKind::Format, "{}: not an image format this build reads (no Radiance '#?' header line)", path);
   bool keep = true;
   while (true) {
-    if (!read_line(f, line)) fail(ErrorKind::Format, "{}: not an image format this build reads (header ends early)", path);
+    if (!read_line(f, line))
+      fail(ErrorKind::Format, "{}: not an image format this build reads (header ends early)", path);
     if (line.empty()) break;
     if (line.rfind("FORMAT=", 0) == 0 && line != "FORMAT=32-bit_rle_rgbe") keep = false;
   }
-  if (!read_line(f, line)) fail(ErrorKind::Format, "{}: not an image format this build reads (no resolution line)", path);
+  if (!read_line(f, line))
+    fail(ErrorKind::Format, "{}: not an image format this build reads (no resolution line)", path);
   char a[3] = {}, b[3] = {};
   int n1 = 0, n2 = 0;
   if (std::sscanf(line.c_str(), "%2s %d %2s %d", a, &n1, b, &n2) != 4)
@@ -195,8 +197,9 @@ std::optional<Decoded> read_rgbe(const std::string& path) {
     const long left = std::ftell(f.get()) - here;
     std::fseek(f.get(), here, SEEK_SET);
     if (here < 0 || left < 4L * h)
-      fail(ErrorKind::Format, "{}: corrupt or truncated image data (the header declares {} rows, the file holds {} bytes of pixels)",
-           path, h, left);
+      fail(ErrorKind::Format,
+           "{}: corrupt or truncated image data (the header declares {} rows, the file holds {} bytes of pixels)", path,
+           h, left);
   }
   Decoded d;
   d.format = "hdr";

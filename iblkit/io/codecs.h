@@ -47,8 +47,11 @@ inline void check_decoded_size(const std::string& path, int64_t width, int64_t h
   std::error_code ec;
   const auto file = std::filesystem::file_size(path, ec);
   if (!ec && bytes > kAnyFileMayDecodeTo && bytes / kMaxCompression > static_cast<int64_t>(file))
-    fail(ErrorKind::Format, "{}: corrupt or truncated: its header declares a {}x{} image of {} channels ({} MB of pixels), which its {} bytes "
-         "cannot hold", path, width, height, channels, bytes >> 20, static_cast<int64_t>(file));
+    fail(ErrorKind::Format,
+         "{}: corrupt or truncated: its header declares a {}x{} image of {} channels ({} MB of pixels), which its {} "
+         "bytes "
+         "cannot hold",
+         path, width, height, channels, bytes >> 20, static_cast<int64_t>(file));
 }
 
 // What a file is, from its first bytes.

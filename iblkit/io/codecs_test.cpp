@@ -113,8 +113,10 @@ TEST(Codecs, ExrWrittenByEitherReadsTheSame) {
       // The same channel names and pixel types in both files.
       Imf::InputFile fa(a.c_str()), fb(b.c_str());
       std::vector<std::pair<std::string, int>> ca, cb;
-      for (auto c = fa.header().channels().begin(); c != fa.header().channels().end(); ++c) ca.push_back({c.name(), c.channel().type});
-      for (auto c = fb.header().channels().begin(); c != fb.header().channels().end(); ++c) cb.push_back({c.name(), c.channel().type});
+      for (auto c = fa.header().channels().begin(); c != fa.header().channels().end(); ++c)
+        ca.push_back({c.name(), c.channel().type});
+      for (auto c = fb.header().channels().begin(); c != fb.header().channels().end(); ++c)
+        cb.push_back({c.name(), c.channel().type});
       EXPECT_EQ(ca, cb);
       EXPECT_EQ(fb.header().compression(), Imf::ZIP_COMPRESSION);
     }
@@ -127,7 +129,8 @@ std::string exr_with_channels(const std::string& name, const std::vector<std::st
   Imath::Box2i win({3, 5}, {3 + 8, 5 + 4});
   Imf::Header h(Imath::Box2i({0, 0}, {20, 20}), win);
   std::vector<float> data(9 * 5 * channels.size());
-  for (size_t i = 0; i < data.size(); ++i) data[i] = static_cast<float>(i % channels.size() + 1) + 0.001f * (i / channels.size());
+  for (size_t i = 0; i < data.size(); ++i)
+    data[i] = static_cast<float>(i % channels.size() + 1) + 0.001f * (i / channels.size());
   Imf::FrameBuffer fb;
   size_t xs = sizeof(float) * channels.size(), ys = xs * 9;
   char* base = reinterpret_cast<char*>(data.data()) - 3 * xs - 5 * ys;
@@ -146,7 +149,8 @@ TEST(Codecs, ExrChannelOrderAndDataWindowFollowOpenImageIO) {
   EXPECT_TRUE(compare_reads(exr_with_channels("ya.exr", {"A", "Y"})));
   EXPECT_TRUE(compare_reads(exr_with_channels("rgby.exr", {"Y", "B", "R", "G"})));
   // Layers and other names: left to OpenImageIO, and read_image still reads them.
-  for (auto chans : std::vector<std::vector<std::string>>{{"diffuse.R", "diffuse.G", "diffuse.B"}, {"Z"}, {"R", "G", "B", "depth"}}) {
+  for (auto chans : std::vector<std::vector<std::string>>{
+           {"diffuse.R", "diffuse.G", "diffuse.B"}, {"Z"}, {"R", "G", "B", "depth"}}) {
     std::string p = exr_with_channels("other.exr", chans);
     EXPECT_FALSE(read_exr(p).has_value()) << chans[0];
     Image img = read_image(p);
@@ -159,7 +163,8 @@ TEST(Codecs, RgbeWrittenByEitherReadsTheSame) {
   for (int w : {37, 5}) {  // run-length encoded scanlines, and flat ones (narrower than 8)
     Image img = test_image(w, 9, 3, 3);
     for (int x = 0; x < w; ++x) img.set_rgb(x, 4, {2.5, 0.5, 1.25});  // long runs
-    std::string a = (tmpdir() / fmt::format("oiio_{}.hdr", w)).string(), b = (tmpdir() / fmt::format("ours_{}.hdr", w)).string();
+    std::string a = (tmpdir() / fmt::format("oiio_{}.hdr", w)).string(),
+                b = (tmpdir() / fmt::format("ours_{}.hdr", w)).string();
     oiio().write(a, img, false, false);
     write_rgbe(b, img);
     ASSERT_TRUE(compare_reads(a));
@@ -178,10 +183,12 @@ TEST(Codecs, PngWrittenByEitherReadsTheSame) {
         for (int c = 0; c < nc; ++c) {
           // Every level, and half steps give or take a few ulps (where rounding rules differ).
           float v = y < 3 ? (x + 0.5f * y + 0.25f * c) / 255.0f : (x + 0.5f) / 255.0f;
-          for (int k = static_cast<int>(rng() % 9) - 4; k != 0; k += k > 0 ? -1 : 1) v = std::nextafter(v, k > 0 ? 2.0f : -1.0f);
+          for (int k = static_cast<int>(rng() % 9) - 4; k != 0; k += k > 0 ? -1 : 1)
+            v = std::nextafter(v, k > 0 ? 2.0f : -1.0f);
           img.at(x, y, c) = std::clamp(v, 0.0f, 1.0f);
         }
-    std::string a = (tmpdir() / fmt::format("oiio_{}.png", nc)).string(), b = (tmpdir() / fmt::format("ours_{}.png", nc)).string();
+    std::string a = (tmpdir() / fmt::format("oiio_{}.png", nc)).string(),
+                b = (tmpdir() / fmt::format("ours_{}.png", nc)).string();
     oiio().write(a, img, true, false);
     write_png(b, img);
     expect_same(oiio().read(a), oiio().read(b), fmt::format("{} channels", nc));
@@ -191,7 +198,8 @@ TEST(Codecs, PngWrittenByEitherReadsTheSame) {
 
 TEST(Codecs, PfmOfEitherByteOrderReadsTheSame) {
   Image img = test_image(6, 4, 3, 11);
-  std::string le = (tmpdir() / "le.pfm").string(), be = (tmpdir() / "be.pfm").string(), grey = (tmpdir() / "grey.pfm").string();
+  std::string le = (tmpdir() / "le.pfm").string(), be = (tmpdir() / "be.pfm").string(),
+              grey = (tmpdir() / "grey.pfm").string();
   write_image(le, img);
   write_image(grey, test_image(6, 4, 1, 12));
   {
@@ -216,7 +224,8 @@ TEST(Codecs, PfmOfEitherByteOrderReadsTheSame) {
 TEST(Codecs, BrokenFilesAreFormatErrorsNamingTheFile) {
   Image img = test_image(64, 16, 3, 5);
   for (const char* ext : {".exr", ".hdr", ".pfm"}) {
-    std::string good = (tmpdir() / (std::string("good") + ext)).string(), cut = (tmpdir() / (std::string("cut") + ext)).string();
+    std::string good = (tmpdir() / (std::string("good") + ext)).string(),
+                cut = (tmpdir() / (std::string("cut") + ext)).string();
     write_image(good, img);
     std::ifstream in(good, std::ios::binary);
     std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

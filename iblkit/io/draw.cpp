@@ -105,7 +105,8 @@ Image contact_sheet(const std::vector<std::pair<std::string, Image>>& pictures, 
   if (!title.empty()) draw_text(sheet, kPad, 24, title, 20, {1, 1, 1});
   for (int i = 0; i < n; ++i) {
     const Image& pic = pictures[i].second;
-    int cx = kPad + (i % columns) * (cell_width + kPad), cy = top + kPad + (i / columns) * (cell_height + kCaption + kPad);
+    int cx = kPad + (i % columns) * (cell_width + kPad),
+        cy = top + kPad + (i / columns) * (cell_height + kCaption + kPad);
     double s = std::min(static_cast<double>(cell_width) / pic.width(), static_cast<double>(cell_height) / pic.height());
     int w = std::max(1, static_cast<int>(pic.width() * s)), h = std::max(1, static_cast<int>(pic.height() * s));
     Image small = resize(pic.channels() >= 3 ? pic : pic.with_channels(3), w, h);

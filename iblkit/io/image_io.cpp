@@ -16,9 +16,7 @@ namespace ibl::io {
 
 namespace fs = std::filesystem;
 
-float srgb_to_linear(float v) {
-  return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
-}
+float srgb_to_linear(float v) { return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f); }
 float linear_to_srgb(float v) {
   v = std::clamp(v, 0.0f, 1.0f);
   return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
@@ -36,7 +34,10 @@ int check_pixels(Image& img, const std::string& what, bool sanitize) {
   double mean_abs = 0;
   size_t finite = 0;
   for (size_t i = 0; i < img.size(); ++i)
-    if (std::isfinite(d[i]) && std::abs(d[i]) <= kMaxPixel) { mean_abs += std::abs(d[i]); ++finite; }
+    if (std::isfinite(d[i]) && std::abs(d[i]) <= kMaxPixel) {
+      mean_abs += std::abs(d[i]);
+      ++finite;
+    }
   float noise = static_cast<float>(finite ? kNoise * mean_abs / finite : 0.0);
   int bad = 0;
   for (size_t i = 0; i < img.size(); ++i) {
@@ -50,8 +51,8 @@ int check_pixels(Image& img, const std::string& what, bool sanitize) {
       size_t p = i / nc;
       int x = static_cast<int>(p % img.width()), y = static_cast<int>(p / img.width());
       const char* kind = std::isnan(v) ? "NaN" : (std::isinf(v) ? "Inf" : (v > kMaxPixel ? "above 1e20" : "negative"));
-      fail(ErrorKind::Value, "{}: pixel ({}, {}) channel {} is {} ({}); sanitize replaces such values by 0",
-           what, x, y, static_cast<int>(i % nc), kind, v);
+      fail(ErrorKind::Value, "{}: pixel ({}, {}) channel {} is {} ({}); sanitize replaces such values by 0", what, x, y,
+           static_cast<int>(i % nc), kind, v);
     }
     d[i] = 0.0f;
     ++bad;
@@ -77,10 +78,14 @@ FileKind sniff(const std::string& path) {
 
 std::optional<Decoded> read_own(const std::string& path) {
   switch (sniff(path)) {
-    case FileKind::OpenExr: return read_exr(path);
-    case FileKind::Rgbe: return read_rgbe(path);
-    case FileKind::Pfm: return read_pfm(path);
-    case FileKind::Other: break;
+    case FileKind::OpenExr:
+      return read_exr(path);
+    case FileKind::Rgbe:
+      return read_rgbe(path);
+    case FileKind::Pfm:
+      return read_pfm(path);
+    case FileKind::Other:
+      break;
   }
   return std::nullopt;
 }
@@ -88,10 +93,17 @@ std::optional<Decoded> read_own(const std::string& path) {
 Header read_header(const std::string& path) {
   std::optional<Header> h;
   switch (sniff(path)) {
-    case FileKind::OpenExr: h = read_exr_header(path); break;
-    case FileKind::Rgbe: h = read_rgbe_header(path); break;
-    case FileKind::Pfm: h = read_pfm_header(path); break;
-    case FileKind::Other: break;
+    case FileKind::OpenExr:
+      h = read_exr_header(path);
+      break;
+    case FileKind::Rgbe:
+      h = read_rgbe_header(path);
+      break;
+    case FileKind::Pfm:
+      h = read_pfm_header(path);
+      break;
+    case FileKind::Other:
+      break;
   }
   return h ? *h : oiio_codec.get().read_header(path);
 }
@@ -141,7 +153,6 @@ void write_pfm(const std::string& file, const std::string& path, const Image& im
   if (!ok) fail(ErrorKind::Io, "{}: write failed", path);
 }
 
-
 // Our own writers where they write what OpenImageIO would; OpenImageIO (a plugin) for the rest (PNG
 // with alpha among them: OpenImageIO divides colour by alpha on writing it).
 void write_encoded(const std::string& file, const std::string& ext, const Image& src, bool ldr, bool half, bool data) {
@@ -149,7 +160,8 @@ void write_encoded(const std::string& file, const std::string& ext, const Image&
   if (ext == ".exr" && nc <= 4) return detail::write_exr(file, src, half);
   if (ext == ".hdr" && nc == 3) return detail::write_rgbe(file, src);
   if (ext == ".png" && (nc == 1 || nc == 3 || (data && nc <= 4))) return detail::write_png(file, src, !data);
-  if (data) fail(ErrorKind::Value, "{}: a data image is written as .png with 1 to 4 channels (got {} channels)", file, nc);
+  if (data)
+    fail(ErrorKind::Value, "{}: a data image is written as .png with 1 to 4 channels (got {} channels)", file, nc);
   detail::oiio_codec.get().write(file, src, ldr, half && ext == ".exr");
 }
 }  // namespace
@@ -174,11 +186,14 @@ void write_image(const std::string& path, const Image& img, const WriteDesc& des
   // format) and the file is renamed into place only when complete; messages name `path`.
   AtomicFile file(path);
   try {
-    if (ext == ".pfm") write_pfm(file.temp_path(), path, img);
-    else write_encoded(file.temp_path(), ext, src, ldr, desc.half, desc.data);
+    if (ext == ".pfm")
+      write_pfm(file.temp_path(), path, img);
+    else
+      write_encoded(file.temp_path(), ext, src, ldr, desc.half, desc.data);
   } catch (const Error& e) {
     std::string msg = e.what();
-    for (size_t at; (at = msg.find(file.temp_path())) != std::string::npos;) msg.replace(at, file.temp_path().size(), path);
+    for (size_t at; (at = msg.find(file.temp_path())) != std::string::npos;)
+      msg.replace(at, file.temp_path().size(), path);
     throw Error(e.kind(), msg);
   }
   file.commit();

@@ -17,7 +17,7 @@ struct ReadDesc {
 };
 
 struct ReadReport {
-  int sanitized = 0;         // values replaced because of `sanitize`
+  int sanitized = 0;          // values replaced because of `sanitize`
   bool srgb_decoded = false;  // 8-bit sRGB input decoded to linear
   std::string format;         // OpenImageIO's name of the format ("openexr", "hdr", "pnm", …)
 };

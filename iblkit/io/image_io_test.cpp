@@ -7,20 +7,20 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 #include <initializer_list>
+#include <iterator>
 #include <limits>
 #include <utility>
 
-#include "iblkit/core/error.h"
-#include "iblkit/io/envmap_io.h"
-#include "iblkit/io/tonemap.h"
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfFrameBuffer.h>
 #include <OpenEXR/ImfHeader.h>
 #include <OpenEXR/ImfTileDescription.h>
 #include <OpenEXR/ImfTiledOutputFile.h>
 #include <vector>
+#include "iblkit/core/error.h"
+#include "iblkit/io/envmap_io.h"
+#include "iblkit/io/tonemap.h"
 
 using ibl::test_util::expect_error;
 
@@ -57,7 +57,7 @@ TEST(ImageIo, FloatFormatsRoundTripExactly) {
 }
 
 TEST(ImageIo, RgbeAndHalfKeepRelativePrecision) {
-  constexpr double kRgbeRelTol = 1.0 / 128;  // 8-bit mantissa shared exponent: ≤ 2^-8 of the largest channel
+  constexpr double kRgbeRelTol = 1.0 / 128;   // 8-bit mantissa shared exponent: ≤ 2^-8 of the largest channel
   constexpr double kHalfRelTol = 1.0 / 1024;  // 10-bit mantissa
   Image img = gradient(16, 8, 3);
   std::string hdr = (tmpdir() / "rt.hdr").string(), exr = (tmpdir() / "half.exr").string();
@@ -114,7 +114,8 @@ TEST(ImageIo, TruncatedFileIsAFormatError) {
 
 // Writes a small EXR at `name` and overwrites int32 (little-endian) values in it: each pair is the offset after
 // the first occurrence of `key` and the value. Returns the path; fails the test where `key` is missing.
-std::string patched_exr(const std::string& name, int size, const std::string& key, std::initializer_list<std::pair<size_t, int32_t>> values) {
+std::string patched_exr(const std::string& name, int size, const std::string& key,
+                        std::initializer_list<std::pair<size_t, int32_t>> values) {
   std::string p = (tmpdir() / name).string();
   write_image(p, gradient(size, size, 3));
   std::ifstream in(p, std::ios::binary);
@@ -132,7 +133,8 @@ TEST(ImageIo, AHeaderDeclaringMorePixelsThanItsFileCanHoldIsRefusedBeforeAllocat
   // A 64×64 EXR whose data window is rewritten to 16384×16384 (4 GB of float RGB): refused from the header and
   // the file's size (io/codecs.h, check_decoded_size), not after OpenEXR allocated the frame buffer. After the key:
   // the attribute's size, then xMin, yMin, xMax, yMax (int32).
-  std::string p = patched_exr("declares-16k.exr", 64, std::string("dataWindow\0box2i\0", 17), {{12, 16383}, {16, 16383}});
+  std::string p =
+      patched_exr("declares-16k.exr", 64, std::string("dataWindow\0box2i\0", 17), {{12, 16383}, {16, 16383}});
   expect_error([&] { read_image(p); }, ErrorKind::Format, {p, "16384x16384", "cannot hold"});
 }
 

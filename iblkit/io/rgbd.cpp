@@ -8,8 +8,8 @@
 namespace ibl::io {
 
 namespace {
-constexpr double kGamma = 2.2;      // Babylon's LinearEncodePowerApprox
-constexpr double kEpsilon = 1e-7;   // its maxEps floor of max(r, g, b)
+constexpr double kGamma = 2.2;     // Babylon's LinearEncodePowerApprox
+constexpr double kEpsilon = 1e-7;  // its maxEps floor of max(r, g, b)
 
 double clean(double v) { return std::isfinite(v) && v > 0 ? v : 0.0; }
 std::uint8_t byte_of(float v) { return static_cast<std::uint8_t>(std::clamp(std::lround(v * 255.0), 0L, 255L)); }

@@ -61,7 +61,8 @@ TEST(Rgbd, RoundTripWithinTheQuantisationBound) {
       ASSERT_LE(err, bound * (1 + 1e-9) + 1e-12) << "c = (" << c.x << ", " << c.y << ", " << c.z << "), channel " << a;
       if (bound > 0) worst_ratio = std::max(worst_ratio, err / bound);
     }
-    if (m >= 1) worst_rel_max = std::max(worst_rel_max, std::abs(d[0] + d[1] + d[2] - c[0] - c[1] - c[2]) / (c[0] + c[1] + c[2]));
+    if (m >= 1)
+      worst_rel_max = std::max(worst_rel_max, std::abs(d[0] + d[1] + d[2] - c[0] - c[1] - c[2]) / (c[0] + c[1] + c[2]));
   }
   EXPECT_GT(worst_ratio, 0.5) << "the bound is far from what quantisation reaches";
   // From m = 1 to 255 the pixel keeps its relative precision: there k = ⌊255/m⌋ (unclamped) and
@@ -92,9 +93,9 @@ TEST(Rgbd, Images) {
       Vec3 want = rgbd_decode(rgbd_encode(hdr.rgb(x, y)));
       for (int c = 0; c < 3; ++c) EXPECT_NEAR(dec.at(x, y, c), want[c], 1e-5 * std::max(1.0, want[c]));
     }
-  EXPECT_THROW(rgbd_decode_image(hdr), Error);   // 3 channels
+  EXPECT_THROW(rgbd_decode_image(hdr), Error);  // 3 channels
   enc.at(0, 0, 3) = 0;
-  EXPECT_THROW(rgbd_decode_image(enc), Error);   // d = 0
+  EXPECT_THROW(rgbd_decode_image(enc), Error);  // d = 0
 }
 
 }  // namespace

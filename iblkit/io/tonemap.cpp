@@ -33,23 +33,28 @@ inline double aces(double x) {
 
 Image tonemap(const Image& img, const ToneMapDesc& desc) {
   require_number("tone map: exposure (stops)", desc.exposure_stops, -64, 64);
-  if (!(desc.key > 0) || !std::isfinite(desc.key)) fail(ErrorKind::Value, "tone map: key {} must be a finite number > 0", desc.key);
+  if (!(desc.key > 0) || !std::isfinite(desc.key))
+    fail(ErrorKind::Value, "tone map: key {} must be a finite number > 0", desc.key);
   double scale = (desc.auto_exposure ? auto_exposure_scale(img, desc.key) : 1.0) * std::exp2(desc.exposure_stops);
   Image out(img.width(), img.height(), 3);
   parallel_for(0, img.height(), [&](int64_t y) {
     for (int x = 0; x < img.width(); ++x) {
       Vec3 c = img.rgb(x, static_cast<int>(y)) * scale;
       switch (desc.curve) {
-        case ToneCurve::Clamp: break;
+        case ToneCurve::Clamp:
+          break;
         case ToneCurve::Reinhard: {
           // Reinhard et al. 2002 on luminance, so hues are kept.
           double l = luminance(c);
           if (l > 0) c = c * (1.0 / (1.0 + l));
           break;
         }
-        case ToneCurve::Aces: c = {aces(c.x), aces(c.y), aces(c.z)}; break;
+        case ToneCurve::Aces:
+          c = {aces(c.x), aces(c.y), aces(c.z)};
+          break;
       }
-      out.set_rgb(x, static_cast<int>(y), {std::clamp(c.x, 0.0, 1.0), std::clamp(c.y, 0.0, 1.0), std::clamp(c.z, 0.0, 1.0)});
+      out.set_rgb(x, static_cast<int>(y),
+                  {std::clamp(c.x, 0.0, 1.0), std::clamp(c.y, 0.0, 1.0), std::clamp(c.z, 0.0, 1.0)});
     }
   });
   return out;

@@ -7,9 +7,9 @@ namespace ibl::io {
 enum class ToneCurve { Clamp, Reinhard, Aces };
 
 struct ToneMapDesc {
-  bool auto_exposure = true;   // scale so that the median luminance lands on `key`
-  double key = 0.18;           // target for the median luminance with auto exposure
-  double exposure_stops = 0.0; // added on top (or alone when auto_exposure is false)
+  bool auto_exposure = true;    // scale so that the median luminance lands on `key`
+  double key = 0.18;            // target for the median luminance with auto exposure
+  double exposure_stops = 0.0;  // added on top (or alone when auto_exposure is false)
   ToneCurve curve = ToneCurve::Aces;
 };
 

@@ -17,11 +17,16 @@ using sphere::MappingKind;
 sphere::Mapping capture_mapping(MappingKind k, int size, double dead_angle_deg) {
   if (size < 1 || size > 16384) fail(ErrorKind::Value, "capture size {} is out of range [1, 16384]", size);
   switch (k) {
-    case MappingKind::LatLong: return {k, 2 * size, size};
-    case MappingKind::CubeHCross: return {k, 4 * size, 3 * size};
-    case MappingKind::CubeVCross: return {k, 3 * size, 4 * size};
-    case MappingKind::CubeStrip: return {k, 6 * size, size};
-    default: return {k, size, size, dead_angle_deg};
+    case MappingKind::LatLong:
+      return {k, 2 * size, size};
+    case MappingKind::CubeHCross:
+      return {k, 4 * size, 3 * size};
+    case MappingKind::CubeVCross:
+      return {k, 3 * size, 4 * size};
+    case MappingKind::CubeStrip:
+      return {k, 6 * size, size};
+    default:
+      return {k, size, size, dead_angle_deg};
   }
 }
 
@@ -65,7 +70,8 @@ uint64_t small_apertures(const Scene& scene, Vec3 position, const CaptureDesc& d
     double omega = e.emit_area * std::abs(dot(w, e.direction)) / (d * d);
     double px, py, pixel = mean_pixel;
     if (m.to_pixel(desc.rotation.transposed() * w, &px, &py)) {
-      int x = std::clamp(static_cast<int>(px), 0, m.width() - 1), y = std::clamp(static_cast<int>(py), 0, m.height() - 1);
+      int x = std::clamp(static_cast<int>(px), 0, m.width() - 1),
+          y = std::clamp(static_cast<int>(py), 0, m.height() - 1);
       if (m.solid_angle_estimate(x, y) > 0) pixel = m.solid_angle_estimate(x, y);
     }
     if (omega < kSmallApertureFactor * pixel) {
@@ -80,8 +86,8 @@ uint64_t small_apertures(const Scene& scene, Vec3 position, const CaptureDesc& d
 // Adds the light of lamp e's aperture to the pixels it falls in: K equal-area points q on the disc,
 // each visible one carrying E = I(−ω)/(K·|q − o|²) into the pixel of ω, divided by that pixel's solid
 // angle (a pixel holds the mean radiance over its solid angle).
-void add_aperture(const Scene& scene, const Emitter& e, int rings, Vec3 o, const CaptureDesc& desc, const sphere::Mapping& m,
-                  Image& img) {
+void add_aperture(const Scene& scene, const Emitter& e, int rings, Vec3 o, const CaptureDesc& desc,
+                  const sphere::Mapping& m, Image& img) {
   const Frame f = Frame::from_normal(e.direction);
   const Mat3 to_probe = desc.rotation.transposed();
   const int sectors = rings, K = rings * sectors;
@@ -100,7 +106,8 @@ void add_aperture(const Scene& scene, const Emitter& e, int rings, Vec3 o, const
       Vec3 local = to_probe * w;
       if (!cone_selects(desc, w)) continue;
       if (!m.to_pixel(local, &px, &py)) continue;  // a direction without data (dead angle)
-      int x = std::clamp(static_cast<int>(px), 0, m.width() - 1), y = std::clamp(static_cast<int>(py), 0, m.height() - 1);
+      int x = std::clamp(static_cast<int>(px), 0, m.width() - 1),
+          y = std::clamp(static_cast<int>(py), 0, m.height() - 1);
       double sa = m.solid_angle(x, y);
       if (sa <= 0) continue;
       img.set_rgb(x, y, img.rgb(x, y) + I / (K * d2 * sa));
@@ -114,16 +121,20 @@ Capture capture_probe(const Scene& scene, Vec3 position, const CaptureDesc& desc
                       const ProgressFn& progress) {
   if (!scene.built()) fail(ErrorKind::Internal, "capture_probe: scene {} is not built", scene.name);
   require_point("capture position", position);
-  if (desc.samples < 1 || desc.samples > 64) fail(ErrorKind::Value, "samples per pixel axis {} is out of range [1, 64]", desc.samples);
+  if (desc.samples < 1 || desc.samples > 64)
+    fail(ErrorKind::Value, "samples per pixel axis {} is out of range [1, 64]", desc.samples);
   bool ball = desc.camera == Camera::MirrorBall;
   if (ball && desc.mapping != MappingKind::MirrorBall)
-    fail(ErrorKind::Value, "the mirror-ball camera makes mirrorball images, not {}", sphere::mapping_name(desc.mapping));
+    fail(ErrorKind::Value, "the mirror-ball camera makes mirrorball images, not {}",
+         sphere::mapping_name(desc.mapping));
   if (desc.cone != CaptureDesc::Cone::All && (ball || !(desc.cone_deg > 0 && desc.cone_deg < 180)))
-    fail(ErrorKind::Value, "a cone selection needs the ideal camera and a half-angle in (0, 180), got {}", desc.cone_deg);
+    fail(ErrorKind::Value, "a cone selection needs the ideal camera and a half-angle in (0, 180), got {}",
+         desc.cone_deg);
   if (ball && !(desc.ball_radius >= 0)) fail(ErrorKind::Value, "ball radius {} must be ≥ 0", desc.ball_radius);
   if (ball && !(desc.ball_reflectance >= 0 && desc.ball_reflectance <= 1))
     fail(ErrorKind::Value, "ball reflectance {} must lie in [0, 1]", desc.ball_reflectance);
-  if (desc.render.area_samples < 1 || desc.render.env_samples < 1 || desc.render.bounces < 0 || desc.render.bounces > 64)
+  if (desc.render.area_samples < 1 || desc.render.env_samples < 1 || desc.render.bounces < 0 ||
+      desc.render.bounces > 64)
     fail(ErrorKind::Value, "need area samples ≥ 1, environment samples ≥ 1 and 0 ≤ bounces ≤ 64 (got {}, {}, {})",
          desc.render.area_samples, desc.render.env_samples, desc.render.bounces);
   Capture cap;

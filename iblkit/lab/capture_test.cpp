@@ -125,8 +125,8 @@ TEST(LabCapture, ClosedEmittingSphereIsUniformEverywhereInside) {
 TEST(LabCapture, DiscLightSeenFromAxisMatchesClosedForm) {
   // A disc of radius R at height h subtends Ω = 2π(1 − h/√(h²+R²)) and delivers E = πL R²/(h²+R²)
   // to an upward normal below its centre.
-  constexpr double kMapTol = 0.02;     // relative: 64×128 map, 4×4 sub-pixels, the disc's rim pixels
-  constexpr double kSampledTol = 0.01; // relative: 16×16 stratified area samples of a disc
+  constexpr double kMapTol = 0.02;      // relative: 64×128 map, 4×4 sub-pixels, the disc's rim pixels
+  constexpr double kSampledTol = 0.01;  // relative: 16×16 stratified area samples of a disc
   const double R = 0.5, h = 1.5, L = 3.0;
   Scene s = disc_light(R, h, {L, L, L});
   TruthDesc td;
@@ -194,9 +194,9 @@ Scene lit_room() {
 }
 
 TEST(LabCapture, MirrorBallCameraMatchesLatLongCapture) {
-  constexpr double kMeanRelTol = 0.03;   // mean |Δ|/mean L over lat-long pixels: footprint + sampling noise
-  constexpr double kPowerTol = 0.02;     // ∫L dω of the two
-  constexpr double kDeadDeg = 40;        // directions this close to −Z are compressed into the ball's rim
+  constexpr double kMeanRelTol = 0.03;  // mean |Δ|/mean L over lat-long pixels: footprint + sampling noise
+  constexpr double kPowerTol = 0.02;    // ∫L dω of the two
+  constexpr double kDeadDeg = 40;       // directions this close to −Z are compressed into the ball's rim
   Scene s = lit_room();
   Vec3 p{0.2, 1.2, -0.3};
   CaptureDesc ll;
@@ -210,7 +210,8 @@ TEST(LabCapture, MirrorBallCameraMatchesLatLongCapture) {
   mb.size = 192;
   mb.samples = 2;
   Capture b = capture_probe(s, p, mb);
-  Image conv = sphere::resample(sphere::EnvMap(b.radiance, sphere::Mapping(sphere::MappingKind::MirrorBall, 192, 192)), a.mapping);
+  Image conv = sphere::resample(sphere::EnvMap(b.radiance, sphere::Mapping(sphere::MappingKind::MirrorBall, 192, 192)),
+                                a.mapping);
   double diff = 0, sum = 0, pa = 0, pb = 0;
   for (int y = 0; y < a.radiance.height(); ++y)
     for (int x = 0; x < a.radiance.width(); ++x) {
@@ -313,7 +314,7 @@ TEST(LabCapture, ApertureOnALatLongPoleIsExact) {
   // A 2.5 cm disc straight above the probe at 1.2 m covers the top row and 60 % of the next of a
   // 256-row map: its rim runs along a row, so point samples cannot average the rim's aliasing out
   // (4×4 samples per pixel gave +13 %). Integrated per pixel it delivers I/d².
-  constexpr double kEnergyTol = 1e-3;  // relative: float32 pixels, 16+ points per covered pixel
+  constexpr double kEnergyTol = 1e-3;       // relative: float32 pixels, 16+ points per covered pixel
   constexpr double kAliasedAtLeast = 0.05;  // point-sampled: off by 13 % (shows the check can fail)
   Scene s;
   Emitter sp = spot({0, 2, 0}, {0, -1, 0}, 60, 50, {10, 10, 10}, 0.025);
@@ -382,7 +383,6 @@ TEST(LabTruth, UniformEnvironmentGivesPiLIrradiance) {
 
 namespace ibl::lab {
 namespace {
-
 
 // A 4 m white floor (albedo 1) at y = 0 under a constant sky of radiance L: E = πL on the floor, so
 // it reflects exactly L.

@@ -7,8 +7,8 @@ namespace ibl::lab {
 
 namespace {
 
-constexpr double kRayEpsilon = 1e-4;      // metres: start of secondary rays (float BVH, scenes ≤ 100 m)
-constexpr double kShadowShorten = 1e-4;   // relative: shadow rays stop this short of the light point
+constexpr double kRayEpsilon = 1e-4;     // metres: start of secondary rays (float BVH, scenes ≤ 100 m)
+constexpr double kShadowShorten = 1e-4;  // relative: shadow rays stop this short of the light point
 
 bool visible(const Scene& s, Vec3 p, Vec3 w, double dist) {
   return !s.tracer().occluded(p, w, kRayEpsilon, dist * (1 - kShadowShorten));
@@ -81,7 +81,9 @@ Vec3 direct_irradiance(const Scene& s, Vec3 p, Vec3 n, Rng& rng, const RenderDes
         e_sum += i * (c / d2);
         break;
       }
-      case EmitterType::Area: e_sum += area_irradiance(s, e, p, n, rng, desc.area_samples); break;
+      case EmitterType::Area:
+        e_sum += area_irradiance(s, e, p, n, rng, desc.area_samples);
+        break;
       case EmitterType::Environment: {
         Vec3 acc;
         for (int k = 0; k < desc.env_samples; ++k) {

@@ -34,8 +34,10 @@ double smoothstep(double a, double b, double x) {
 // The built-in patterns on [−1,1]² (x right, y up).
 Vec3 builtin_pattern(Pattern p, double x, double y) {
   switch (p) {
-    case Pattern::White: return {1, 1, 1};
-    case Pattern::Disc: return x * x + y * y <= 1 ? Vec3{1, 1, 1} : Vec3{0, 0, 0};
+    case Pattern::White:
+      return {1, 1, 1};
+    case Pattern::Disc:
+      return x * x + y * y <= 1 ? Vec3{1, 1, 1} : Vec3{0, 0, 0};
     case Pattern::Checker: {
       auto ix = static_cast<int>(std::floor((x + 1) * 4)), iy = static_cast<int>(std::floor((y + 1) * 4));
       return ((ix + iy) & 1) ? Vec3{0.05, 0.05, 0.05} : Vec3{1, 1, 1};
@@ -48,7 +50,8 @@ Vec3 builtin_pattern(Pattern p, double x, double y) {
       if (y >= 0) return x < 0 ? Vec3{1, 0.05, 0.05} : Vec3{0.05, 1, 0.05};
       return x < 0 ? Vec3{0.05, 0.05, 1} : Vec3{1, 1, 0.05};
     }
-    case Pattern::Image: break;
+    case Pattern::Image:
+      break;
   }
   return {0, 0, 0};
 }
@@ -75,8 +78,10 @@ void Emitter::prepare() {
 
 Vec3 Emitter::intensity_towards(Vec3 w) const {
   switch (type) {
-    case EmitterType::Point: return intensity;
-    case EmitterType::Spot: return intensity * smoothstep(cos_cone, cos_falloff, dot(w, direction));
+    case EmitterType::Point:
+      return intensity;
+    case EmitterType::Spot:
+      return intensity * smoothstep(cos_cone, cos_falloff, dot(w, direction));
     case EmitterType::Projector: {
       Vec3 l = frame.to_local(w);
       if (l.z <= 0) return {0, 0, 0};
@@ -86,7 +91,8 @@ Vec3 Emitter::intensity_towards(Vec3 w) const {
         return intensity * image->view().sample_rgb_uv(0.5 * (sx + 1), 0.5 * (1 - sy), Wrap::Clamp);
       return intensity * builtin_pattern(pattern, sx, sy);
     }
-    default: return {0, 0, 0};
+    default:
+      return {0, 0, 0};
   }
 }
 
@@ -128,7 +134,8 @@ void Scene::build() {
         if (env_index_ >= 0) fail(ErrorKind::Value, "scene {}: more than one environment emitter", name);
         env_index_ = static_cast<int>(i);
         break;
-      case EmitterType::Point: break;
+      case EmitterType::Point:
+        break;
     }
   }
   auto tracer = std::make_shared<geometry::RayTracer>();

@@ -23,9 +23,9 @@ using nlohmann::json;
 namespace {
 
 struct Ctx {
-  std::string file;  // for messages
-  fs::path dir;      // relative paths start here
-  std::string where; // "surfaces[2]"
+  std::string file;   // for messages
+  fs::path dir;       // relative paths start here
+  std::string where;  // "surfaces[2]"
   std::string rel(const std::string& p) const { return fs::path(p).is_absolute() ? p : (dir / p).string(); }
   [[noreturn]] void bad(const std::string& field, const std::string& why) const {
     if (where.empty()) fail(ErrorKind::Format, "{}: {}: {}", file, field, why);
@@ -47,7 +47,8 @@ double num(const json& j, const char* f, const Ctx& c, std::optional<double> def
 // A whole number in [lo, hi] (a count: segments, rings, samples).
 int count(const json& j, const char* f, const Ctx& c, int def, int lo, int hi) {
   double v = num(j, f, c, double(def));
-  if (v != std::floor(v) || v < lo || v > hi) c.bad(f, fmt::format("expected a whole number from {} to {}, got {}", lo, hi, v));
+  if (v != std::floor(v) || v < lo || v > hi)
+    c.bad(f, fmt::format("expected a whole number from {} to {}, got {}", lo, hi, v));
   return static_cast<int>(v);
 }
 
@@ -100,7 +101,8 @@ Texture texture(const json& j, const Ctx& c) {
     t.b = vec3(tmp, "b", c);
     t.tiles = vec2(a, "tiles", c, Vec2{8, 8});
   } else if (a.is_object() && a.contains("texture")) {
-    t.image = std::make_shared<Image>(io::read_image(c.rel(a["texture"].get<std::string>()), {false, 3}).with_channels(3));
+    t.image =
+        std::make_shared<Image>(io::read_image(c.rel(a["texture"].get<std::string>()), {false, 3}).with_channels(3));
     t.scale = vec2(a, "scale", c, Vec2{1, 1});
   } else {
     c.bad("albedo", "expected a number, [r,g,b], {\"texture\": file} or {\"checker\": [a, b]}");
@@ -153,10 +155,12 @@ Surface surface(const json& j, const Ctx& c) {
                                  count(j, "segments", c, 64, 3, 1000000));
   } else if (type == "sphere") {
     s.mesh = geometry::make_sphere(vec3(j, "center", c), num(j, "radius", c), count(j, "rings", c, 32, 2, 1000000),
-                                   count(j, "segments", c, 64, 3, 1000000), opt_field(j, c.file + ": " + c.where, "inward", false));
+                                   count(j, "segments", c, 64, 3, 1000000),
+                                   opt_field(j, c.file + ": " + c.where, "inward", false));
   } else if (type == "cylinder") {
     s.mesh = geometry::make_cylinder(vec3(j, "base", c), vec3(j, "axis", c), num(j, "radius", c),
-                                     count(j, "segments", c, 48, 3, 1000000), opt_field(j, c.file + ": " + c.where, "caps", true));
+                                     count(j, "segments", c, 48, 3, 1000000),
+                                     opt_field(j, c.file + ": " + c.where, "caps", true));
   } else if (type == "mesh") {
     if (!j.contains("file")) c.bad("file", "missing");
     s.mesh = geometry::read_mesh(c.rel(j["file"].get<std::string>()));
@@ -188,7 +192,10 @@ Emitter emitter(const json& j, const Ctx& c) {
     e.center = vec3(j, "center", c);
     e.normal = vec3(j, "normal", c);
     e.up = vec3(j, "up", c, Vec3{0, 0, 1});
-    if (e.disc) e.radius = num(j, "radius", c); else e.size = vec2(j, "size", c);
+    if (e.disc)
+      e.radius = num(j, "radius", c);
+    else
+      e.size = vec2(j, "size", c);
     e.radiance = vec3(j, "radiance", c);
     nonneg(e.radiance, "radiance", c);
   } else if (type == "spot" || type == "projector" || type == "point") {
@@ -215,7 +222,8 @@ Emitter emitter(const json& j, const Ctx& c) {
         c.bad("fov_deg", "must lie in (0, 180)");
       if (j.contains("image")) {
         e.pattern = Pattern::Image;
-        e.image = std::make_shared<Image>(io::read_image(c.rel(j["image"].get<std::string>()), {false, 3}).with_channels(3));
+        e.image =
+            std::make_shared<Image>(io::read_image(c.rel(j["image"].get<std::string>()), {false, 3}).with_channels(3));
       } else {
         e.pattern = pattern(j.value("pattern", "squares"), c);
       }
@@ -265,7 +273,8 @@ Scene load_scene(const std::string& name_or_path, bool build) {
   std::string path = resolve_scene_path(name_or_path);
   const json j = read_json_file(path);
   Ctx c{path, fs::path(path).parent_path(), ""};
-  if (!j.is_object() || !j.contains("format") || j["format"] != "iblkit.scene/1") c.bad("format", "expected \"iblkit.scene/1\"");
+  if (!j.is_object() || !j.contains("format") || j["format"] != "iblkit.scene/1")
+    c.bad("format", "expected \"iblkit.scene/1\"");
   Scene s;
   s.source = path;
   s.name = opt_field(j, path, "name", fs::path(path).stem().string());
@@ -277,7 +286,8 @@ Scene load_scene(const std::string& name_or_path, bool build) {
       s.volume_max = vec3(j["volume"], "max", c);
       for (int k = 0; k < 3; ++k)
         if (!(s.volume_max[k] > s.volume_min[k])) c.bad("max", "must exceed min on every axis");
-      if (!in_range(s.volume_min) || !in_range(s.volume_max)) c.bad("min", fmt::format("the corners must lie within ±{:g} m", kMaxCoordinate));
+      if (!in_range(s.volume_min) || !in_range(s.volume_max))
+        c.bad("min", fmt::format("the corners must lie within ±{:g} m", kMaxCoordinate));
     }
     if (j.contains("settings")) {
       c.where = "settings";
@@ -286,7 +296,8 @@ Scene load_scene(const std::string& name_or_path, bool build) {
       s.render.env_samples = count(st, "env_samples", c, s.render.env_samples, 1, 1000000);
       s.render.bounces = count(st, "bounces", c, s.render.bounces, 0, 64);
       const double seed = num(st, "seed", c, static_cast<double>(s.render.seed));
-      if (seed < 0 || seed > 9007199254740992.0 || seed != std::floor(seed)) c.bad("seed", fmt::format("expected a whole number ≥ 0, got {}", seed));
+      if (seed < 0 || seed > 9007199254740992.0 || seed != std::floor(seed))
+        c.bad("seed", fmt::format("expected a whole number ≥ 0, got {}", seed));
       s.render.seed = static_cast<uint64_t>(seed);
       if (s.render.area_samples < 1 || s.render.env_samples < 1 || s.render.bounces < 0)
         c.bad("area_samples", "need area_samples ≥ 1, env_samples ≥ 1, bounces ≥ 0");

@@ -86,10 +86,14 @@ TEST(LabScene, BadFilesNameTheFieldAtFault) {
   expect_error("{", "not valid JSON");
   expect_error(R"({"format":"iblkit.scene/2","surfaces":[]})", "format");
   expect_error(R"({"format":"iblkit.scene/1","surfaces":[{"type":"teapot"}]})", "surfaces[0].type");
-  expect_error(R"({"format":"iblkit.scene/1","surfaces":[{"type":"quad","center":[0,0],"normal":[0,1,0],"size":1}]})", "center");
-  expect_error(R"({"format":"iblkit.scene/1","surfaces":[],"emitters":[{"type":"area","center":[0,1,0],"normal":[0,-1,0],"size":1,"radiance":-1}]})", "emitters[0].radiance");
+  expect_error(R"({"format":"iblkit.scene/1","surfaces":[{"type":"quad","center":[0,0],"normal":[0,1,0],"size":1}]})",
+               "center");
+  expect_error(
+      R"({"format":"iblkit.scene/1","surfaces":[],"emitters":[{"type":"area","center":[0,1,0],"normal":[0,-1,0],"size":1,"radiance":-1}]})",
+      "emitters[0].radiance");
   expect_error(R"({"format":"iblkit.scene/1","surfaces":[{"type":"mesh","file":"nope.obj"}]})", "nope.obj");
-  expect_error(R"({"format":"iblkit.scene/1","surfaces":[{"type":"room","min":[0,0,0],"max":[1,1,1],"albedo":1.5}]})", "albedo");
+  expect_error(R"({"format":"iblkit.scene/1","surfaces":[{"type":"room","min":[0,0,0],"max":[1,1,1],"albedo":1.5}]})",
+               "albedo");
   EXPECT_THROW(load_scene("no-such-scene"), Error);
   fs::remove_all(dir);
 }

@@ -31,14 +31,16 @@ using nlohmann::json;
 constexpr double kMaxProbes = 1e6;
 static void require_probe_count(const std::string& what, double n, const char* hint) {
   if (n > kMaxProbes)
-    fail(ErrorKind::Value, "{} of {:.4g} probes exceeds the {:g} a capture supports ({:.3g} GB for the positions alone); {}", what, n,
+    fail(ErrorKind::Value,
+         "{} of {:.4g} probes exceeds the {:g} a capture supports ({:.3g} GB for the positions alone); {}", what, n,
          kMaxProbes, n * sizeof(Vec3) / 1e9, hint);
 }
 
 std::vector<Vec3> grid_positions(Vec3 lo, Vec3 hi, int nx, int ny, int nz) {
   if (nx < 1 || ny < 1 || nz < 1) fail(ErrorKind::Value, "grid counts {}x{}x{} must be ≥ 1", nx, ny, nz);
   require_box("grid volume", lo, hi);
-  require_probe_count(fmt::format("a grid of {}x{}x{}", nx, ny, nz), double(nx) * ny * nz, "choose fewer grid points per axis");
+  require_probe_count(fmt::format("a grid of {}x{}x{}", nx, ny, nz), double(nx) * ny * nz,
+                      "choose fewer grid points per axis");
   auto at = [](double a, double b, int i, int n) { return n == 1 ? 0.5 * (a + b) : a + (b - a) * i / (n - 1); };
   std::vector<Vec3> p;
   for (int k = 0; k < nz; ++k)
@@ -59,7 +61,10 @@ std::vector<Vec3> path_positions(const std::vector<Vec3>& pts, int count) {
     double s = count == 1 ? 0 : acc.back() * k / (count - 1);
     size_t i = 1;
     while (i < acc.size() && acc[i] < s) ++i;
-    if (i >= acc.size()) { out.push_back(pts.back()); continue; }
+    if (i >= acc.size()) {
+      out.push_back(pts.back());
+      continue;
+    }
     double seg = acc[i] - acc[i - 1], t = seg > 0 ? (s - acc[i - 1]) / seg : 0;
     out.push_back(pts[i - 1] + (pts[i] - pts[i - 1]) * t);
   }
@@ -125,9 +130,7 @@ json rotation_json(const Mat3& m) {
   return r;
 }
 
-void make_dir(const fs::path& p) {
-  ibl::make_output_folders(p.string());
-}
+void make_dir(const fs::path& p) { ibl::make_output_folders(p.string()); }
 
 // Captures every probe and hands it to `sink(k, capture)` on a writer thread while the next one
 // renders, so memory stays at two probes. Picks the contact-sheet probes on the way.
@@ -142,7 +145,8 @@ std::vector<std::pair<std::string, Image>> stream(const Scene& scene, const std:
     Capture cap = capture_probe(scene, positions[k], desc.capture, k);
     if (sheet && (k * sheet) / n != ((k + 1) * sheet) / n) {
       Vec3 p = positions[k];
-      pics.push_back({fmt::format("#{} ({:.2f}, {:.2f}, {:.2f})", k, p.x, p.y, p.z), io::resize(io::tonemap(cap.radiance), 256, 256 * cap.radiance.height() / cap.radiance.width())});
+      pics.push_back({fmt::format("#{} ({:.2f}, {:.2f}, {:.2f})", k, p.x, p.y, p.z),
+                      io::resize(io::tonemap(cap.radiance), 256, 256 * cap.radiance.height() / cap.radiance.width())});
     }
     if (writing.valid()) writing.get();
     writing = std::async(std::launch::async, [&sink, k, c = std::move(cap)] { sink(k, c); });
@@ -188,7 +192,8 @@ SequenceResult write_sequence(const Scene& scene, const std::vector<Vec3>& posit
     ilf::ProbeEntry e;
     e.image = (out / fmt::format("frames/{:06d}{}", seq.probes.size(), desc.frame_ext)).string();
     e.position = p;
-    if (desc.capture.depth) e.depth = (out / fmt::format("frames/{:06d}_depth{}", seq.probes.size(), desc.frame_ext)).string();
+    if (desc.capture.depth)
+      e.depth = (out / fmt::format("frames/{:06d}_depth{}", seq.probes.size(), desc.frame_ext)).string();
     seq.probes.push_back(e);
     for (int k = 0; k < 3; ++k) {
       lo[k] = std::min(lo[k], p[k]);
@@ -200,7 +205,8 @@ SequenceResult write_sequence(const Scene& scene, const std::vector<Vec3>& posit
   seq.volume_given = true;
   auto pics = stream(scene, positions, desc, progress, [&](size_t k, const Capture& c) {
     io::write_image(seq.probes[k].image, c.radiance, {desc.half});
-    if (c.depth.width()) io::write_image((out / fmt::format("frames/{:06d}_depth{}", k, desc.frame_ext)).string(), c.depth, {desc.half});
+    if (c.depth.width())
+      io::write_image((out / fmt::format("frames/{:06d}_depth{}", k, desc.frame_ext)).string(), c.depth, {desc.half});
   });
   SequenceResult r;
   r.manifest = (out / "sequence.json").string();
@@ -230,8 +236,11 @@ SequenceResult write_probe_set(const Scene& scene, const std::vector<Vec3>& posi
     io::write_image((out / fmt::format("probes/p{}{}", k, desc.frame_ext)).string(), c.radiance, {desc.half});
     io::write_image((out / fmt::format("probes/p{}_depth{}", k, desc.frame_ext)).string(), c.depth, {desc.half});
   });
-  json m = {{"format", "iblkit.probes/1"}, {"proxy", "proxy.obj"}, {"mapping", sphere::mapping_name(desc.capture.mapping)},
-            {"scene", scene.name}, {"probes", probes}};
+  json m = {{"format", "iblkit.probes/1"},
+            {"proxy", "proxy.obj"},
+            {"mapping", sphere::mapping_name(desc.capture.mapping)},
+            {"scene", scene.name},
+            {"probes", probes}};
   SequenceResult r;
   r.manifest = (out / "probes.json").string();
   write_json_file(r.manifest, m);

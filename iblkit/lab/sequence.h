@@ -25,18 +25,18 @@ std::vector<Vec3> random_positions(Vec3 lo, Vec3 hi, int count, uint64_t seed);
 std::vector<Vec3> cluster_positions(Vec3 lo, Vec3 hi, int clusters, int count, double spread, uint64_t seed);
 
 struct SequenceDesc {
-  CaptureDesc capture;           // mapping, size, camera, samples, render settings
-  std::string out_dir;           // created if missing
+  CaptureDesc capture;             // mapping, size, camera, samples, render settings
+  std::string out_dir;             // created if missing
   std::string frame_ext = ".exr";  // image format of every frame
-  bool half = false;             // .exr frames as 16-bit halves
-  int sheet_probes = 16;         // probes on the contact sheet (evenly picked; 0: no sheet)
+  bool half = false;               // .exr frames as 16-bit halves
+  int sheet_probes = 16;           // probes on the contact sheet (evenly picked; 0: no sheet)
 };
 
 struct SequenceResult {
-  std::string manifest;          // path of sequence.json or probes.json
-  std::string contact_sheet;     // path of contact_sheet.png (empty when none)
-  size_t probes = 0;             // frames written
-  double seconds = 0;            // wall time of capture + writing
+  std::string manifest;       // path of sequence.json or probes.json
+  std::string contact_sheet;  // path of contact_sheet.png (empty when none)
+  size_t probes = 0;          // frames written
+  double seconds = 0;         // wall time of capture + writing
 };
 
 // Writes OUT/frames/000000.EXT … (with 000000_depth.EXT when capture.depth) and OUT/sequence.json

@@ -58,14 +58,16 @@ Truth ground_truth(const Scene& scene, Vec3 position, const TruthDesc& desc, con
   if (desc.bands > 0 && desc.blind_cone_deg > 0) {
     // The same map rendered only inside the cone (the same random streams, so the same values
     // there, at a fraction of the cost), subtracted: the map without the cone, sub-sample exact.
-    if (!(desc.blind_cone_deg < 180)) fail(ErrorKind::Value, "blind cone {}° must lie in (0, 180)", desc.blind_cone_deg);
+    if (!(desc.blind_cone_deg < 180))
+      fail(ErrorKind::Value, "blind cone {}° must lie in (0, 180)", desc.blind_cone_deg);
     cd.cone = CaptureDesc::Cone::Inside;
     cd.cone_deg = desc.blind_cone_deg;
     if (length(desc.blind_axis) == 0) fail(ErrorKind::Value, "blind cone axis (0,0,0) has no direction");
     cd.cone_axis = normalize(desc.blind_axis);
     Capture inside = capture_probe(scene, position, cd, 0);
     sphere::EnvMap vis = t.radiance;
-    for (size_t i = 0; i < vis.image.size(); ++i) vis.image.data()[i] = std::max(0.0f, vis.image.data()[i] - inside.radiance.data()[i]);
+    for (size_t i = 0; i < vis.image.size(); ++i)
+      vis.image.data()[i] = std::max(0.0f, vis.image.data()[i] - inside.radiance.data()[i]);
     t.sh_visible = sh::project(vis, desc.bands);
   }
   for (Vec3 n : desc.normals) {
@@ -81,14 +83,17 @@ std::vector<Vec3> radiance_along(const Scene& scene, Vec3 position, const std::v
   if (streams < 1) fail(ErrorKind::Value, "radiance along rays: {} random streams per ray (need ≥ 1)", streams);
   require_point("radiance position", position);
   std::vector<Vec3> out(directions.size());
-  parallel_for(0, static_cast<int64_t>(directions.size()), [&](int64_t i) {
-    Vec3 s;
-    for (int k = 0; k < streams; ++k) {
-      Rng rng(stream_key(desc.seed, 7, static_cast<uint64_t>(i), k));
-      s += radiance(scene, position, directions[static_cast<size_t>(i)], rng, desc);
-    }
-    out[static_cast<size_t>(i)] = s / streams;
-  }, 64);
+  parallel_for(
+      0, static_cast<int64_t>(directions.size()),
+      [&](int64_t i) {
+        Vec3 s;
+        for (int k = 0; k < streams; ++k) {
+          Rng rng(stream_key(desc.seed, 7, static_cast<uint64_t>(i), k));
+          s += radiance(scene, position, directions[static_cast<size_t>(i)], rng, desc);
+        }
+        out[static_cast<size_t>(i)] = s / streams;
+      },
+      64);
   return out;
 }
 

@@ -11,12 +11,12 @@
 namespace ibl::lab {
 
 struct TruthDesc {
-  int size = 128;          // lat-long height of the radiance map (width 2·size)
-  int samples = 4;         // n×n sub-pixel samples per pixel (the map is a pixel-area average)
-  int area_samples = 64;   // shadow rays per area light per diffuse hit (more than a capture: less noise)
-  int bands = 3;           // SH bands of the projection (0: none)
+  int size = 128;             // lat-long height of the radiance map (width 2·size)
+  int samples = 4;            // n×n sub-pixel samples per pixel (the map is a pixel-area average)
+  int area_samples = 64;      // shadow rays per area light per diffuse hit (more than a capture: less noise)
+  int bands = 3;              // SH bands of the projection (0: none)
   std::vector<Vec3> normals;  // irradiance is computed for each (normalised here)
-  uint64_t seed = 1;       // random streams
+  uint64_t seed = 1;          // random streams
   double blind_cone_deg = 0;  // > 0: also project `sh_visible`, the map without the directions within
                               // this angle of blind_axis (a mirror-ball sequence's dead angle)
   Vec3 blind_axis{0, 0, -1};  // world axis of that cone (−Z: a ball seen along −Z, identity rotation)

@@ -53,7 +53,8 @@ TEST(LabView, SphereUnderPointLightMatchesClosedForm) {
       Vec3 p = o + d * (-b - std::sqrt(disc)), n = normalize(p), to = q - p;
       double cosl = std::max(0.0, dot(n, normalize(to)));
       Vec3 want = I * (rho / kPi * cosl / dot(to, to));
-      for (int ch = 0; ch < 3; ++ch) ASSERT_NEAR(v.radiance.at(x, y, ch), want[ch], kFacetTol * I.x * rho / kPi) << x << "," << y;
+      for (int ch = 0; ch < 3; ++ch)
+        ASSERT_NEAR(v.radiance.at(x, y, ch), want[ch], kFacetTol * I.x * rho / kPi) << x << "," << y;
       ++checked;
     }
   EXPECT_GT(checked, 300);

@@ -26,14 +26,17 @@ struct Sat {
     w = width;
     h = height;
     s.assign(static_cast<size_t>(w + 1) * (h + 1), T{});
-    parallel_for(0, h, [&](int64_t y) {
-      T* row = &s[static_cast<size_t>(y + 1) * (w + 1)];
-      T acc{};
-      for (int x = 0; x < w; ++x) {
-        acc = acc + value(x, static_cast<int>(y));
-        row[x + 1] = acc;
-      }
-    }, 8);
+    parallel_for(
+        0, h,
+        [&](int64_t y) {
+          T* row = &s[static_cast<size_t>(y + 1) * (w + 1)];
+          T acc{};
+          for (int x = 0; x < w; ++x) {
+            acc = acc + value(x, static_cast<int>(y));
+            row[x + 1] = acc;
+          }
+        },
+        8);
     for (int y = 1; y <= h; ++y) {
       T* row = &s[static_cast<size_t>(y) * (w + 1)];
       const T* prev = row - (w + 1);
@@ -52,8 +55,8 @@ struct Moment {
 };
 
 struct Region {
-  int x0, y0, x1, y1;  // half-open pixel rectangle
-  double key = 0;      // priority: energy (median cut) or variance removed by the best split
+  int x0, y0, x1, y1;      // half-open pixel rectangle
+  double key = 0;          // priority: energy (median cut) or variance removed by the best split
   int axis = -1, pos = 0;  // variance cut: the best split (axis −1: none)
 };
 
@@ -103,7 +106,8 @@ double energy(const LatLongGrid& g, int x, int y) {
 // Lit-pixel counts: exact emptiness tests that summed doubles cannot give.
 Sat<int> lit_counts(const LatLongGrid& g) {
   Sat<int> c;
-  c.build(g.width, g.height, [&](int x, int y) { return luminance(g.rgb[static_cast<size_t>(y) * g.width + x]) > 0 ? 1 : 0; });
+  c.build(g.width, g.height,
+          [&](int x, int y) { return luminance(g.rgb[static_cast<size_t>(y) * g.width + x]) > 0 ? 1 : 0; });
   return c;
 }
 
@@ -193,20 +197,46 @@ LightSet median_cut(const LatLongGrid& g, const CutDesc& desc) {
     int total = C(hi);
     // First split index with a lit pixel on the left; last with one on the right.
     int a0 = lo + 1, a1 = hi - 1;
-    while (a0 < a1) { int m = (a0 + a1) / 2; if (C(m) >= 1) a1 = m; else a0 = m + 1; }
+    while (a0 < a1) {
+      int m = (a0 + a1) / 2;
+      if (C(m) >= 1)
+        a1 = m;
+      else
+        a0 = m + 1;
+    }
     int s_lo = a0;
-    a0 = lo + 1; a1 = hi - 1;
-    while (a0 < a1) { int m = (a0 + a1 + 1) / 2; if (C(m) <= total - 1) a0 = m; else a1 = m - 1; }
+    a0 = lo + 1;
+    a1 = hi - 1;
+    while (a0 < a1) {
+      int m = (a0 + a1 + 1) / 2;
+      if (C(m) <= total - 1)
+        a0 = m;
+      else
+        a1 = m - 1;
+    }
     int s_hi = a0;
     if (C(s_lo) < 1 || C(s_hi) > total - 1 || s_lo > s_hi) return false;
     double half = 0.5 * E(hi);
-    a0 = s_lo; a1 = s_hi;
-    while (a0 < a1) { int m = (a0 + a1) / 2; if (E(m) >= half) a1 = m; else a0 = m + 1; }
+    a0 = s_lo;
+    a1 = s_hi;
+    while (a0 < a1) {
+      int m = (a0 + a1) / 2;
+      if (E(m) >= half)
+        a1 = m;
+      else
+        a0 = m + 1;
+    }
     int s = a0;
     if (s - 1 >= s_lo && std::abs(E(s - 1) - half) <= std::abs(E(s) - half)) --s;
     *a = r;
     *b = r;
-    if (axis == 0) { a->x1 = s; b->x0 = s; } else { a->y1 = s; b->y0 = s; }
+    if (axis == 0) {
+      a->x1 = s;
+      b->x0 = s;
+    } else {
+      a->y1 = s;
+      b->y0 = s;
+    }
     a->key = e.sum(a->x0, a->y0, a->x1, a->y1);
     b->key = e.sum(b->x0, b->y0, b->x1, b->y1);
     return true;
@@ -228,7 +258,11 @@ LightSet median_cut(const LatLongGrid& g, const CutDesc& desc) {
         std::vector<Region> next;
         for (const auto& r : out) {
           Region a, b;
-          if (split(r, &a, &b)) { next.push_back(a); next.push_back(b); } else next.push_back(r);
+          if (split(r, &a, &b)) {
+            next.push_back(a);
+            next.push_back(b);
+          } else
+            next.push_back(r);
         }
         out.swap(next);
       }
@@ -271,7 +305,11 @@ LightSet variance_cut(const LatLongGrid& g, const CutDesc& desc) {
         int ca = axis == 0 ? lit.sum(r.x0, r.y0, s, r.y1) : lit.sum(r.x0, r.y0, r.x1, s);
         if (ca == 0 || ca == total) continue;
         double v = a.variance() + (whole - a).variance();
-        if (v < best || r.axis < 0) { best = v; r.axis = axis; r.pos = s; }
+        if (v < best || r.axis < 0) {
+          best = v;
+          r.axis = axis;
+          r.pos = s;
+        }
       }
     }
     r.key = r.axis < 0 ? -1.0 : whole.variance() - best;
@@ -284,7 +322,13 @@ LightSet variance_cut(const LatLongGrid& g, const CutDesc& desc) {
       if (r.axis < 0) return false;
       *a = r;
       *b = r;
-      if (r.axis == 0) { a->x1 = r.pos; b->x0 = r.pos; } else { a->y1 = r.pos; b->y0 = r.pos; }
+      if (r.axis == 0) {
+        a->x1 = r.pos;
+        b->x0 = r.pos;
+      } else {
+        a->y1 = r.pos;
+        b->y0 = r.pos;
+      }
       best_split(*a);
       best_split(*b);
       return true;

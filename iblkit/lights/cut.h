@@ -17,10 +17,10 @@
 namespace ibl::lights {
 
 struct CutDesc {
-  int count = 16;                  // number of lights N ≥ 1 (1 ≤ N ≤ pixels that carry light)
-  bool power_of_two = false;       // median cut only: the classic form, every region split K times (N = 2^K)
-  double min_separation_deg = 0;   // merge lights closer than this angle, then cut further to reach N (0: off)
-  ProgressFn progress;             // optional progress callback
+  int count = 16;                 // number of lights N ≥ 1 (1 ≤ N ≤ pixels that carry light)
+  bool power_of_two = false;      // median cut only: the classic form, every region split K times (N = 2^K)
+  double min_separation_deg = 0;  // merge lights closer than this angle, then cut further to reach N (0: off)
+  ProgressFn progress;            // optional progress callback
 };
 
 // Median cut [1]. Each split goes along the region's longest side measured on the sphere (width

@@ -25,7 +25,8 @@ LightSet median_2k(const sphere::EnvMap& e, const CutDesc& d) {
   return median_cut(e, c);
 }
 LightSet variance(const sphere::EnvMap& e, const CutDesc& d) { return variance_cut(e, d); }
-const NamedCut kCuts[] = {{"median-cut", median_any, false}, {"median-cut-2k", median_2k, true}, {"variance-cut", variance, false}};
+const NamedCut kCuts[] = {
+    {"median-cut", median_any, false}, {"median-cut-2k", median_2k, true}, {"variance-cut", variance, false}};
 
 LightSet run(const NamedCut& c, const sphere::EnvMap& env, int n) {
   CutDesc d;
@@ -36,7 +37,10 @@ LightSet run(const NamedCut& c, const sphere::EnvMap& env, int n) {
 TEST(MedianCut, UnitRadianceWithinPedersensFigures) {
   // Pedersen 2008 Table 7.1 (unit-radiance map, median cut): 16 lights average 3.046 with RMS 0.241,
   // 64 lights 3.108 with RMS 0.050 (GT π). Every cut must do as well or better on both.
-  struct Row { int n; double mean_irr, rms; };
+  struct Row {
+    int n;
+    double mean_irr, rms;
+  };
   const Row kPedersen[] = {{16, 3.046, 0.241}, {64, 3.108, 0.050}};
   auto env = constant_probe(256, 128);
   auto normals = sphere::icosphere_face_centres(3);
@@ -96,8 +100,10 @@ TEST(MedianCut, LightsSumToProbeIntegral) {
       if (c.power_of_two && (n & (n - 1))) continue;
       auto set = run(c, env, n);
       // The 2^K form keeps a region it cannot split (a lone sun pixel) whole: at most N lights.
-      if (c.power_of_two) EXPECT_LE(set.lights.size(), static_cast<size_t>(n)) << c.name;
-      else EXPECT_EQ(set.lights.size(), static_cast<size_t>(n)) << c.name;
+      if (c.power_of_two)
+        EXPECT_LE(set.lights.size(), static_cast<size_t>(n)) << c.name;
+      else
+        EXPECT_EQ(set.lights.size(), static_cast<size_t>(n)) << c.name;
       Vec3 t = total_irradiance(set);
       for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(t[ch], integral[ch], kSumTol * integral[ch]) << c.name << " N=" << n;
       double omega = 0;
@@ -150,7 +156,8 @@ TEST(MedianCut, MinimumSeparationHonoured) {
     EXPECT_EQ(set.lights.size(), 24u) << c.name;
     for (size_t i = 0; i < set.lights.size(); ++i)
       for (size_t j = i + 1; j < set.lights.size(); ++j)
-        EXPECT_LE(dot(set.lights[i].direction, set.lights[j].direction), std::cos(kSepDeg * kPi / 180) + 1e-12) << c.name;
+        EXPECT_LE(dot(set.lights[i].direction, set.lights[j].direction), std::cos(kSepDeg * kPi / 180) + 1e-12)
+            << c.name;
   }
 }
 

@@ -51,8 +51,8 @@ struct Tiles {
   struct Tile {
     size_t begin = 0, count = 0;  // padded range in the arrays
     Vec3 axis;
-    double sin_half = 2.0;       // > 1: the cone is wider than a hemisphere, never classified
-    double m[3][3] = {};         // M_tile per channel (rows) and direction component (columns)
+    double sin_half = 2.0;  // > 1: the cone is wider than a hemisphere, never classified
+    double m[3][3] = {};    // M_tile per channel (rows) and direction component (columns)
   };
   std::vector<Tile> tiles;
 };
@@ -62,7 +62,9 @@ Tiles build_tiles(const sphere::EnvMap& env, int tile) {
   const auto& map = env.mapping;
   int tw = (img.width() + tile - 1) / tile, th = (img.height() + tile - 1) / tile;
   int nc = img.channels();
-  struct Px { Vec3 d, l; };
+  struct Px {
+    Vec3 d, l;
+  };
   std::vector<std::vector<Px>> per(static_cast<size_t>(tw) * th);
   parallel_for(0, static_cast<int64_t>(per.size()), [&](int64_t t) {
     int tx = static_cast<int>(t % tw), ty = static_cast<int>(t / tw);
@@ -128,10 +130,12 @@ inline Vec3 tile_kernel(const Tiles& T, const Tiles::Tile& t, Vec3 n) {
   __m256 ar0 = zero, ag0 = zero, ab0 = zero, ar1 = zero, ag1 = zero, ab1 = zero;
   size_t i = 0;
   for (; i + 16 <= t.count; i += 16) {
-    __m256 d0 = _mm256_fmadd_ps(nx, _mm256_loadu_ps(wx + i),
-                                _mm256_fmadd_ps(ny, _mm256_loadu_ps(wy + i), _mm256_mul_ps(nz, _mm256_loadu_ps(wz + i))));
-    __m256 d1 = _mm256_fmadd_ps(nx, _mm256_loadu_ps(wx + i + 8),
-                                _mm256_fmadd_ps(ny, _mm256_loadu_ps(wy + i + 8), _mm256_mul_ps(nz, _mm256_loadu_ps(wz + i + 8))));
+    __m256 d0 =
+        _mm256_fmadd_ps(nx, _mm256_loadu_ps(wx + i),
+                        _mm256_fmadd_ps(ny, _mm256_loadu_ps(wy + i), _mm256_mul_ps(nz, _mm256_loadu_ps(wz + i))));
+    __m256 d1 = _mm256_fmadd_ps(
+        nx, _mm256_loadu_ps(wx + i + 8),
+        _mm256_fmadd_ps(ny, _mm256_loadu_ps(wy + i + 8), _mm256_mul_ps(nz, _mm256_loadu_ps(wz + i + 8))));
     d0 = _mm256_max_ps(d0, zero);
     d1 = _mm256_max_ps(d1, zero);
     ar0 = _mm256_fmadd_ps(d0, _mm256_loadu_ps(r + i), ar0);
@@ -142,8 +146,9 @@ inline Vec3 tile_kernel(const Tiles& T, const Tiles::Tile& t, Vec3 n) {
     ab1 = _mm256_fmadd_ps(d1, _mm256_loadu_ps(b + i + 8), ab1);
   }
   for (; i < t.count; i += 8) {
-    __m256 d0 = _mm256_fmadd_ps(nx, _mm256_loadu_ps(wx + i),
-                                _mm256_fmadd_ps(ny, _mm256_loadu_ps(wy + i), _mm256_mul_ps(nz, _mm256_loadu_ps(wz + i))));
+    __m256 d0 =
+        _mm256_fmadd_ps(nx, _mm256_loadu_ps(wx + i),
+                        _mm256_fmadd_ps(ny, _mm256_loadu_ps(wy + i), _mm256_mul_ps(nz, _mm256_loadu_ps(wz + i))));
     d0 = _mm256_max_ps(d0, zero);
     ar0 = _mm256_fmadd_ps(d0, _mm256_loadu_ps(r + i), ar0);
     ag0 = _mm256_fmadd_ps(d0, _mm256_loadu_ps(g + i), ag0);
@@ -175,7 +180,8 @@ std::vector<Vec3> irradiance_ground_truth(const sphere::EnvMap& env, const std::
                                           const GroundTruthDesc& desc) {
   if (env.image.empty()) fail(ErrorKind::Value, "the probe is empty (0 pixels)");
   if (desc.tile < 1 || desc.normal_block < 1)
-    fail(ErrorKind::Value, "ground truth: tile ({}) and normal_block ({}) must be positive", desc.tile, desc.normal_block);
+    fail(ErrorKind::Value, "ground truth: tile ({}) and normal_block ({}) must be positive", desc.tile,
+         desc.normal_block);
   Tiles T = build_tiles(env, desc.tile);
   std::vector<Vec3> out(normals.size());
   int64_t nblocks = (static_cast<int64_t>(normals.size()) + desc.normal_block - 1) / desc.normal_block;
@@ -208,16 +214,19 @@ std::vector<Vec3> irradiance_ground_truth(const sphere::EnvMap& env, const std::
 
 std::vector<Vec3> irradiance_from_lights(const std::vector<Light>& lights, const std::vector<Vec3>& normals) {
   std::vector<Vec3> out(normals.size());
-  parallel_chunks(0, static_cast<int64_t>(normals.size()), [&](int64_t lo, int64_t hi) {
-    for (int64_t k = lo; k < hi; ++k) {
-      Vec3 e;
-      for (const auto& l : lights) {
-        double c = dot(normals[k], l.direction);
-        if (c > 0) e += l.irradiance * c;
-      }
-      out[k] = e;
-    }
-  }, 256);
+  parallel_chunks(
+      0, static_cast<int64_t>(normals.size()),
+      [&](int64_t lo, int64_t hi) {
+        for (int64_t k = lo; k < hi; ++k) {
+          Vec3 e;
+          for (const auto& l : lights) {
+            double c = dot(normals[k], l.direction);
+            if (c > 0) e += l.irradiance * c;
+          }
+          out[k] = e;
+        }
+      },
+      256);
   return out;
 }
 

@@ -11,8 +11,8 @@
 namespace ibl::lights {
 
 struct GroundTruthDesc {
-  int tile = 16;       // pixels per side of the tiles that are classified against a normal's hemisphere
-  bool cull = true;    // false: every pixel through the SIMD kernel for every normal (pure brute force)
+  int tile = 16;          // pixels per side of the tiles that are classified against a normal's hemisphere
+  bool cull = true;       // false: every pixel through the SIMD kernel for every normal (pure brute force)
   int normal_block = 64;  // normals per task (each task streams every tile once)
   ProgressFn progress;    // optional progress callback
 };

@@ -80,7 +80,8 @@ TEST(LightsGroundTruth, AnyMappingAgreesWithLatLong) {
   sphere::EnvMap mb(sphere::resample(ll, ball), ball);
   auto normals = sphere::icosphere_face_centres(2);
   auto a = irradiance_ground_truth(ll, normals), b = irradiance_ground_truth(mb, normals);
-  for (size_t k = 0; k < normals.size(); ++k) EXPECT_NEAR(luminance(b[k]), luminance(a[k]), kMappingTol * luminance(a[k]));
+  for (size_t k = 0; k < normals.size(); ++k)
+    EXPECT_NEAR(luminance(b[k]), luminance(a[k]), kMappingTol * luminance(a[k]));
 }
 
 TEST(LightsErrors, RelativeErrorsAndGuard) {

@@ -133,7 +133,10 @@ EvalResult evaluate_methods(const sphere::EnvMap& env, const MethodsEvalDesc& de
   int done = 0, total = static_cast<int>(desc.methods.size() * desc.counts.size());
   for (const auto& m : desc.methods)
     for (int n : desc.counts) {
-      if (m == "median-cut-2k" && (n & (n - 1)) != 0) { ++done; continue; }
+      if (m == "median-cut-2k" && (n & (n - 1)) != 0) {
+        ++done;
+        continue;
+      }
       ed.method = m;
       ed.count = n;
       auto ex = extract(env, ed, normals, gt);
@@ -149,16 +152,14 @@ EvalResult evaluate_methods(const sphere::EnvMap& env, const MethodsEvalDesc& de
 
 void write_eval_csv(const std::string& path, const EvalResult& r) {
   std::ostringstream f;
-  f << "method,count,mean_rel,max_rel,rms_rel,rms_abs,mean_irradiance_Y,seconds,iterations,final_iterations,converged,initial_cost,final_cost\n";
+  f << "method,count,mean_rel,max_rel,rms_rel,rms_abs,mean_irradiance_Y,seconds,iterations,final_iterations,converged,"
+       "initial_cost,final_cost\n";
   for (const auto& row : r.rows) {
     const auto& o = row.optimizer;
     f << fmt::format("{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.4f},{},{},{},{},{}\n", row.method, row.count,
-                     row.err.mean_rel, row.err.max_rel, row.err.rms_rel, row.err.rms_abs,
-                     luminance(row.err.mean_est), row.seconds,
-                     o ? std::to_string(o->iterations) : "",
-                     o ? std::to_string(o->final_iterations) : "",
-                     o ? (o->converged ? "yes" : "no") : "",
-                     o ? fmt::format("{:.6g}", o->initial_cost) : "",
+                     row.err.mean_rel, row.err.max_rel, row.err.rms_rel, row.err.rms_abs, luminance(row.err.mean_est),
+                     row.seconds, o ? std::to_string(o->iterations) : "", o ? std::to_string(o->final_iterations) : "",
+                     o ? (o->converged ? "yes" : "no") : "", o ? fmt::format("{:.6g}", o->initial_cost) : "",
                      o ? fmt::format("{:.6g}", o->final_cost) : "");
   }
   if (r.have_sh)

@@ -29,7 +29,7 @@ struct ExtractDesc {
   // "optimize": the optimiser's settings and the icosphere level of its normals (count and
   // min_separation_deg are taken from above; init picks the starting cut).
   OptimizeDesc optimize;
-  ProgressFn progress;                // optional: ground truth and optimiser progress ("optimize" only)
+  ProgressFn progress;  // optional: ground truth and optimiser progress ("optimize" only)
 };
 
 struct Extraction {
@@ -50,10 +50,11 @@ Extraction extract(const sphere::EnvMap& env, const ExtractDesc& desc, const std
 
 struct MethodsEvalDesc {
   std::vector<std::string> methods = {"median-cut", "variance-cut", "optimize"};  // extraction methods
-  std::vector<int> counts = {1, 2, 4, 8, 16, 32, 64, 128, 256};  // light counts N (median-cut-2k skips non-powers of two)
-  int normals_level = 5;          // icosphere level of the M normals (5: 20480, as the paper)
-  int sh_bands = 3;               // bands of the SH reference line (≤ 0: none; at most sh::kMaxBands)
-  double min_separation_deg = 0;  // minimum angular separation of the lights in degrees (0: off)
+  std::vector<int> counts = {1,  2,  4,   8,  16,
+                             32, 64, 128, 256};  // light counts N (median-cut-2k skips non-powers of two)
+  int normals_level = 5;                         // icosphere level of the M normals (5: 20480, as the paper)
+  int sh_bands = 3;                              // bands of the SH reference line (≤ 0: none; at most sh::kMaxBands)
+  double min_separation_deg = 0;                 // minimum angular separation of the lights in degrees (0: off)
   int picture_count = 16;         // the N whose light sets are kept for pictures (EvalResult::picture_sets)
   OptimizeDesc optimize;          // "optimize": iterations, tolerance, initial cut (count is each N)
   std::optional<LightSet> given;  // also evaluated, as the row "<method> (file)" (a set read from a file)

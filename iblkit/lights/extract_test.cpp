@@ -88,7 +88,8 @@ TEST(LightsExtract, BadSettingsAreNamed) {
   auto env = lobes();
   ExtractDesc ed;
   ed.method = "k-means";
-  expect_error([&] { extract(env, ed); }, "unknown method 'k-means': use median-cut, median-cut-2k, variance-cut, optimize");
+  expect_error([&] { extract(env, ed); },
+               "unknown method 'k-means': use median-cut, median-cut-2k, variance-cut, optimize");
   ed.method = "optimize";
   ed.optimize.normals_level = kMaxNormalsLevel + 1;
   expect_error([&] { extract(env, ed); }, "normals level must be in [0, 7] (got 8)");
@@ -195,7 +196,9 @@ TEST(LightsEvaluateMethods, CsvNamesTheShReferenceByItsBands) {
     write_eval_csv(p.string(), r);
     std::string csv = read_all(p);
     EXPECT_EQ(csv.rfind("method,count,mean_rel,max_rel,rms_rel,rms_abs,mean_irradiance_Y,seconds,iterations,"
-                        "final_iterations,converged,initial_cost,final_cost\n", 0), 0u);
+                        "final_iterations,converged,initial_cost,final_cost\n",
+                        0),
+              0u);
     EXPECT_NE(csv.find("\nvariance-cut,2,"), std::string::npos) << csv;
     EXPECT_NE(csv.find("\noptimize,2,"), std::string::npos) << csv;
     std::string sh_row = "\n" + sh_reference_name(bands) + "," + std::to_string(bands * bands) + ",";

@@ -15,18 +15,25 @@ void quaternion_z_to(Vec3 d, double q[4]) {
   // q = normalize(1 + z·d, z × d) with z × d = (−d.y, d.x, 0); for d = −Z any half turn about X.
   constexpr double kOpposite = 1e-12;
   if (1.0 + d.z < kOpposite) {
-    q[0] = 1; q[1] = 0; q[2] = 0; q[3] = 0;
+    q[0] = 1;
+    q[1] = 0;
+    q[2] = 0;
+    q[3] = 0;
     return;
   }
   double x = -d.y, y = d.x, z = 0, w = 1.0 + d.z;
   double n = std::sqrt(x * x + y * y + z * z + w * w);
-  q[0] = x / n; q[1] = y / n; q[2] = z / n; q[3] = w / n;
+  q[0] = x / n;
+  q[1] = y / n;
+  q[2] = z / n;
+  q[3] = w / n;
 }
 
 nlohmann::json to_gltf(const LightSet& set, const GltfDesc& desc) {
   if (!(desc.lux_per_unit > 0) || !std::isfinite(desc.lux_per_unit))
     fail(ErrorKind::Value, "glTF export: lux per unit must be positive (got {})", desc.lux_per_unit);
-  nlohmann::json lights = nlohmann::json::array(), nodes = nlohmann::json::array(), scene_nodes = nlohmann::json::array();
+  nlohmann::json lights = nlohmann::json::array(), nodes = nlohmann::json::array(),
+                 scene_nodes = nlohmann::json::array();
   for (size_t i = 0; i < set.lights.size(); ++i) {
     const Light& l = set.lights[i];
     double mx = max_component(l.irradiance);

@@ -16,7 +16,7 @@
 namespace ibl::lights {
 
 struct GltfDesc {
-  double lux_per_unit = 1.0;  // lux per unit of probe irradiance (1: pixel values read as cd/m²)
+  double lux_per_unit = 1.0;           // lux per unit of probe irradiance (1: pixel values read as cd/m²)
   std::string name = "iblkit lights";  // scene name
 };
 

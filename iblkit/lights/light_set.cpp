@@ -33,29 +33,40 @@ void validate_probe(const sphere::EnvMap& env, int count) {
   int nc = std::min(img.channels(), 3);
   bool all_valid = env.mapping.kind() == sphere::MappingKind::LatLong;
   // Per row: lit pixels, and the first bad value (x, channel) if any; rows in parallel.
-  struct Row { int64_t lit = 0; int bad_x = -1, bad_c = 0; };
+  struct Row {
+    int64_t lit = 0;
+    int bad_x = -1, bad_c = 0;
+  };
   std::vector<Row> rows(img.height());
-  parallel_for(0, img.height(), [&](int64_t y) {
-    Row r;
-    for (int x = 0; x < img.width() && r.bad_x < 0; ++x) {
-      const float* p = img.pixel(x, static_cast<int>(y));
-      bool any = false;
-      for (int c = 0; c < nc; ++c) {
-        float v = p[c];
-        if (!(v >= 0) || !std::isfinite(v)) { r.bad_x = x; r.bad_c = c; break; }
-        any = any || v > 0;
-      }
-      if (any && (all_valid || env.mapping.valid(x, static_cast<int>(y)))) ++r.lit;
-    }
-    rows[y] = r;
-  }, 8);
+  parallel_for(
+      0, img.height(),
+      [&](int64_t y) {
+        Row r;
+        for (int x = 0; x < img.width() && r.bad_x < 0; ++x) {
+          const float* p = img.pixel(x, static_cast<int>(y));
+          bool any = false;
+          for (int c = 0; c < nc; ++c) {
+            float v = p[c];
+            if (!(v >= 0) || !std::isfinite(v)) {
+              r.bad_x = x;
+              r.bad_c = c;
+              break;
+            }
+            any = any || v > 0;
+          }
+          if (any && (all_valid || env.mapping.valid(x, static_cast<int>(y)))) ++r.lit;
+        }
+        rows[y] = r;
+      },
+      8);
   int64_t lit = 0;
   for (int y = 0; y < img.height(); ++y) {
     const Row& r = rows[y];
     if (r.bad_x >= 0) {
       float v = img.pixel(r.bad_x, y)[r.bad_c];
-      fail(ErrorKind::Value, "probe pixel ({}, {}) channel {} is {} (reading it with sanitize replaces such values by 0)", r.bad_x, y, r.bad_c,
-           std::isfinite(v) ? fmt::format("negative ({})", v) : fmt::format("{}", v));
+      fail(ErrorKind::Value,
+           "probe pixel ({}, {}) channel {} is {} (reading it with sanitize replaces such values by 0)", r.bad_x, y,
+           r.bad_c, std::isfinite(v) ? fmt::format("negative ({})", v) : fmt::format("{}", v));
     }
     lit += r.lit;
   }
@@ -148,7 +159,10 @@ int merge_pass(LightSet& set, double min_separation_rad) {
     const Light& l = set.lights[i];
     int join = -1;
     for (size_t k = 0; k < kept.size(); ++k)
-      if (dot(merged[k].direction, l.direction) > cos_min) { join = static_cast<int>(k); break; }
+      if (dot(merged[k].direction, l.direction) > cos_min) {
+        join = static_cast<int>(k);
+        break;
+      }
     double w = std::max(luminance(l.irradiance), 1e-300);
     if (join < 0) {
       owner[i] = static_cast<int>(kept.size());
@@ -229,12 +243,8 @@ LightSet from_json(const nlohmann::json& j, const std::string& what) {
   return set;
 }
 
-void write_lights(const std::string& path, const LightSet& set) {
-  write_json_file(path, to_json(set), 2);
-}
+void write_lights(const std::string& path, const LightSet& set) { write_json_file(path, to_json(set), 2); }
 
-LightSet read_lights(const std::string& path) {
-  return from_json(read_json_file(path), path);
-}
+LightSet read_lights(const std::string& path) { return from_json(read_json_file(path), path); }
 
 }  // namespace ibl::lights

@@ -24,9 +24,9 @@
 namespace ibl::lights {
 
 struct Light {
-  Vec3 direction;          // unit vector towards the light (world frame of the probe)
-  Vec3 irradiance;         // RGB irradiance at normal incidence, W/m² (Σ L·dω over its region)
-  double solid_angle = 0;  // sr of the probe region the light stands for
+  Vec3 direction;                // unit vector towards the light (world frame of the probe)
+  Vec3 irradiance;               // RGB irradiance at normal incidence, W/m² (Σ L·dω over its region)
+  double solid_angle = 0;        // sr of the probe region the light stands for
   std::optional<Vec3> position;  // where the light sits when localised (fusion), world metres
   Vec3 radiance() const { return solid_angle > 0 ? irradiance / solid_angle : Vec3{}; }
 };
@@ -56,8 +56,8 @@ Vec3 total_irradiance(const LightSet& set);
 // A probe as a lat-long grid with exact pixel solid angles: what median cut and variance cut read.
 struct LatLongGrid {
   int width = 0, height = 0;
-  std::vector<Vec3> rgb;            // radiance, row-major
-  std::vector<double> row_solid_angle;  // exact solid angle of one pixel of row y (2π/W)(cosθ0 − cosθ1)
+  std::vector<Vec3> rgb;                       // radiance, row-major
+  std::vector<double> row_solid_angle;         // exact solid angle of one pixel of row y (2π/W)(cosθ0 − cosθ1)
   Vec3 direction(double px, double py) const;  // direction through continuous pixel coordinates
 };
 

@@ -12,7 +12,9 @@ namespace {
 LightSet sample_set() {
   LightSet s;
   s.method = "median-cut";
-  s.lights = {{normalize(Vec3{0.2, 0.9, 0.1}), {3, 2, 1}, 0.01}, {{0, -1, 0}, {0.5, 0.5, 0.5}, 2.0}, {{0, 0, -1}, {0, 0, 1}, 0.5}};
+  s.lights = {{normalize(Vec3{0.2, 0.9, 0.1}), {3, 2, 1}, 0.01},
+              {{0, -1, 0}, {0.5, 0.5, 0.5}, 2.0},
+              {{0, 0, -1}, {0, 0, 1}, 0.5}};
   return s;
 }
 
@@ -27,7 +29,8 @@ TEST(LightsJson, RoundTrip) {
     EXPECT_NEAR(dot(back.lights[i].direction, s.lights[i].direction), 1, kExact);
     EXPECT_NEAR(back.lights[i].irradiance.x, s.lights[i].irradiance.x, kExact);
     EXPECT_NEAR(back.lights[i].solid_angle, s.lights[i].solid_angle, kExact);
-    EXPECT_NEAR(j["lights"][i]["radiance"][0].get<double>(), s.lights[i].irradiance.x / s.lights[i].solid_angle, kExact * 1e3);
+    EXPECT_NEAR(j["lights"][i]["radiance"][0].get<double>(), s.lights[i].irradiance.x / s.lights[i].solid_angle,
+                kExact * 1e3);
   }
   EXPECT_EQ(back.method, "median-cut");
   EXPECT_FALSE(back.origin);
@@ -48,9 +51,10 @@ TEST(LightsJson, LocalisedPositionsAndOriginRoundTrip) {
   ASSERT_TRUE(back.lights[1].position);
   EXPECT_NEAR(back.lights[1].position->y, 2, kExact);
   EXPECT_NEAR(back.lights[1].position->z, -7, kExact);
-  EXPECT_THROW(from_json(nlohmann::json::parse(
-                   R"({"format":"iblkit.lights/1","origin":[1,2],"lights":[{"direction":[0,1,0],"irradiance":[1,1,1]}]})")),
-               Error);
+  EXPECT_THROW(
+      from_json(nlohmann::json::parse(
+          R"({"format":"iblkit.lights/1","origin":[1,2],"lights":[{"direction":[0,1,0],"irradiance":[1,1,1]}]})")),
+      Error);
 }
 
 TEST(LightsJson, BadFilesNameTheField) {

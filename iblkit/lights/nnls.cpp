@@ -12,7 +12,8 @@ namespace {
 
 // x_F = argmin on the free set F (x_B = 0): H_FF x_F = b_F, by LDLᵀ with a tiny ridge so that two
 // identical columns (two lights in one direction) do not make it singular.
-Eigen::VectorXd solve_free(const Eigen::MatrixXd& H, const Eigen::VectorXd& b, const std::vector<int>& F, double ridge) {
+Eigen::VectorXd solve_free(const Eigen::MatrixXd& H, const Eigen::VectorXd& b, const std::vector<int>& F,
+                           double ridge) {
   const int m = static_cast<int>(F.size());
   Eigen::MatrixXd A(m, m);
   Eigen::VectorXd r(m);
@@ -31,11 +32,14 @@ NnlsReport nnls(const Eigen::MatrixXd& H, const Eigen::VectorXd& b, Eigen::Vecto
   NnlsReport rep;
   if (x.size() != n) x = Eigen::VectorXd::Zero(n);
   x = x.cwiseMax(0.0);
-  if (n == 0) { rep.kkt = true; return rep; }
+  if (n == 0) {
+    rep.kkt = true;
+    return rep;
+  }
   const double hmax = H.diagonal().cwiseAbs().maxCoeff();
   constexpr double kRidge = 1e-13;  // relative to the largest diagonal entry: far below any real curvature
   const double ridge = kRidge * hmax + 1e-300;
-  constexpr double kKkt = 1e-11;    // relative KKT tolerance on the gradient of the bound variables
+  constexpr double kKkt = 1e-11;  // relative KKT tolerance on the gradient of the bound variables
   const double tol = kKkt * std::max(b.cwiseAbs().maxCoeff(), 1e-300);
   const int max_solves = 3 * n + 20;  // Lawson–Hanson ends in finitely many steps; this only guards round-off cycling
   std::vector<char> free(n), skip(n, 0);
@@ -48,7 +52,10 @@ NnlsReport nnls(const Eigen::MatrixXd& H, const Eigen::VectorXd& b, Eigen::Vecto
       std::vector<int> F;
       for (int i = 0; i < n; ++i)
         if (free[i]) F.push_back(i);
-      if (F.empty()) { x.setZero(); break; }
+      if (F.empty()) {
+        x.setZero();
+        break;
+      }
       Eigen::VectorXd z = solve_free(H, b, F, ridge);
       ++rep.solves;
       const int m = static_cast<int>(F.size());
@@ -57,12 +64,16 @@ NnlsReport nnls(const Eigen::MatrixXd& H, const Eigen::VectorXd& b, Eigen::Vecto
       for (int a = 0; a < m; ++a)
         if (z(a) <= 0) {
           double t = x(F[a]) / (x(F[a]) - z(a));
-          if (blocking < 0 || t < alpha) { alpha = t; blocking = a; }
+          if (blocking < 0 || t < alpha) {
+            alpha = t;
+            blocking = a;
+          }
         }
       if (blocking < 0) {
         x.setZero();
         for (int a = 0; a < m; ++a) x(F[a]) = z(a);
-        if (just_added >= 0) std::fill(skip.begin(), skip.end(), 0);  // progress made: every bound variable may enter again
+        if (just_added >= 0)
+          std::fill(skip.begin(), skip.end(), 0);  // progress made: every bound variable may enter again
         just_added = -1;
         break;
       }
@@ -77,7 +88,10 @@ NnlsReport nnls(const Eigen::MatrixXd& H, const Eigen::VectorXd& b, Eigen::Vecto
       for (int a = 0; a < m; ++a) {
         int i = F[a];
         x(i) += alpha * (z(a) - x(i));
-        if (a == blocking || x(i) <= 0) { x(i) = 0; free[i] = 0; }
+        if (a == blocking || x(i) <= 0) {
+          x(i) = 0;
+          free[i] = 0;
+        }
       }
       just_added = -1;
     }
@@ -86,8 +100,14 @@ NnlsReport nnls(const Eigen::MatrixXd& H, const Eigen::VectorXd& b, Eigen::Vecto
     int best = -1;
     double bw = tol;
     for (int i = 0; i < n; ++i)
-      if (!free[i] && !skip[i] && w(i) > bw) { bw = w(i); best = i; }
-    if (best < 0) { rep.kkt = true; return rep; }
+      if (!free[i] && !skip[i] && w(i) > bw) {
+        bw = w(i);
+        best = i;
+      }
+    if (best < 0) {
+      rep.kkt = true;
+      return rep;
+    }
     free[best] = 1;
     just_added = best;
   }

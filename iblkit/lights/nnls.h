@@ -11,8 +11,8 @@
 namespace ibl::lights {
 
 struct NnlsReport {
-  int solves = 0;     // linear solves on the free set (the algorithm's cost unit)
-  bool kkt = false;   // ended with the Karush–Kuhn–Tucker conditions met (else: solve cap)
+  int solves = 0;    // linear solves on the free set (the algorithm's cost unit)
+  bool kkt = false;  // ended with the Karush–Kuhn–Tucker conditions met (else: solve cap)
 };
 
 // Lawson–Hanson active set [1], warm-started from `x` (clipped to ≥ 0; its positive entries are the

@@ -7,9 +7,9 @@
 #include <limits>
 #include <numeric>
 
+#include <fmt/format.h>
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
-#include <fmt/format.h>
 
 #include "iblkit/core/parallel.h"
 #include "iblkit/lights/cut.h"
@@ -71,12 +71,12 @@ namespace {
  * positive definite); the Marquardt scaling D and the convergence decrement use the Gauss–Newton H.
  */
 
-constexpr int kPatch = 64;   // normals per patch
-constexpr int kRanges = 4;   // fixed partition of the patches: sums do not depend on the thread count
+constexpr int kPatch = 64;  // normals per patch
+constexpr int kRanges = 4;  // fixed partition of the patches: sums do not depend on the thread count
 
 struct Problem {
-  std::vector<Vec3> n, gt, w;    // normals (patch order), ground truth, residual weights
-  std::vector<int64_t> patch;    // patch p is [patch[p], patch[p+1])
+  std::vector<Vec3> n, gt, w;  // normals (patch order), ground truth, residual weights
+  std::vector<int64_t> patch;  // patch p is [patch[p], patch[p+1])
 };
 
 Problem make_problem(const std::vector<Vec3>& normals, const std::vector<Vec3>& gt, double floor_fraction) {
@@ -86,15 +86,21 @@ Problem make_problem(const std::vector<Vec3>& normals, const std::vector<Vec3>& 
   // gives compact patches; the icosphere's own order (children follow parents) is kept within a cell.
   auto cells = sphere::icosphere_face_centres(2);
   std::vector<int> cell(M);
-  parallel_for(0, static_cast<int64_t>(M), [&](int64_t k) {
-    int best = 0;
-    double bc = -2;
-    for (int c = 0; c < static_cast<int>(cells.size()); ++c) {
-      double d = dot(normals[k], cells[c]);
-      if (d > bc) { bc = d; best = c; }
-    }
-    cell[k] = best;
-  }, 256);
+  parallel_for(
+      0, static_cast<int64_t>(M),
+      [&](int64_t k) {
+        int best = 0;
+        double bc = -2;
+        for (int c = 0; c < static_cast<int>(cells.size()); ++c) {
+          double d = dot(normals[k], cells[c]);
+          if (d > bc) {
+            bc = d;
+            best = c;
+          }
+        }
+        cell[k] = best;
+      },
+      256);
   std::vector<size_t> order(M);
   std::iota(order.begin(), order.end(), 0);
   std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return cell[a] < cell[b]; });
@@ -183,7 +189,11 @@ std::array<Eigen::MatrixXd, 3> gram_pass(const Problem& P, const Frames& F) {
         }
       }
       col.resize(c3);
-      for (int a = 0; a < u; ++a) { col[a] = U[a]; col[u + a] = N + U[a]; col[2 * u + a] = 2 * N + U[a]; }
+      for (int a = 0; a < u; ++a) {
+        col[a] = U[a];
+        col[u + a] = N + U[a];
+        col[2 * u + a] = 2 * N + U[a];
+      }
       col[3 * u] = 3 * N;
       for (int ch = 0; ch < 3; ++ch) {
         wv.resize(m);
@@ -242,7 +252,9 @@ double cost_and_gradient(const Problem& P, const Frames& F, const std::vector<Ve
         for (int i : U) {
           if (hor && std::abs(dots(r, i)) < band / 2) {
             double s = dot(rw, E[i]) / band, nt = dot(n, F.t[i]), ns = dot(n, F.s[i]);
-            hq[q](3 * i) += s * nt * nt; hq[q](3 * i + 1) += s * nt * ns; hq[q](3 * i + 2) += s * ns * ns;
+            hq[q](3 * i) += s * nt * nt;
+            hq[q](3 * i + 1) += s * nt * ns;
+            hq[q](3 * i + 2) += s * ns * ns;
           }
           if (dots(r, i) <= 0) continue;
           double s = dot(rw, E[i]);
@@ -344,16 +356,16 @@ StageResult solve_stage(const Problem& P, const std::vector<Vec3>& dirs, const s
   const int N = static_cast<int>(dirs.size());
   State S = evaluate_state(P, dirs, E);
   StageResult R;
-  double lambda = 1e-3, nu = 2;              // damping relative to diag(H_GN); Nielsen's update [3]
-  constexpr double kMinLambda = 1e-7;        // keeps one rejection from needing dozens of retries to re-damp
-  constexpr double kMaxLambda = 1e12;        // a step damped this much moves lights by ~1e-12 rad: nothing left to gain
-  constexpr int kWindow = 3;                 // accepted steps of the kink-limited stopping test
+  double lambda = 1e-3, nu = 2;        // damping relative to diag(H_GN); Nielsen's update [3]
+  constexpr double kMinLambda = 1e-7;  // keeps one rejection from needing dozens of retries to re-damp
+  constexpr double kMaxLambda = 1e12;  // a step damped this much moves lights by ~1e-12 rad: nothing left to gain
+  constexpr int kWindow = 3;           // accepted steps of the kink-limited stopping test
   double last = std::numeric_limits<double>::infinity();
-  std::vector<double> history = {S.cost};    // cost after every accepted step
+  std::vector<double> history = {S.cost};  // cost after every accepted step
   std::vector<int> live;
   Eigen::MatrixXd Hgn, Hfull;
   Eigen::VectorXd gl, D;
-  bool fresh = true;                         // S changed: rebuild the model
+  bool fresh = true;  // S changed: rebuild the model
   while (true) {
     if (fresh) {
       fresh = false;
@@ -398,10 +410,14 @@ StageResult solve_stage(const Problem& P, const std::vector<Vec3>& dirs, const s
     const bool smooth = last < tol && R.decrement < tol;
     if (smooth || window_gain < tol) {
       R.converged = true;
-      R.termination = smooth ? fmt::format("converged: last step gained {:.2g} and a Gauss–Newton step would gain {:.2g} "
-                                           "of the cost (< {:.0e})", last, R.decrement, tol)
-                             : fmt::format("converged: the last {} steps gained {:.2g} of the cost (< {:.0e}); "
-                                           "Gauss–Newton decrement {:.2g}", kWindow, window_gain, tol, R.decrement);
+      R.termination = smooth ? fmt::format(
+                                   "converged: last step gained {:.2g} and a Gauss–Newton step would gain {:.2g} "
+                                   "of the cost (< {:.0e})",
+                                   last, R.decrement, tol)
+                             : fmt::format(
+                                   "converged: the last {} steps gained {:.2g} of the cost (< {:.0e}); "
+                                   "Gauss–Newton decrement {:.2g}",
+                                   kWindow, window_gain, tol, R.decrement);
       break;
     }
     if (R.iterations >= max_iterations) {
@@ -418,7 +434,11 @@ StageResult solve_stage(const Problem& P, const std::vector<Vec3>& dirs, const s
     Eigen::MatrixXd A = Hfull;
     A.diagonal() += lambda * D;
     Eigen::LLT<Eigen::MatrixXd> llt(A);
-    if (llt.info() != Eigen::Success) { lambda *= nu; nu *= 2; continue; }  // indefinite model: damp more
+    if (llt.info() != Eigen::Success) {
+      lambda *= nu;
+      nu *= 2;
+      continue;
+    }  // indefinite model: damp more
     Eigen::VectorXd step = -llt.solve(gl);
     double pred = -(gl.dot(step) + 0.5 * step.dot(Hfull * step));
     std::vector<Vec3> nd = S.dirs;
@@ -451,13 +471,19 @@ StageResult solve_stage(const Problem& P, const std::vector<Vec3>& dirs, const s
 
 double cost_of(const Problem& P, const std::vector<Light>& lights) {
   std::vector<Vec3> d, E;
-  for (const auto& l : lights) { d.push_back(normalize(l.direction)); E.push_back(l.irradiance); }
+  for (const auto& l : lights) {
+    d.push_back(normalize(l.direction));
+    E.push_back(l.irradiance);
+  }
   return cost_and_gradient(P, frames_of(d), E, nullptr);
 }
 
 std::vector<Light> to_lights(const StageResult& s) {
   std::vector<Light> out(s.dirs.size());
-  for (size_t i = 0; i < out.size(); ++i) { out[i].direction = normalize(s.dirs[i]); out[i].irradiance = s.E[i]; }
+  for (size_t i = 0; i < out.size(); ++i) {
+    out[i].direction = normalize(s.dirs[i]);
+    out[i].irradiance = s.E[i];
+  }
   return out;
 }
 
@@ -477,7 +503,10 @@ void voronoi_regions(const sphere::EnvMap& env, LightSet& set) {
       double bc = -2;
       for (int i = 0; i < n; ++i) {
         double c = dot(w, set.lights[i].direction);
-        if (c > bc) { bc = c; best = i; }
+        if (c > bc) {
+          bc = c;
+          best = i;
+        }
       }
       set.regions.label[static_cast<size_t>(y) * g.width + x] = best;
       omega[y][best] += g.row_solid_angle[y];
@@ -496,9 +525,11 @@ LightSet optimize_lights_from(const sphere::EnvMap& env, const std::vector<Vec3>
   if (initial.empty()) fail(ErrorKind::Value, "optimiser: no initial lights");
   if (normals.size() != ground_truth.size() || normals.empty())
     fail(ErrorKind::Value, "optimiser: {} normals but {} ground-truth values", normals.size(), ground_truth.size());
-  if (desc.max_iterations < 1) fail(ErrorKind::Value, "optimiser: max_iterations must be ≥ 1 (got {})", desc.max_iterations);
+  if (desc.max_iterations < 1)
+    fail(ErrorKind::Value, "optimiser: max_iterations must be ≥ 1 (got {})", desc.max_iterations);
   if (!(desc.tolerance > 0) || !(desc.coarse_tolerance > 0))
-    fail(ErrorKind::Value, "optimiser: tolerances must be positive (got {}, {})", desc.tolerance, desc.coarse_tolerance);
+    fail(ErrorKind::Value, "optimiser: tolerances must be positive (got {}, {})", desc.tolerance,
+         desc.coarse_tolerance);
   for (const auto& l : initial)
     if (!(length(l.direction) > 0) || !(l.irradiance.x >= 0 && l.irradiance.y >= 0 && l.irradiance.z >= 0))
       fail(ErrorKind::Value, "optimiser: an initial light has a zero direction or negative irradiance");
@@ -519,19 +550,28 @@ LightSet optimize_lights_from(const sphere::EnvMap& env, const std::vector<Vec3>
       if (2 * coarse.size() > normals.size() || 3 * coarse.size() < 10 * 5 * static_cast<size_t>(N)) continue;
       Problem cp = make_problem(coarse, irradiance_ground_truth(env, coarse), desc.floor_fraction);
       std::vector<Vec3> d, E;
-      for (const auto& l : lights) { d.push_back(normalize(l.direction)); E.push_back(l.irradiance); }
+      for (const auto& l : lights) {
+        d.push_back(normalize(l.direction));
+        E.push_back(l.irradiance);
+      }
       auto s = solve_stage(cp, d, E, desc.coarse_tolerance, desc.max_iterations);
       rep.coarse_iterations += s.iterations;
       auto cand = to_lights(s);
       double c = cost_of(full, cand);
-      if (c < best) { best = c; lights = cand; }
+      if (c < best) {
+        best = c;
+        lights = cand;
+      }
       report(desc.progress, "optimise", level == 3 ? 0.3 : 0.6);
     }
   }
   StageResult fin;
   for (int round = 0; round < 4; ++round) {
     std::vector<Vec3> d, E;
-    for (const auto& l : lights) { d.push_back(normalize(l.direction)); E.push_back(l.irradiance); }
+    for (const auto& l : lights) {
+      d.push_back(normalize(l.direction));
+      E.push_back(l.irradiance);
+    }
     fin = solve_stage(full, d, E, desc.tolerance, desc.max_iterations);
     rep.final_iterations += fin.iterations;
     lights = to_lights(fin);

@@ -48,30 +48,30 @@ namespace ibl::lights {
 inline constexpr int kMinNormalsLevel = 0, kMaxNormalsLevel = 7;
 
 struct OptimizeDesc {
-  int count = 16;                  // number of lights N ≥ 1
-  int normals_level = 5;           // icosphere level of the M normals (5: the 20480 of Madsen & Laursen)
+  int count = 16;                     // number of lights N ≥ 1
+  int normals_level = 5;              // icosphere level of the M normals (5: the 20480 of Madsen & Laursen)
   std::string init = "variance-cut";  // initial lights: "variance-cut" or "median-cut"
-  double floor_fraction = 0.01;    // residual weight 1/max(E_gt, floor_fraction·mean E_gt), per channel
-  double tolerance = 1e-6;         // τ of the stopping rule above (relative cost decrease)
-  double coarse_tolerance = 1e-4;  // the same for the coarse (warm-start) stages
-  int max_iterations = 1000;       // safety cap on Levenberg–Marquardt steps per stage (reported when hit)
-  bool coarse_to_fine = true;      // warm starts on level-3 and level-4 normals before the full set
-  double min_separation_deg = 0;   // merge lights that end closer than this and re-solve (0: off)
-  ProgressFn progress;             // optional progress callback
+  double floor_fraction = 0.01;       // residual weight 1/max(E_gt, floor_fraction·mean E_gt), per channel
+  double tolerance = 1e-6;            // τ of the stopping rule above (relative cost decrease)
+  double coarse_tolerance = 1e-4;     // the same for the coarse (warm-start) stages
+  int max_iterations = 1000;          // safety cap on Levenberg–Marquardt steps per stage (reported when hit)
+  bool coarse_to_fine = true;         // warm starts on level-3 and level-4 normals before the full set
+  double min_separation_deg = 0;      // merge lights that end closer than this and re-solve (0: off)
+  ProgressFn progress;                // optional progress callback
 };
 
 struct OptimizeReport {
-  int iterations = 0;          // Levenberg–Marquardt steps tried, all stages (each costs one Gram pass)
-  int final_iterations = 0;    // of those, on the full normal set
-  int coarse_iterations = 0;   // of those, on the coarse normal sets
-  int dark_lights = 0;         // lights that ended with zero irradiance (the fit has no use for them)
-  double initial_cost = 0;     // ½ Σ r² of the initial lights on the final normals
-  double final_cost = 0;       // ½ Σ r² at the end
-  double last_decrease = 0;    // relative cost decrease of the last accepted step (full set)
-  double decrement = 0;        // ½ gᵀH⁻¹g / cost at the end: what a full Gauss–Newton step would still gain
-  double seconds = 0;          // wall time of the optimisation (ground truth excluded)
-  bool converged = false;      // the stopping rule was met on the full set (false: iteration cap)
-  std::string termination;     // which test ended the final stage, with its figures
+  int iterations = 0;         // Levenberg–Marquardt steps tried, all stages (each costs one Gram pass)
+  int final_iterations = 0;   // of those, on the full normal set
+  int coarse_iterations = 0;  // of those, on the coarse normal sets
+  int dark_lights = 0;        // lights that ended with zero irradiance (the fit has no use for them)
+  double initial_cost = 0;    // ½ Σ r² of the initial lights on the final normals
+  double final_cost = 0;      // ½ Σ r² at the end
+  double last_decrease = 0;   // relative cost decrease of the last accepted step (full set)
+  double decrement = 0;       // ½ gᵀH⁻¹g / cost at the end: what a full Gauss–Newton step would still gain
+  double seconds = 0;         // wall time of the optimisation (ground truth excluded)
+  bool converged = false;     // the stopping rule was met on the full set (false: iteration cap)
+  std::string termination;    // which test ended the final stage, with its figures
 };
 
 // The optimiser is part of every build (it needs only Eigen).

@@ -57,7 +57,10 @@ TEST(LightsOptimize, FindsASunFromAFarStart) {
 TEST(LightsOptimize, UnitRadianceWithinPedersensFigures) {
   // Pedersen 2008 Table 7.1 (median cut, unit radiance): 16 lights average 3.046 / RMS 0.241,
   // 64 lights 3.108 / RMS 0.050. The optimiser must match or beat both.
-  struct Row { int n; double mean_irr, rms; };
+  struct Row {
+    int n;
+    double mean_irr, rms;
+  };
   const Row kPedersen[] = {{16, 3.046, 0.241}, {64, 3.108, 0.050}};
   auto env = testing::constant_probe(128, 64);
   for (const auto& row : kPedersen) {
@@ -85,7 +88,8 @@ TEST(LightsOptimize, BeatsMedianCutAndNeverWorseOnBlenderProbes) {
       EXPECT_LE(f.err.mean_rel, f.init_err.mean_rel) << p << " N=" << n;
       // The mean irradiance over the sphere of normals stays within the fit's own (RMS relative) error.
       for (int c = 0; c < 3; ++c)
-        EXPECT_LE(std::abs(f.err.mean_est[c] - f.err.mean_gt[c]), f.err.rms_rel * f.err.mean_gt[c] + 1e-12) << p << " N=" << n;
+        EXPECT_LE(std::abs(f.err.mean_est[c] - f.err.mean_gt[c]), f.err.rms_rel * f.err.mean_gt[c] + 1e-12)
+            << p << " N=" << n;
     }
   }
 }

@@ -21,7 +21,8 @@ int dual_unknowns(Basis b) { return static_cast<int>(kQ * dual_half_width(b)); }
 double gram(Basis b, int k, int j) {
   static const double gx[3] = {-std::sqrt(0.6), 0.0, std::sqrt(0.6)}, gw[3] = {5.0 / 9, 8.0 / 9, 5.0 / 9};
   const double step = 1.0 / kQ;
-  double lo = std::max((k - 1) * step, j - primal_half_width(b)), hi = std::min((k + 1) * step, j + primal_half_width(b));
+  double lo = std::max((k - 1) * step, j - primal_half_width(b)),
+         hi = std::min((k + 1) * step, j + primal_half_width(b));
   double acc = 0;
   for (double a = lo; a < hi - 1e-12; a += step) {
     double c = a + 0.5 * step, r = 0.5 * step;
@@ -51,7 +52,8 @@ std::vector<double> solve_dual(Basis b) {
   }
   // Underdetermined: the minimum-norm solution.
   Eigen::VectorXd a = M.completeOrthogonalDecomposition().solve(rhs);
-  if ((M * a - rhs).norm() > 1e-10) fail(ErrorKind::Internal, "dual filter of the {} basis: inconsistent conditions", basis_name(b));
+  if ((M * a - rhs).norm() > 1e-10)
+    fail(ErrorKind::Internal, "dual filter of the {} basis: inconsistent conditions", basis_name(b));
   return std::vector<double>(a.data(), a.data() + a.size());
 }
 
@@ -87,7 +89,10 @@ double dual(Basis b, double x) {
 
 double shift_invariance_error(double theta0, double w, bool two_d) {
   // cos⁴θ of the ray from the origin of S to (u, v) on the plane at distance 1: 1/(1 + u² + v²)².
-  auto g = [](double u, double v) { double r = 1 + u * u + v * v; return 1 / (r * r); };
+  auto g = [](double u, double v) {
+    double r = 1 + u * u + v * v;
+    return 1 / (r * r);
+  };
   const double u0 = std::tan(theta0);
   const double ulo = u0 - w / 2, uhi = u0 + w / 2;
   // g decreases with |u| and |v|: the maximum is at the point of F closest to the axis, the minimum

@@ -23,7 +23,9 @@ constexpr EnumName<Basis> kBasisNames[] = {{Basis::Bilinear, "bilinear"}, {Basis
 }  // namespace
 
 const char* basis_name(Basis b) { return name_of(kBasisNames, b); }
-Basis parse_basis(const std::string& name, const std::string& what) { return parse_enum(kBasisNames, name, "basis", what); }
+Basis parse_basis(const std::string& name, const std::string& what) {
+  return parse_enum(kBasisNames, name, "basis", what);
+}
 
 Image Dataset::measurement(int i, int j) const {
   const size_t k = static_cast<size_t>(j * nx + i);
@@ -37,12 +39,14 @@ Image Dataset::measurement(int i, int j) const {
 
 void Dataset::validate(const std::string& what) const {
   if (nx < 1 || ny < 1) fail(ErrorKind::Value, "{}: grid {}x{} has no filter positions", what, nx, ny);
-  if (!(spacing > 0) || !std::isfinite(spacing)) fail(ErrorKind::Value, "{}: spacing {} must be positive", what, spacing);
+  if (!(spacing > 0) || !std::isfinite(spacing))
+    fail(ErrorKind::Value, "{}: spacing {} must be positive", what, spacing);
   const double want = 2 * dual_half_width(basis) * spacing;
   if (!(std::abs(filter_width - want) <= 1e-6 * want))  // written with 6+ significant digits
     fail(ErrorKind::Value, "{}: filter_width {} m does not match the {} basis at spacing {} m (its dual is {} m wide)",
          what, filter_width, basis_name(basis), spacing, want);
-  if (!(distance > 0) || !std::isfinite(distance)) fail(ErrorKind::Value, "{}: distance {} must be positive", what, distance);
+  if (!(distance > 0) || !std::isfinite(distance))
+    fail(ErrorKind::Value, "{}: distance {} must be positive", what, distance);
   if (!(m_max.x > m_min.x) || !(m_max.y > m_min.y))
     fail(ErrorKind::Value, "{}: M extent [{}, {}]x[{}, {}] is empty", what, m_min.x, m_max.x, m_min.y, m_max.y);
   if (!(filter_gain > 0)) fail(ErrorKind::Value, "{}: filter_gain {} must be positive", what, filter_gain);
@@ -56,16 +60,19 @@ void Dataset::validate(const std::string& what) const {
       const Image& img = part ? negative[k] : positive[k];
       const int i = static_cast<int>(k) % nx, j = static_cast<int>(k) / nx;
       const char* pn = part ? "negative" : "positive";
-      if (img.empty()) fail(ErrorKind::Value, "{}: the {} image of filter position ({}, {}) is missing", what, pn, i, j);
+      if (img.empty())
+        fail(ErrorKind::Value, "{}: the {} image of filter position ({}, {}) is missing", what, pn, i, j);
       if (img.width() != w || img.height() != h || img.channels() < 3)
-        fail(ErrorKind::Value, "{}: the {} image of ({}, {}) is {}x{}x{}, the first is {}x{}x3", what, pn, i, j, img.width(),
-             img.height(), img.channels(), w, h);
+        fail(ErrorKind::Value, "{}: the {} image of ({}, {}) is {}x{}x{}, the first is {}x{}x3", what, pn, i, j,
+             img.width(), img.height(), img.channels(), w, h);
       for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x)
           for (int c = 0; c < 3; ++c) {
             const float v = img.at(x, y, c);
             if (!std::isfinite(v) || v < 0)
-              fail(ErrorKind::Value, "{}: the {} image of ({}, {}) has pixel ({}, {}) channel {} = {} (measurements are non-negative irradiances)",
+              fail(ErrorKind::Value,
+                   "{}: the {} image of ({}, {}) has pixel ({}, {}) channel {} = {} (measurements are non-negative "
+                   "irradiances)",
                    what, pn, i, j, x, y, c, v);
           }
     }
@@ -95,17 +102,21 @@ Dataset read_dataset(const std::string& path) {
   ds.distance = number(j, "distance", path);
   if (!j.contains("grid") || !j["grid"].is_array() || j["grid"].size() != 2 || !j["grid"][0].is_number_integer() ||
       !j["grid"][1].is_number_integer())
-    fail(ErrorKind::Format, "{}: field \"grid\" must be [nx, ny] of whole numbers, got {}", path, j.contains("grid") ? j["grid"].dump() : "nothing");
+    fail(ErrorKind::Format, "{}: field \"grid\" must be [nx, ny] of whole numbers, got {}", path,
+         j.contains("grid") ? j["grid"].dump() : "nothing");
   const int64_t nx = j["grid"][0].get<int64_t>(), ny = j["grid"][1].get<int64_t>();
-  if (nx < 1 || ny < 1 || nx > 256 || ny > 256) fail(ErrorKind::Value, "{}: field \"grid\": {}x{} out of range (1..256)", path, nx, ny);
+  if (nx < 1 || ny < 1 || nx > 256 || ny > 256)
+    fail(ErrorKind::Value, "{}: field \"grid\": {}x{} out of range (1..256)", path, nx, ny);
   ds.nx = static_cast<int>(nx);
   ds.ny = static_cast<int>(ny);
-  if (!j.contains("m_extent") || !j["m_extent"].is_object()) fail(ErrorKind::Format, "{}: 'm_extent' {{min, max}} missing", path);
+  if (!j.contains("m_extent") || !j["m_extent"].is_object())
+    fail(ErrorKind::Format, "{}: 'm_extent' {{min, max}} missing", path);
   ds.m_min = vec2(j["m_extent"].value("min", json()), path + ": m_extent.min");
   ds.m_max = vec2(j["m_extent"].value("max", json()), path + ": m_extent.max");
   ds.m_basis = parse_basis(opt_field(j, path, "m_basis", "bilinear"), path + ": m_basis");
   ds.filter_gain = opt_field(j, path, "filter_gain", 1.0);
-  if (!j.contains("measurements") || !j["measurements"].is_array()) fail(ErrorKind::Format, "{}: 'measurements' array missing", path);
+  if (!j.contains("measurements") || !j["measurements"].is_array())
+    fail(ErrorKind::Format, "{}: 'measurements' array missing", path);
   const size_t n = static_cast<size_t>(ds.count());
   ds.positive.assign(n, Image());
   ds.negative.assign(n, Image());
@@ -135,8 +146,8 @@ Dataset read_dataset(const std::string& path) {
   }
   for (size_t k = 0; k < n; ++k)
     if (!seen[k])
-      fail(ErrorKind::Value, "{}: filter position ({}, {}) of the {}x{} grid has no measurement", path, k % ds.nx, k / ds.nx,
-           ds.nx, ds.ny);
+      fail(ErrorKind::Value, "{}: filter position ({}, {}) of the {}x{} grid has no measurement", path, k % ds.nx,
+           k / ds.nx, ds.nx, ds.ny);
   ds.validate(path);
   return ds;
 }
@@ -151,7 +162,8 @@ void write_dataset(const std::string& path, const Dataset& ds) {
   for (int j = 0; j < ds.ny; ++j)
     for (int i = 0; i < ds.nx; ++i) {
       const size_t k = static_cast<size_t>(j * ds.nx + i);
-      std::string pos = fmt::format("{}/ij_{}_{}_pos.exr", sub, i, j), neg = fmt::format("{}/ij_{}_{}_neg.exr", sub, i, j);
+      std::string pos = fmt::format("{}/ij_{}_{}_pos.exr", sub, i, j),
+                  neg = fmt::format("{}/ij_{}_{}_neg.exr", sub, i, j);
       io::write_image((dir / pos).string(), ds.positive[k]);
       io::write_image((dir / neg).string(), ds.negative[k]);
       ms.push_back({{"i", i}, {"j", j}, {"positive", pos}, {"negative", neg}});

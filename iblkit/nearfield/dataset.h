@@ -35,24 +35,22 @@ const char* basis_name(Basis b);
 Basis parse_basis(const std::string& name, const std::string& what);  // throws ibl::Error naming `what`
 
 struct Dataset {
-  std::string name;              // e.g. "flashlight-7x7"
-  std::string luminaire;         // the lab luminaire a simulated dataset came from ("" when measured)
-  Basis basis = Basis::Biquadratic;  // Φ on S
-  double spacing = 0.005;        // h: distance between neighbouring filter positions on S, metres
-  double filter_width = 0.02;    // support width of the dual filter Φ' (must match basis and spacing)
-  int nx = 5, ny = 5;            // filter positions along s and t
-  double distance = 0.5;         // d: distance between S and M, metres
+  std::string name;                             // e.g. "flashlight-7x7"
+  std::string luminaire;                        // the lab luminaire a simulated dataset came from ("" when measured)
+  Basis basis = Basis::Biquadratic;             // Φ on S
+  double spacing = 0.005;                       // h: distance between neighbouring filter positions on S, metres
+  double filter_width = 0.02;                   // support width of the dual filter Φ' (must match basis and spacing)
+  int nx = 5, ny = 5;                           // filter positions along s and t
+  double distance = 0.5;                        // d: distance between S and M, metres
   Vec2 m_min{-0.25, -0.25}, m_max{0.25, 0.25};  // extent of every image on M (metres, M's (s,t))
-  Basis m_basis = Basis::Bilinear;  // the basis of the images on M (pixels): bilinear = interpolating
-  double filter_gain = 1;        // E_ij = gain·(E⁺_ij − E⁻_ij) (transmittance scale of a real slide)
+  Basis m_basis = Basis::Bilinear;              // the basis of the images on M (pixels): bilinear = interpolating
+  double filter_gain = 1;  // E_ij = gain·(E⁺_ij − E⁻_ij) (transmittance scale of a real slide)
   // Measurements, index j·nx + i, each W×H RGB, non-negative irradiance (W/m²) on M behind the
   // positive and negative parts of the filter Φ'_ij scaled to transmittance h²·Φ'_ij / gain.
   std::vector<Image> positive, negative;
 
   int count() const { return nx * ny; }
-  Vec2 filter_center(int i, int j) const {
-    return {(i - 0.5 * (nx - 1)) * spacing, (j - 0.5 * (ny - 1)) * spacing};
-  }
+  Vec2 filter_center(int i, int j) const { return {(i - 0.5 * (nx - 1)) * spacing, (j - 0.5 * (ny - 1)) * spacing}; }
   // M coordinates of pixel centre (x, y) of a W×H image.
   Vec2 pixel_to_m(double x, double y, int w, int h) const {
     return {m_min.x + (x + 0.5) * (m_max.x - m_min.x) / w, m_max.y - (y + 0.5) * (m_max.y - m_min.y) / h};

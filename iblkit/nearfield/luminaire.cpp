@@ -182,7 +182,8 @@ Dataset simulate(const Luminaire& lum, const SimulateDesc& desc, const ProgressF
   };
   std::vector<Pt> pts;
   for (size_t e = 0; e < lum.emitters.size(); ++e) {
-    if (lum.emitters[e].center.z >= 0) fail(ErrorKind::Value, "simulate: emitter {} of '{}' is not behind S (z >= 0)", e, lum.name);
+    if (lum.emitters[e].center.z >= 0)
+      fail(ErrorKind::Value, "simulate: emitter {} of '{}' is not behind S (z >= 0)", e, lum.name);
     for (auto& [y, da] : lum.quadrature(lum.emitters[e])) pts.push_back({static_cast<int>(e), y, da});
   }
   const double h = desc.spacing, half = dual_half_width(desc.basis), d = desc.distance;
@@ -203,15 +204,18 @@ Dataset simulate(const Luminaire& lum, const SimulateDesc& desc, const ProgressF
         // Where the ray crosses S, in units of h from the grid's corner position (0,0).
         const double k = -q.y.z / v.z;
         const double cu = (q.y.x + v.x * k) / h + 0.5 * (desc.nx - 1), cv = (q.y.y + v.y * k) / h + 0.5 * (desc.ny - 1);
-        const int i0 = std::max(0, static_cast<int>(std::ceil(cu - half))), i1 = std::min(desc.nx - 1, static_cast<int>(std::floor(cu + half)));
-        const int j0 = std::max(0, static_cast<int>(std::ceil(cv - half))), j1 = std::min(desc.ny - 1, static_cast<int>(std::floor(cv + half)));
+        const int i0 = std::max(0, static_cast<int>(std::ceil(cu - half))),
+                  i1 = std::min(desc.nx - 1, static_cast<int>(std::floor(cu + half)));
+        const int j0 = std::max(0, static_cast<int>(std::ceil(cv - half))),
+                  j1 = std::min(desc.ny - 1, static_cast<int>(std::floor(cv + half)));
         for (int j = j0; j <= j1; ++j) {
           const double fv = dual(desc.basis, cv - j);
           if (fv == 0) continue;
           for (int i = i0; i <= i1; ++i) {
             const double f = fv * dual(desc.basis, cu - i);  // transmittance h²Φ'_ij
             if (f == 0) continue;
-            Image& img = f > 0 ? ds.positive[static_cast<size_t>(j * desc.nx + i)] : ds.negative[static_cast<size_t>(j * desc.nx + i)];
+            Image& img = f > 0 ? ds.positive[static_cast<size_t>(j * desc.nx + i)]
+                               : ds.negative[static_cast<size_t>(j * desc.nx + i)];
             float* o = img.pixel(px, static_cast<int>(py));
             const double af = std::abs(f);
             o[0] += static_cast<float>(l.x * af);

@@ -24,23 +24,23 @@
 namespace ibl::nearfield {
 
 struct DiscEmitter {
-  Vec3 center;              // luminaire frame, metres (z < 0)
-  Vec3 normal{0, 0, 1};     // the disc faces this way (unit)
-  double radius = 0.001;    // metres
-  Vec3 radiance{1, 1, 1};   // W/(sr·m²) on the lobe axis
-  Vec3 axis{0, 0, 1};       // lobe axis (unit)
-  double exponent = 1;      // lobe sharpness
-  double ripple = 0;        // azimuthal modulation depth in [0, 1)
-  int facets = 0;           // azimuthal modulation frequency (reflector facets)
-  Vec3 lobe_ref{1, 0, 0};   // φ = 0 direction about the axis (made orthogonal to it)
+  Vec3 center;             // luminaire frame, metres (z < 0)
+  Vec3 normal{0, 0, 1};    // the disc faces this way (unit)
+  double radius = 0.001;   // metres
+  Vec3 radiance{1, 1, 1};  // W/(sr·m²) on the lobe axis
+  Vec3 axis{0, 0, 1};      // lobe axis (unit)
+  double exponent = 1;     // lobe sharpness
+  double ripple = 0;       // azimuthal modulation depth in [0, 1)
+  int facets = 0;          // azimuthal modulation frequency (reflector facets)
+  Vec3 lobe_ref{1, 0, 0};  // φ = 0 direction about the axis (made orthogonal to it)
 };
 
 struct Luminaire {
-  std::string name;                 // "flashlight", "bikelight"
+  std::string name;  // "flashlight", "bikelight"
   std::vector<DiscEmitter> emitters;
-  double cutoff_deg = 30;           // housing: no light beyond this angle from +z
-  double taper_deg = 5;             // housing: cosine taper width below the cut-off
-  int rings = 2, sectors = 8;       // the disc quadrature rule (rings·sectors points per disc)
+  double cutoff_deg = 30;      // housing: no light beyond this angle from +z
+  double taper_deg = 5;        // housing: cosine taper width below the cut-off
+  int rings = 2, sectors = 8;  // the disc quadrature rule (rings·sectors points per disc)
 
   // Radiance of emitter e towards unit direction w (luminaire frame).
   Vec3 emitted(const DiscEmitter& e, Vec3 w) const;

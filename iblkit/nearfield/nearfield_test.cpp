@@ -40,8 +40,11 @@ TEST(NearfieldReconstruction, SpotlightsMatchTheExactLuminaireAndBeatTheFarField
   origin.position = {0, 0, 0};
   const auto lights = spotlights(ds, origin, false);
   ASSERT_EQ(lights.size(), 63u);
-  const auto ff = far_field_spotlight([&](Vec3 w) { return lum.intensity(w); }, ds.distance, ds.m_max.x, 64, origin, false);
-  struct Row { double z, near_max, far_min; };
+  const auto ff =
+      far_field_spotlight([&](Vec3 w) { return lum.intensity(w); }, ds.distance, ds.m_max.x, 64, origin, false);
+  struct Row {
+    double z, near_max, far_min;
+  };
   // Measured (docs/nearfield.md): near 1.3%/0.3%/0.9% RMS at z = 0.3/0.6/1.2 m, far 25%/11%/5%.
   // Bounds: 2–3× the measured near-field error (texture resolution 64 here, 96 in the docs), and the
   // far field at least 3× worse than the near field at these near distances.
@@ -120,7 +123,8 @@ TEST(NearfieldReconstruction, BiquadraticMBasisDeconvolvesASmoothField) {
     // 2e-4 here; the outermost pixels carry the mirror boundary's error (0.7%) and are left out.
     const double tol = mb == Basis::Bilinear ? 1e-5 : 5e-4;
     for (int y = 1; y < W - 1; y += 6)
-      for (int x = 1; x < W - 1; x += 6) EXPECT_NEAR(ep[3].at(x, y, 1), 2.0, 2.0 * tol) << basis_name(mb) << " " << x << "," << y;
+      for (int x = 1; x < W - 1; x += 6)
+        EXPECT_NEAR(ep[3].at(x, y, 1), 2.0, 2.0 * tol) << basis_name(mb) << " " << x << "," << y;
   }
 }
 

@@ -114,7 +114,8 @@ std::vector<TexturedSpotlight> spotlights(const Dataset& ds, const Placement& pl
 TexturedSpotlight far_field_spotlight(const std::function<Vec3(Vec3)>& intensity, double d, double extent,
                                       int resolution, const Placement& placement, bool shadow) {
   if (!(d > 0) || !(extent > 0) || resolution < 1)
-    fail(ErrorKind::Value, "far-field spotlight: distance {}, extent {}, resolution {} must be positive", d, extent, resolution);
+    fail(ErrorKind::Value, "far-field spotlight: distance {}, extent {}, resolution {} must be positive", d, extent,
+         resolution);
   Image tex(resolution, resolution, 3);
   parallel_for(0, resolution, [&](int64_t y) {
     for (int x = 0; x < resolution; ++x) {

@@ -21,8 +21,9 @@ Vec3 plane_point(const PlaneDesc& pl, int x, int y) {
 
 void check_plane(const PlaneDesc& pl) {
   if (!(pl.z > 0) || !(pl.half_extent > 0) || pl.resolution < 1 || pl.resolution > 8192)
-    fail(ErrorKind::Value, "receiver plane: distance {} m, half extent {} m, resolution {}: need z > 0, extent > 0, 1..8192 pixels",
-         pl.z, pl.half_extent, pl.resolution);
+    fail(ErrorKind::Value,
+         "receiver plane: distance {} m, half extent {} m, resolution {}: need z > 0, extent > 0, 1..8192 pixels", pl.z,
+         pl.half_extent, pl.resolution);
 }
 
 }  // namespace
@@ -134,8 +135,8 @@ Image render_rows(const SceneView& sv, const geometry::Camera& view, const Progr
 
 }  // namespace
 
-Image render_spotlights(const SceneView& sv, const std::vector<TexturedSpotlight>& lights, const geometry::Camera& view, bool shadows,
-                        const ProgressFn& progress, int srgbe_group) {
+Image render_spotlights(const SceneView& sv, const std::vector<TexturedSpotlight>& lights, const geometry::Camera& view,
+                        bool shadows, const ProgressFn& progress, int srgbe_group) {
   if (srgbe_group < 0) fail(ErrorKind::Value, "sRGBE pass size {} must be ≥ 0", srgbe_group);
   return render_rows(sv, view, progress, [&](Vec3 p, Vec3 n) {
     Vec3 e{0, 0, 0}, pass{0, 0, 0};
@@ -152,8 +153,8 @@ Image render_spotlights(const SceneView& sv, const std::vector<TexturedSpotlight
   });
 }
 
-Image render_exact(const SceneView& sv, const Luminaire& lum, const Placement& placement, const geometry::Camera& view, bool shadows,
-                   const ProgressFn& progress) {
+Image render_exact(const SceneView& sv, const Luminaire& lum, const Placement& placement, const geometry::Camera& view,
+                   bool shadows, const ProgressFn& progress) {
   const Frame f = placement.frame();
   std::vector<Vec3> centres;
   for (const auto& e : lum.emitters) centres.push_back(placement.position + f.from_local(e.center));

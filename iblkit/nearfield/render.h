@@ -24,13 +24,14 @@ namespace ibl::nearfield {
 // luminaire, sampled at resolution² pixel centres over [−half_extent, half_extent]² of (right, up);
 // row 0 is the largest up coordinate (as the dataset images).
 struct PlaneDesc {
-  double z = 1;             // distance from S along forward (metres)
-  double half_extent = 0.5; // metres
-  int resolution = 128;     // pixels per side
+  double z = 1;              // distance from S along forward (metres)
+  double half_extent = 0.5;  // metres
+  int resolution = 128;      // pixels per side
 };
 
 // Irradiance (W/m², RGB) on the plane from the spotlights (no occlusion), `placement` locating the plane.
-Image plane_irradiance(const std::vector<TexturedSpotlight>& lights, const Placement& placement, const PlaneDesc& plane);
+Image plane_irradiance(const std::vector<TexturedSpotlight>& lights, const Placement& placement,
+                       const PlaneDesc& plane);
 // The exact irradiance from the luminaire (luminaire frame, no occlusion).
 Image plane_irradiance_exact(const Luminaire& lum, const PlaneDesc& plane);
 

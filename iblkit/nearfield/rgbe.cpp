@@ -32,7 +32,9 @@ std::array<uint8_t, 4> encode_rgbe(Vec3 c) {
   const double f = std::frexp(m, &e);  // m = f·2^e, f in [½, 1)
   (void)f;
   const double s = std::ldexp(256.0, -e);
-  auto q = [&](double x) { return static_cast<uint8_t>(std::clamp(static_cast<long>(std::max(0.0, x) * s), 0L, 255L)); };
+  auto q = [&](double x) {
+    return static_cast<uint8_t>(std::clamp(static_cast<long>(std::max(0.0, x) * s), 0L, 255L));
+  };
   return {q(c.x), q(c.y), q(c.z), static_cast<uint8_t>(std::clamp(e + 128, 0, 255))};
 }
 

@@ -20,12 +20,14 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 std::optional<Luminaire> exact_luminaire(const Dataset& ds, const std::string& name) {
   if (name.empty() || name == "none") return std::nullopt;
   const std::string lum = name == "auto" ? ds.luminaire : name;
-  if (lum.empty()) fail(ErrorKind::Value, "exact luminaire 'auto': the dataset names no lab luminaire (a measured dataset)");
+  if (lum.empty())
+    fail(ErrorKind::Value, "exact luminaire 'auto': the dataset names no lab luminaire (a measured dataset)");
   return make_luminaire(lum);
 }
 
 SceneRender render_scene(const SceneView& sv, const SceneRenderDesc& d, const ProgressFn& progress) {
-  if (d.dataset.empty() == d.ies.empty()) fail(ErrorKind::Value, "scene render: give a dataset or an IES file (one of them)");
+  if (d.dataset.empty() == d.ies.empty())
+    fail(ErrorKind::Value, "scene render: give a dataset or an IES file (one of them)");
   const Placement& pl = d.placement;
   pl.frame();  // validates
   SceneRender r;

@@ -29,17 +29,17 @@ struct SceneRenderDesc {
 };
 
 struct SceneRender {
-  std::string label;              // the dataset's name, or the IES file's path
-  size_t spotlights = 0;          // textured spotlights in `near_field`
-  Image near_field;               // outgoing radiance (RGB, W/(sr·m²)) under the spotlights (Eq. 14)
-  std::optional<Image> exact;     // the same view lit by the virtual luminaire (with `exact`)
-  std::optional<Image> far_field; // lit by the far-field spotlight (with `exact` and `far_field`)
+  std::string label;               // the dataset's name, or the IES file's path
+  size_t spotlights = 0;           // textured spotlights in `near_field`
+  Image near_field;                // outgoing radiance (RGB, W/(sr·m²)) under the spotlights (Eq. 14)
+  std::optional<Image> exact;      // the same view lit by the virtual luminaire (with `exact`)
+  std::optional<Image> far_field;  // lit by the far-field spotlight (with `exact` and `far_field`)
   std::optional<ErrorStats> near_field_error, far_field_error;  // against `exact`
   std::optional<ErrorStats> srgbe_error;  // the sRGBE frame buffer against `near_field` (with `srgbe`)
-  size_t srgbe_passes = 0;        // passes of 3 spotlights through that frame buffer
-  double setup_seconds = 0;       // reading the dataset and building its E' textures (or the IES file)
-  double render_seconds = 0;      // rendering `near_field`
-  double exact_seconds = 0;       // rendering `exact`
+  size_t srgbe_passes = 0;                // passes of 3 spotlights through that frame buffer
+  double setup_seconds = 0;               // reading the dataset and building its E' textures (or the IES file)
+  double render_seconds = 0;              // rendering `near_field`
+  double exact_seconds = 0;               // rendering `exact`
 };
 
 // The lab luminaire a dataset is compared with: `name` ("auto": the one the dataset was simulated from),

@@ -79,8 +79,9 @@ TEST(NearfieldSceneRender, SpotlightsExactAndFarFieldAsTheirPrimitivesMakeThem) 
   EXPECT_EQ(r.near_field_error->rel_rms, compare(r.near_field, *r.exact).rel_rms);
   EXPECT_EQ(r.far_field_error->rel_rms, compare(*r.far_field, *r.exact).rel_rms);
   EXPECT_EQ(r.srgbe_passes, 21u);  // 63 spotlights in passes of 3
-  EXPECT_EQ(r.srgbe_error->rel_rms, compare(render_spotlights(sv, spotlights(ds, d.placement, true), d.camera, true, {}, 3),
-                                            r.near_field).rel_rms);
+  EXPECT_EQ(
+      r.srgbe_error->rel_rms,
+      compare(render_spotlights(sv, spotlights(ds, d.placement, true), d.camera, true, {}, 3), r.near_field).rel_rms);
   // The near field beats the far field in a scene a metre from the lamp.
   EXPECT_LT(r.near_field_error->rel_rms, r.far_field_error->rel_rms);
 
@@ -113,7 +114,8 @@ TEST(NearfieldSceneRender, IesFileAndBadParameters) {
   EXPECT_EQ(r.label, ies);
   EXPECT_EQ(r.spotlights, 1u);
   EXPECT_FALSE(r.exact);
-  expect_same(r.near_field, render_spotlights(sv, {ies_spotlight(read_ies(ies), d.placement, 80, 256)}, d.camera, true));
+  expect_same(r.near_field,
+              render_spotlights(sv, {ies_spotlight(read_ies(ies), d.placement, 80, 256)}, d.camera, true));
 
   d.dataset = f.manifest;  // both
   EXPECT_THROW(render_scene(sv, d), Error);

@@ -95,8 +95,8 @@ Frame Placement::frame() const {
   require_direction("luminaire up", up_hint);
   const Vec3 r = cross(up_hint, f);
   if (length(f) == 0 || length(r) < 1e-9)
-    fail(ErrorKind::Value, "luminaire placement: forward ({}, {}, {}) is zero or parallel to up ({}, {}, {})", forward.x,
-         forward.y, forward.z, up_hint.x, up_hint.y, up_hint.z);
+    fail(ErrorKind::Value, "luminaire placement: forward ({}, {}, {}) is zero or parallel to up ({}, {}, {})",
+         forward.x, forward.y, forward.z, up_hint.x, up_hint.y, up_hint.z);
   const Vec3 right = normalize(r);
   return Frame{right, cross(f, right), f};
 }

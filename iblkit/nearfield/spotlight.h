@@ -49,10 +49,10 @@ struct TexturedSpotlight {
   double plane_distance = 1;  // d between S and M (metres)
   Vec2 tex_min, tex_max;      // texture extent on M, (right, up) metres relative to position + d·forward
   std::shared_ptr<const std::vector<Image>> mips;  // E'_mn RGB radiance texture, level 0 full size, 2×2 box chain
-  double support_area = 1;    // A = ∫ Φ_mn du dv (m²); h² for the B-spline bases
-  double support_width = 0;   // width of the box Ē' averages over on S (metres): half Φ_mn's support,
-                              // where its weight sits (docs/nearfield.md); 0 = no filtering (a point light)
-  bool shadow = true;         // cast shadows (V_mn from a shadow ray / shadow map towards position)
+  double support_area = 1;                         // A = ∫ Φ_mn du dv (m²); h² for the B-spline bases
+  double support_width = 0;  // width of the box Ē' averages over on S (metres): half Φ_mn's support,
+                             // where its weight sits (docs/nearfield.md); 0 = no filtering (a point light)
+  bool shadow = true;        // cast shadows (V_mn from a shadow ray / shadow map towards position)
 };
 
 // Ē'(x): the trilinear texture lookup above (no geometric factors). Zero behind S.
@@ -65,9 +65,9 @@ std::vector<Image> build_mips(const Image& img);
 
 // Where a luminaire sits in the world: its S origin (the centre of the filter grid) and orientation.
 struct Placement {
-  Vec3 position{0, 1, 0};    // world position of S's origin (metres)
-  Vec3 forward{0, 0, 1};     // the direction the luminaire shines (normal of S towards M)
-  Vec3 up_hint{0, 1, 0};     // S's t axis is this, made orthogonal to forward
+  Vec3 position{0, 1, 0};  // world position of S's origin (metres)
+  Vec3 forward{0, 0, 1};   // the direction the luminaire shines (normal of S towards M)
+  Vec3 up_hint{0, 1, 0};   // S's t axis is this, made orthogonal to forward
   // right = normalize(cross(up_hint, forward)), up = cross(forward, right). Throws when degenerate.
   Frame frame() const;
   Vec3 to_world(Vec3 local) const;  // luminaire frame (x right, y up, z forward) -> world

@@ -85,7 +85,7 @@ TEST(NearfieldSpotlight, ConstantTextureGivesTheClosedForm) {
   constexpr double kFloatTol = 1e-6;  // float texels
   EXPECT_NEAR(e.x, 2.5e-5 * cl * 1.0 / d2 * 7.0, kFloatTol * e.x);
   EXPECT_EQ(irradiance(L, L.position - Vec3{0, 0, 0.3}, {0, 0, 1}).x, 0.0);  // behind S
-  EXPECT_EQ(irradiance(L, x, -n).x, 0.0);                                       // facing away
+  EXPECT_EQ(irradiance(L, x, -n).x, 0.0);                                    // facing away
   EXPECT_EQ(L.frame.t.x, 1.0);  // right = +x, up = +y, right × up = forward = +z
 }
 

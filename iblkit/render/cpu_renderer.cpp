@@ -3,8 +3,8 @@
 #include <embree3/rtcore.h>
 
 #include <algorithm>
-#include <cmath>
 #include <atomic>
+#include <cmath>
 #include <limits>
 #include <memory>
 
@@ -52,10 +52,15 @@ class ShadowScene {
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     RTCRay ray{};
-    ray.org_x = static_cast<float>(o.x); ray.org_y = static_cast<float>(o.y); ray.org_z = static_cast<float>(o.z);
-    ray.dir_x = static_cast<float>(dir.x); ray.dir_y = static_cast<float>(dir.y); ray.dir_z = static_cast<float>(dir.z);
+    ray.org_x = static_cast<float>(o.x);
+    ray.org_y = static_cast<float>(o.y);
+    ray.org_z = static_cast<float>(o.z);
+    ray.dir_x = static_cast<float>(dir.x);
+    ray.dir_y = static_cast<float>(dir.y);
+    ray.dir_z = static_cast<float>(dir.z);
     ray.tnear = 0.0f;
-    ray.tfar = std::isfinite(distance) ? static_cast<float>(distance * (1 - 1e-4)) : std::numeric_limits<float>::infinity();
+    ray.tfar =
+        std::isfinite(distance) ? static_cast<float>(distance * (1 - 1e-4)) : std::numeric_limits<float>::infinity();
     ray.mask = 0xffffffff;
     rtcOccluded1(scene_, &ctx, &ray);
     return ray.tfar < 0.0f;
@@ -115,8 +120,10 @@ void raster_triangle(const ClipVertex& v0, const ClipVertex& v1, const ClipVerte
   if (area >= 0) return;  // back-facing (counter-clockwise in world is clockwise in y-down screen)
   double minx = std::min({sx[0], sx[1], sx[2]}), maxx = std::max({sx[0], sx[1], sx[2]});
   double miny = std::min({sy[0], sy[1], sy[2]}), maxy = std::max({sy[0], sy[1], sy[2]});
-  int x0 = std::max(0, static_cast<int>(std::ceil(minx - 0.5))), x1 = std::min(W - 1, static_cast<int>(std::floor(maxx - 0.5)));
-  int y0 = std::max(y_lo, static_cast<int>(std::ceil(miny - 0.5))), y1 = std::min(y_hi - 1, static_cast<int>(std::floor(maxy - 0.5)));
+  int x0 = std::max(0, static_cast<int>(std::ceil(minx - 0.5))),
+      x1 = std::min(W - 1, static_cast<int>(std::floor(maxx - 0.5)));
+  int y0 = std::max(y_lo, static_cast<int>(std::ceil(miny - 0.5))),
+      y1 = std::min(y_hi - 1, static_cast<int>(std::floor(maxy - 0.5)));
   for (int y = y0; y <= y1; ++y)
     for (int x = x0; x <= x1; ++x) {
       double px = x + 0.5, py = y + 0.5;
@@ -162,7 +169,8 @@ RenderResult render_cpu(const FrameDesc& d, const ProgressFn& progress) {
         ClipVertex poly[4];
         int n = clip_near(tri, poly);
         for (int f = 1; f + 1 < n; ++f)
-          raster_triangle(poly[0], poly[f], poly[f + 1], W, H, y_lo, y_hi, static_cast<int>(oi), static_cast<uint32_t>(t), hits);
+          raster_triangle(poly[0], poly[f], poly[f + 1], W, H, y_lo, y_hi, static_cast<int>(oi),
+                          static_cast<uint32_t>(t), hits);
       }
     }
   });

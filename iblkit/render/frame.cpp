@@ -13,7 +13,9 @@ void check_objects(const FrameDesc& d) {
     if (!is_finite(a) || a.x < 0 || a.y < 0 || a.z < 0 || a.x > 1 || a.y > 1 || a.z > 1)
       fail(ErrorKind::Value, "object {}: albedo ({}, {}, {}) must lie in [0, 1] per channel", i, a.x, a.y, a.z);
     if (!m->has_normals() && m->vertex_count() > 0)
-      fail(ErrorKind::Value, "object {}: its mesh has {} normals for {} vertices (geometry::with_normals gives a mesh its shading normals)",
+      fail(ErrorKind::Value,
+           "object {}: its mesh has {} normals for {} vertices (geometry::with_normals gives a mesh its shading "
+           "normals)",
            i, m->normals.size(), m->vertex_count());
   }
 }

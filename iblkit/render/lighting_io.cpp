@@ -42,7 +42,8 @@ std::string read_light_set(const nlohmann::json& j, const std::string& path, int
     shadow[i] = static_cast<int>(i) < shadows;
     const nlohmann::json& lj = j["lights"][i];
     if (lj.contains("shadow")) {
-      if (!lj["shadow"].is_boolean()) fail(ErrorKind::Format, "{}: light {}: \"shadow\" must be true or false", path, i);
+      if (!lj["shadow"].is_boolean())
+        fail(ErrorKind::Format, "{}: light {}: \"shadow\" must be true or false", path, i);
       shadow[i] = lj["shadow"].get<bool>();
     }
   }
@@ -62,19 +63,24 @@ void read_lighting(const std::string& path, const LightingReadDesc& desc, Lighti
                        ext == ".shtree" ? " (adaptive, resampled to dense)" : "");
   } else if (ext == ".json") {
     const nlohmann::json j = read_json_file(path);
-    if (!j.is_object()) fail(ErrorKind::Format, "{}: expected a JSON object (an iblkit.lights/1, iblkit.sh/1 or iblkit.nearfield/1 file), got {}", path, j.type_name());
+    if (!j.is_object())
+      fail(ErrorKind::Format,
+           "{}: expected a JSON object (an iblkit.lights/1, iblkit.sh/1 or iblkit.nearfield/1 file), got {}", path,
+           j.type_name());
     const std::string format = opt_field(j, path, "format", "");
     if (format == "iblkit.lights/1") {
       what = read_light_set(j, path, desc.shadows, L);
     } else if (format == "iblkit.nearfield/1") {
       nearfield::Dataset ds = nearfield::read_dataset(path);
       L->spotlights = nearfield::spotlights(ds, desc.luminaire, desc.shadows > 0);
-      what = fmt::format("near-field luminaire {} ({}x{} textured spotlights{})", ds.name, ds.nx, ds.ny, desc.shadows > 0 ? ", shadows" : "");
+      what = fmt::format("near-field luminaire {} ({}x{} textured spotlights{})", ds.name, ds.nx, ds.ny,
+                         desc.shadows > 0 ? ", shadows" : "");
     } else if (format == "iblkit.sh/1") {
       L->environment = sh::coeffs_from_json(j, path);
       what = fmt::format("SH environment, {} bands", L->environment->bands);
     } else {
-      fail(ErrorKind::Format, "{}: \"format\" is '{}'; expected iblkit.lights/1, iblkit.sh/1 or iblkit.nearfield/1", path, format);
+      fail(ErrorKind::Format, "{}: \"format\" is '{}'; expected iblkit.lights/1, iblkit.sh/1 or iblkit.nearfield/1",
+           path, format);
     }
   } else {
     auto env = io::read_envmap(path, desc.read);
@@ -83,7 +89,8 @@ void read_lighting(const std::string& path, const LightingReadDesc& desc, Lighti
     if (desc.glossy_exponent > 0) {
       L->glossy_maps.push_back(prefilter_phong(env, desc.glossy_exponent));
       const Image& g = L->glossy_maps.back().latlong;
-      what += fmt::format(", glossy from a prefiltered {}x{} Phong map (s = {:g})", g.width(), g.height(), desc.glossy_exponent);
+      what += fmt::format(", glossy from a prefiltered {}x{} Phong map (s = {:g})", g.width(), g.height(),
+                          desc.glossy_exponent);
     }
   }
   if (kind) *kind = what;

@@ -40,23 +40,30 @@ std::string error_of(const std::string& path, const LightingReadDesc& desc = {})
 TEST(RenderLightingIo, ShFileIsCheckedAsEverywhere) {
   Lighting L;
   std::string kind;
-  read_lighting(temp_file("env.json", R"({"format":"iblkit.sh/1","bands":2,"coefficients":[[1,2,3],[0,0.5,0],[0,0,0],[-0.25,0,0]]})"), {},
-                &L, &kind);
+  read_lighting(
+      temp_file("env.json",
+                R"({"format":"iblkit.sh/1","bands":2,"coefficients":[[1,2,3],[0,0.5,0],[0,0,0],[-0.25,0,0]]})"),
+      {}, &L, &kind);
   ASSERT_TRUE(L.environment);
   EXPECT_EQ(L.environment->bands, 2);
   EXPECT_EQ(L.environment->c[0].y, 2.0);
   EXPECT_EQ(L.environment->c[3].x, -0.25);
   EXPECT_EQ(kind, "SH environment, 2 bands");
-  EXPECT_NE(error_of(temp_file("zero.json", R"({"format":"iblkit.sh/1","bands":0,"coefficients":[]})")).find("\"bands\""), std::string::npos);
-  EXPECT_NE(error_of(temp_file("null.json", R"({"format":"iblkit.sh/1","bands":1,"coefficients":[[1,null,3]]})")).find("coefficient 0"),
+  EXPECT_NE(
+      error_of(temp_file("zero.json", R"({"format":"iblkit.sh/1","bands":0,"coefficients":[]})")).find("\"bands\""),
+      std::string::npos);
+  EXPECT_NE(error_of(temp_file("null.json", R"({"format":"iblkit.sh/1","bands":1,"coefficients":[[1,null,3]]})"))
+                .find("coefficient 0"),
             std::string::npos);
-  EXPECT_NE(error_of(temp_file("other.json", R"({"format":"iblkit.scene/1"})")).find("expected iblkit.lights/1"), std::string::npos);
+  EXPECT_NE(error_of(temp_file("other.json", R"({"format":"iblkit.scene/1"})")).find("expected iblkit.lights/1"),
+            std::string::npos);
 }
 
 // A light set: a light with a position in a set with an origin is a point light of intensity
 // E·|q − o|², the others directional; the first `shadows` cast shadows unless a light says itself.
 TEST(RenderLightingIo, LightSetBecomesPointAndDirectionalLights) {
-  const std::string path = temp_file("lights.json", R"({"format":"iblkit.lights/1","method":"test","origin":[0,1,0],"lights":[
+  const std::string path =
+      temp_file("lights.json", R"({"format":"iblkit.lights/1","method":"test","origin":[0,1,0],"lights":[
     {"direction":[0,1,0],"irradiance":[1,2,3],"solid_angle":0.1,"position":[0,3,0]},
     {"direction":[2,0,0],"irradiance":[1,1,1],"solid_angle":0.1,"shadow":true},
     {"direction":[0,0,1],"irradiance":[0.5,0.5,0.5],"solid_angle":0.1},
@@ -70,14 +77,16 @@ TEST(RenderLightingIo, LightSetBecomesPointAndDirectionalLights) {
   ASSERT_EQ(L.lights.size(), 3u);
   EXPECT_EQ(L.point_lights[0].position.y, 3.0);
   EXPECT_EQ(L.point_lights[0].intensity.z, 12.0);  // 3 W/m² at 2 m
-  EXPECT_TRUE(L.point_lights[0].shadow);            // first in priority order
-  EXPECT_EQ(L.lights[0].direction.x, 1.0);          // unit
-  EXPECT_TRUE(L.lights[0].shadow);                  // says so itself
+  EXPECT_TRUE(L.point_lights[0].shadow);           // first in priority order
+  EXPECT_EQ(L.lights[0].direction.x, 1.0);         // unit
+  EXPECT_TRUE(L.lights[0].shadow);                 // says so itself
   EXPECT_FALSE(L.lights[1].shadow);
   EXPECT_FALSE(L.lights[2].shadow);
   EXPECT_EQ(kind, "1 point lights and 3 directional lights");
   EXPECT_NE(error_of(temp_file("bad_shadow.json", R"({"format":"iblkit.lights/1","lights":[
-    {"direction":[0,1,0],"irradiance":[1,1,1],"shadow":"yes"}]})")).find("\"shadow\""), std::string::npos);
+    {"direction":[0,1,0],"irradiance":[1,1,1],"shadow":"yes"}]})"))
+                .find("\"shadow\""),
+            std::string::npos);
 }
 
 // An SH grid comes as it was written; a constant probe image projects to c00 = √(4π)·L and, with a
@@ -86,7 +95,9 @@ TEST(RenderLightingIo, GridAndProbeImage) {
   constexpr double kProjectTol = 1e-4;     // lat-long quadrature of a constant: exact up to float pixels
   constexpr double kQuadratureTol = 5e-3;  // the prefilter's midpoint rule (as Prefilter.ConstantSkyGivesItsRadiance)
   ilf::GridDesc gd;
-  gd.nx = 2; gd.ny = 3; gd.nz = 2;
+  gd.nx = 2;
+  gd.ny = 3;
+  gd.nz = 2;
   gd.volume = {{0, 0, 0}, {1, 2, 1}};
   ilf::SHGrid g(gd, 2);
   for (size_t i = 0; i < g.data().size(); ++i) g.data()[i] = static_cast<float>(i);

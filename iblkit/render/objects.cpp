@@ -11,7 +11,8 @@ namespace ibl::render {
 geometry::TriMesh make_object(const ObjectDesc& desc) {
   const std::string& scene = desc.scene;
   const double size = desc.size;
-  if (!(size > 0) && (scene == "blob" || scene == "sphere")) fail(ErrorKind::Value, "object size {} must be > 0 for the {}", size, scene);
+  if (!(size > 0) && (scene == "blob" || scene == "sphere"))
+    fail(ErrorKind::Value, "object size {} must be > 0 for the {}", size, scene);
   require_point("object position", desc.at);
   require_number("object size", size, 0, kMaxCoordinate);
   geometry::TriMesh object;

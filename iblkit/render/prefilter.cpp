@@ -66,9 +66,15 @@ GlossyMap prefilter_phong(const sphere::EnvMap& probe, double s, int height, con
       bool all = false;
       for (double tt : {row_theta0[row], t, row_theta1[row]}) {
         double dn = st * std::sin(tt);
-        if (dn < 1e-9) { all = true; break; }
+        if (dn < 1e-9) {
+          all = true;
+          break;
+        }
         double c = (cos_min - ct * std::cos(tt)) / dn;
-        if (c <= -1) { all = true; break; }
+        if (c <= -1) {
+          all = true;
+          break;
+        }
         if (c < 1) widest = std::max(widest, std::acos(c));
       }
       if (all) continue;

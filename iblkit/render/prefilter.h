@@ -10,10 +10,10 @@
 // at half-integers), so the CPU reference and the GL frame read identical values.
 //
 // Resolution: the lobe's angular width is σ ≈ 1/√s (cos^s θ ≈ exp(−sθ²/2)); the map's pixels are
-// π/H on a side, and H = the power of two ≥ 3π√s (three pixels per σ), between 16 and 256 rows (s ≲ 700 at three pixels per σ).
-// Quadrature: the probe is first resampled (area-preserving) to a lat-long of H rows, and (1) is
-// summed over its pixels with exact solid angles inside the lobe's support (r·ω)^s ≥ 10⁻⁶ only
-// (rows and, per row, azimuths outside it are skipped).
+// π/H on a side, and H = the power of two ≥ 3π√s (three pixels per σ), between 16 and 256 rows (s ≲ 700 at three pixels
+// per σ). Quadrature: the probe is first resampled (area-preserving) to a lat-long of H rows, and (1) is summed over
+// its pixels with exact solid angles inside the lobe's support (r·ω)^s ≥ 10⁻⁶ only (rows and, per row, azimuths outside
+// it are skipped).
 #pragma once
 #include <vector>
 
@@ -31,7 +31,8 @@ struct GlossyMap {
 // Rows of the map for exponent s (the rule above).
 int glossy_map_height(double exponent);
 // Equation (1) for one exponent; height 0 picks glossy_map_height(exponent).
-GlossyMap prefilter_phong(const sphere::EnvMap& probe, double exponent, int height = 0, const ProgressFn& progress = {});
+GlossyMap prefilter_phong(const sphere::EnvMap& probe, double exponent, int height = 0,
+                          const ProgressFn& progress = {});
 // Bilinear lookup of G_s at unit reflection direction r (the filter the GL renderer uses).
 Vec3 lookup(const GlossyMap& map, Vec3 r);
 

@@ -46,8 +46,8 @@ TEST(Prefilter, ConstantSkyGivesItsRadiance) {
 TEST(Prefilter, BandLimitedSkyMatchesShConvolution) {
   constexpr double kRelTol = 5e-3;  // quadrature and the map's bilinear interpolation
   const int bands = 3;
-  std::vector<Vec3> c = {{2.0, 1.8, 1.5}, {0.3, 0.1, 0.0}, {0.6, 0.5, 0.2}, {-0.2, 0.1, 0.3},
-                         {0.1, 0.0, 0.1}, {0.05, 0.1, 0.0}, {0.2, 0.1, 0.1}, {0.0, 0.1, 0.05}, {-0.1, 0.05, 0.1}};
+  std::vector<Vec3> c = {{2.0, 1.8, 1.5},  {0.3, 0.1, 0.0}, {0.6, 0.5, 0.2},  {-0.2, 0.1, 0.3}, {0.1, 0.0, 0.1},
+                         {0.05, 0.1, 0.0}, {0.2, 0.1, 0.1}, {0.0, 0.1, 0.05}, {-0.1, 0.05, 0.1}};
   auto env = latlong(64);
   std::vector<double> y(9);
   for (int py = 0; py < env.image.height(); ++py)
@@ -68,7 +68,8 @@ TEST(Prefilter, BandLimitedSkyMatchesShConvolution) {
     for (int l = 0; l < bands; ++l)
       for (int k = l * l; k < (l + 1) * (l + 1); ++k) want += c[k] * (zh[l] * y[k]);
     Vec3 got = lookup(g, r);
-    for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(got[ch], want[ch], kRelTol * want[0]) << "r=" << r.x << "," << r.y << "," << r.z;
+    for (int ch = 0; ch < 3; ++ch)
+      EXPECT_NEAR(got[ch], want[ch], kRelTol * want[0]) << "r=" << r.x << "," << r.y << "," << r.z;
   }
 }
 

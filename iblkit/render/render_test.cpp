@@ -8,10 +8,10 @@
 #include <functional>
 
 #include "iblkit/core/error.h"
+#include "iblkit/geometry/mesh.h"
 #include "iblkit/io/image_io.h"
 #include "iblkit/io/tonemap.h"
 #include "iblkit/render/cpu_renderer.h"
-#include "iblkit/geometry/mesh.h"
 #include "iblkit/sh/basis.h"
 #ifdef IBLKIT_HAVE_GL
 #include <epoxy/gl.h>
@@ -51,7 +51,8 @@ FrameDesc blob_scene(const geometry::TriMesh* blob, const geometry::TriMesh* flo
 // Holds the red channel of every pixel that sees the 0.4 m sphere at the origin (away from its
 // silhouette, where facets and the true sphere disagree) to want(p, n) at the exact hit point p with
 // normal n, and checks that over 1000 pixels were compared.
-void expect_sphere_shading(const FrameDesc& d, const RenderResult& f, double tol, const std::function<double(Vec3, Vec3)>& want) {
+void expect_sphere_shading(const FrameDesc& d, const RenderResult& f, double tol,
+                           const std::function<double(Vec3, Vec3)>& want) {
   int checked = 0;
   for (int y = 0; y < f.color.height(); ++y)
     for (int x = 0; x < f.color.width(); ++x) {
@@ -100,7 +101,8 @@ TEST(RenderCpu, DirectionalLightOnSphereMatchesClosedForm) {
   d.objects[0].material.albedo = {0.5, 0.5, 0.5};
   Vec3 l = normalize(Vec3{0.4, 0.8, 0.5});
   d.lighting.lights.push_back({l, {3, 3, 3}, false});
-  expect_sphere_shading(d, render_cpu(d), kFacetTol, [&](Vec3, Vec3 n) { return 0.5 / kPi * 3 * std::max(0.0, dot(n, l)); });
+  expect_sphere_shading(d, render_cpu(d), kFacetTol,
+                        [&](Vec3, Vec3 n) { return 0.5 / kPi * 3 * std::max(0.0, dot(n, l)); });
 }
 
 // A point light near a sphere: L_o = ρ/π · I · max(0, n·l)/d² with l and d from the exact hit point.
@@ -155,7 +157,7 @@ class RenderGl : public ::testing::Test {
 // Relative error statistics over pixels covered in both frames.
 struct Agreement {
   double median = 0, p99 = 0;
-  int pixels = 0;            // covered in both
+  int pixels = 0;                // covered in both
   double coverage_mismatch = 0;  // fraction of covered pixels covered in one frame only
 };
 // Pixels covered by one renderer only: edge pixels where GL's top-left rule and the reference's
@@ -195,8 +197,8 @@ ilf::SHGrid unit_box_grid(int bands, int nx, int ny, int nz) {
 
 // A textured spotlight at `at` shining along `forward`, its texture over ±half on a plane 0.5 m
 // ahead, a filter support of 0.01 m² and the given width.
-nearfield::TexturedSpotlight square_spot(Vec3 at, Vec3 forward, double half, std::shared_ptr<const std::vector<Image>> mips,
-                                         double support_width) {
+nearfield::TexturedSpotlight square_spot(Vec3 at, Vec3 forward, double half,
+                                         std::shared_ptr<const std::vector<Image>> mips, double support_width) {
   nearfield::TexturedSpotlight sp;
   sp.position = at;
   sp.frame = Frame::from_normal(normalize(forward));
@@ -251,7 +253,8 @@ TEST_F(RenderGl, GlslShBasisMatchesCpp) {
   std::vector<double> cpu(bands * bands);
   for (size_t i = 0; i < dirs.size(); ++i) {
     sh::eval_basis(bands, dirs[i], cpu.data());
-    for (int k = 0; k < bands * bands; ++k) ASSERT_NEAR(gpu[i * bands * bands + k], cpu[k], kBasisTol) << "k=" << k << " i=" << i;
+    for (int k = 0; k < bands * bands; ++k)
+      ASSERT_NEAR(gpu[i * bands * bands + k], cpu[k], kBasisTol) << "k=" << k << " i=" << i;
   }
 }
 
@@ -291,7 +294,8 @@ TEST_F(RenderGl, GlslShTableMatchesCpp) {
     double z = 1 - 2 * (i + 0.5) / 4000, r = std::sqrt(1 - z * z), ph = 2.39996 * i;
     dirs.push_back({r * std::cos(ph), r * std::sin(ph), z});
   }
-  for (Vec3 c : {Vec3{1, 1, 1}, Vec3{-1, 1, -1}, Vec3{1, 0, 1}, Vec3{0, -1, 1}, Vec3{1, 0, 0}, Vec3{0, 0, -1}}) dirs.push_back(normalize(c));
+  for (Vec3 c : {Vec3{1, 1, 1}, Vec3{-1, 1, -1}, Vec3{1, 0, 1}, Vec3{0, -1, 1}, Vec3{1, 0, 0}, Vec3{0, 0, -1}})
+    dirs.push_back(normalize(c));
   for (double z : {0.999, 1.0, 1.001})  // along an edge: either side of it, and on it (ties)
     for (int i = 0; i < 200; ++i) dirs.push_back(normalize(Vec3{1, -1 + 0.01 * i, z}));
   std::vector<double> cpu(dirs.size() * K);
@@ -299,8 +303,8 @@ TEST_F(RenderGl, GlslShTableMatchesCpp) {
   // Measured on llvmpipe: 0.037, 0.0088, 0.0021, 0.00053 for 16², 32², 64², 128² (the worst at the
   // faces' centres, Y_40's peak). GPUs with 8-bit filter weights add ~ΔY_texel/512 (≈ 2e-4), which
   // matters only at the larger sizes: the ratio is checked up to 64², 128² against a bound.
-  constexpr double kQuadratic = 0.3;     // error ratio per doubling of the face size (¼ ideally)
-  constexpr double kTable64Tol = 3e-3;   // the size the docs recommend
+  constexpr double kQuadratic = 0.3;    // error ratio per doubling of the face size (¼ ideally)
+  constexpr double kTable64Tol = 3e-3;  // the size the docs recommend
   constexpr double kTable128Tol = 1e-3;
   double previous = 0;
   for (int size : {16, 32, 64, 128}) {
@@ -327,7 +331,8 @@ TEST_F(RenderGl, ShEnvironmentAgreesWithCpu) {
   sh::Coeffs env;
   env.bands = 5;
   env.c.resize(25);
-  for (int k = 0; k < 25; ++k) env.c[k] = Vec3{1.0 + 0.3 * std::sin(k), 0.8 + 0.2 * std::cos(3 * k), 0.5} * (k == 0 ? 3.0 : 0.4);
+  for (int k = 0; k < 25; ++k)
+    env.c[k] = Vec3{1.0 + 0.3 * std::sin(k), 0.8 + 0.2 * std::cos(3 * k), 0.5} * (k == 0 ? 3.0 : 0.4);
   d.lighting.environment = env;
   d.objects[0].material.specular = {0.2, 0.2, 0.2};
   d.objects[0].material.exponent = 12;
@@ -345,7 +350,8 @@ TEST_F(RenderGl, ShGridAgreesWithCpu) {
   geometry::TriMesh m = geometry::make_blob(6000, 0.5);
   FrameDesc d = sphere_scene(&m, 96, 72);
   ilf::SHGrid g = unit_box_grid(5, 4, 5, 3);
-  for (size_t i = 0; i < g.data().size(); ++i) g.data()[i] = static_cast<float>((i % 75 < 3 ? 2.0 : 0.1) * (1 + 0.5 * std::sin(0.37 * i)));
+  for (size_t i = 0; i < g.data().size(); ++i)
+    g.data()[i] = static_cast<float>((i % 75 < 3 ? 2.0 : 0.1) * (1 + 0.5 * std::sin(0.37 * i)));
   d.lighting.grid = g;
   d.objects[0].material.specular = {0.3, 0.3, 0.3};
   d.objects[0].material.exponent = 30;
@@ -363,7 +369,8 @@ TEST_F(RenderGl, DirectionalLightsWithShadowsAgreeWithCpu) {
   gl::Context ctx;
   geometry::TriMesh blob = geometry::make_blob(6000, 0.5), floor = geometry::make_floor(3, -0.25);
   FrameDesc d = blob_scene(&blob, &floor);
-  d.lighting.lights = {{normalize(Vec3{0.5, 1, 0.3}), {2, 2, 2}, true}, {normalize(Vec3{-0.6, 0.7, -0.2}), {0.5, 0.4, 0.3}, true},
+  d.lighting.lights = {{normalize(Vec3{0.5, 1, 0.3}), {2, 2, 2}, true},
+                       {normalize(Vec3{-0.6, 0.7, -0.2}), {0.5, 0.4, 0.3}, true},
                        {normalize(Vec3{0, 1, 0}), {0.2, 0.2, 0.3}, false}};
   d.shadow_map_size = 2048;
   RenderResult cpu = render_cpu(d);
@@ -378,7 +385,8 @@ TEST_F(RenderGl, PointLightsWithShadowsAgreeWithCpu) {
   gl::Context ctx;
   geometry::TriMesh blob = geometry::make_blob(6000, 0.5), floor = geometry::make_floor(1.6, -0.25);
   FrameDesc d = blob_scene(&blob, &floor);
-  d.lighting.point_lights = {{{1.2, 1.5, 0.6}, {4, 4, 4}, true}, {{-1.0, 0.8, -0.9}, {1.0, 0.8, 0.6}, true},
+  d.lighting.point_lights = {{{1.2, 1.5, 0.6}, {4, 4, 4}, true},
+                             {{-1.0, 0.8, -0.9}, {1.0, 0.8, 0.6}, true},
                              {{0, 2, 0}, {0.3, 0.3, 0.4}, false}};
   // As for directional lights: shadow edges differ, the rest is float.
   constexpr double kLightsMedianTol = 1e-3;
@@ -392,8 +400,8 @@ TEST_F(RenderGl, PointLightsWithShadowsAgreeWithCpu) {
   EXPECT_EQ(probe.render(d).unshadowed_lights, 0);
   expect_gl_agrees(d, render_cpu(d), {kLightsMedianTol, kLightsP99Tol, 4000}, "point_light_cube");
   // Three cubes need 18 layers of the 16: the third light goes unshadowed, and is counted.
-  d.lighting.point_lights = {{{0.45, 0.35, 0.3}, {1, 1, 1}, true}, {{-0.45, 0.35, 0.3}, {1, 1, 1}, true},
-                             {{0, 0.35, -0.45}, {1, 1, 1}, true}};
+  d.lighting.point_lights = {
+      {{0.45, 0.35, 0.3}, {1, 1, 1}, true}, {{-0.45, 0.35, 0.3}, {1, 1, 1}, true}, {{0, 0.35, -0.45}, {1, 1, 1}, true}};
   gl::Renderer r;
   EXPECT_EQ(r.render(d).unshadowed_lights, 1);
 }
@@ -408,7 +416,10 @@ TEST_F(RenderGl, TexturedSpotlightsWithShadowsAgreeWithCpu) {
   Image tex(32, 24, 3);
   for (int y = 0; y < 24; ++y)
     for (int x = 0; x < 32; ++x)
-      tex.set_rgb(x, y, Vec3{1.0 + 0.5 * std::sin(0.4 * x), 0.8 + 0.4 * std::cos(0.3 * y), ((x / 4 + y / 4) % 2) ? 1.5 : 0.3} * 1e6);  // beyond half floats: the GL path must rescale
+      tex.set_rgb(
+          x, y,
+          Vec3{1.0 + 0.5 * std::sin(0.4 * x), 0.8 + 0.4 * std::cos(0.3 * y), ((x / 4 + y / 4) % 2) ? 1.5 : 0.3} *
+              1e6);  // beyond half floats: the GL path must rescale
   auto mips = std::make_shared<const std::vector<Image>>(nearfield::build_mips(tex));
   for (int j = 0; j < 3; ++j)
     for (int i = 0; i < 3; ++i) {
@@ -429,7 +440,7 @@ TEST_F(RenderGl, TexturedSpotlightsWithShadowsAgreeWithCpu) {
   double peak = 0;
   for (int y = 0; y < 96; ++y)
     for (int x = 0; x < 128; ++x) peak = std::max(peak, luminance(cpu.color.rgb(x, y)));
-  EXPECT_GT(peak, 0.01);  // the spotlights light the scene
+  EXPECT_GT(peak, 0.01);                   // the spotlights light the scene
   constexpr double kSpotMedianTol = 2e-3;  // float math and GL's 8-bit filter weights (bilinear and between mips)
   constexpr double kSpotP99Tol = 0.5;      // shadow-map edges against exact shadow rays
   expect_gl_agrees(d, cpu, {kSpotMedianTol, kSpotP99Tol, 4000}, "spotlights");
@@ -448,7 +459,8 @@ TEST_F(RenderGl, LayeredShadowPassEqualsPassPerLight) {
     GTEST_SKIP() << "this GL has no GL_ARB_shader_viewport_layer_array: the renderer uses one pass per light";
   geometry::TriMesh blob = geometry::make_blob(6000, 0.5), floor = geometry::make_floor(1.6, -0.25);
   FrameDesc d = blob_scene(&blob, &floor);
-  d.lighting.lights = {{normalize(Vec3{0.5, 1, 0.3}), {1, 1, 1}, true}, {normalize(Vec3{-0.6, 0.7, -0.2}), {0.5, 0.4, 0.3}, true}};
+  d.lighting.lights = {{normalize(Vec3{0.5, 1, 0.3}), {1, 1, 1}, true},
+                       {normalize(Vec3{-0.6, 0.7, -0.2}), {0.5, 0.4, 0.3}, true}};
   d.lighting.point_lights = {{{0.45, 0.35, 0.3}, {1, 1, 1}, true}};  // inside the bounds: a cube of six layers
   Image tex(8, 8, 3);
   for (int y = 0; y < 8; ++y)
@@ -619,7 +631,8 @@ TEST_F(RenderGl, OverlayCopiesItsPictureByteForByte) {
   glClearNamedFramebufferfv(fbo, GL_COLOR, 0, zero);
   Image pic(4, 2, 3);
   for (int y = 0; y < 2; ++y)
-    for (int x = 0; x < 4; ++x) pic.set_rgb(x, y, {(10 + 40 * x) / 255.0, (200 + 50 * y) / 255.0, (x + 4 * y + 1) / 255.0});
+    for (int x = 0; x < 4; ++x)
+      pic.set_rgb(x, y, {(10 + 40 * x) / 255.0, (200 + 50 * y) / 255.0, (x + 4 * y + 1) / 255.0});
   gl::Overlay ov;
   ov.set(pic);
   EXPECT_EQ(ov.width(), 4);

@@ -56,7 +56,8 @@ Vec3 shade(const Lighting& lighting, const Material& m, Vec3 p, Vec3 n, Vec3 v, 
     E += irradiance * ndl;
     G += irradiance * glossy_lobe(m, n, v, r, l);
   };
-  for (const DirectionalLight& L : lighting.lights) add_light(L.direction, L.irradiance, L.shadow, std::numeric_limits<double>::infinity());
+  for (const DirectionalLight& L : lighting.lights)
+    add_light(L.direction, L.irradiance, L.shadow, std::numeric_limits<double>::infinity());
   for (const PointLight& L : lighting.point_lights) {
     Vec3 to = L.position - p;
     double d2 = dot(to, to);

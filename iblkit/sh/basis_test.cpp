@@ -57,7 +57,14 @@ TEST(ShBasis, MatchesRamamoorthiHanrahanPolynomials) {
     double y[9];
     eval_basis(3, d, y);
     const double x = d.x, yy = d.y, z = d.z;
-    double expect[9] = {c0, c1 * yy, c1 * z, c1 * x, c2 * x * yy, c2 * yy * z, c20 * (3 * z * z - 1), c2 * x * z,
+    double expect[9] = {c0,
+                        c1 * yy,
+                        c1 * z,
+                        c1 * x,
+                        c2 * x * yy,
+                        c2 * yy * z,
+                        c20 * (3 * z * z - 1),
+                        c2 * x * z,
                         c22 * (x * x - yy * yy)};
     for (int k = 0; k < 9; ++k) EXPECT_NEAR(y[k], expect[k], kClosedFormTol) << k;
   }

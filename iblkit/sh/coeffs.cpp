@@ -5,8 +5,8 @@
 
 #include <fmt/format.h>
 
-#include "iblkit/core/error.h"
 #include "iblkit/core/atomic_file.h"
+#include "iblkit/core/error.h"
 #include "iblkit/core/json_file.h"
 #include "iblkit/sh/basis.h"
 
@@ -33,7 +33,8 @@ Coeffs Coeffs::resized(int new_bands) const {
 }
 
 void Coeffs::validate(const std::string& what) const {
-  if (bands < 1 || bands > kMaxBands) fail(ErrorKind::Value, "{}: SH bands must be in 1..{} (got {})", what, kMaxBands, bands);
+  if (bands < 1 || bands > kMaxBands)
+    fail(ErrorKind::Value, "{}: SH bands must be in 1..{} (got {})", what, kMaxBands, bands);
   if (static_cast<int>(c.size()) != coeff_count(bands))
     fail(ErrorKind::Value, "{}: {} bands need {} coefficients, got {}", what, bands, coeff_count(bands), c.size());
   for (size_t k = 0; k < c.size(); ++k)
@@ -58,9 +59,11 @@ Coeffs coeffs_from_json(const nlohmann::json& j, const std::string& what) {
   if (!j.is_object()) fail(ErrorKind::Format, "{}: expected a JSON object", what);
   if (!j.contains("format") || j["format"] != "iblkit.sh/1")
     fail(ErrorKind::Format, "{}: \"format\" must be \"iblkit.sh/1\"", what);
-  if (!j.contains("bands") || !j["bands"].is_number_integer()) fail(ErrorKind::Format, "{}: \"bands\" must be an integer", what);
+  if (!j.contains("bands") || !j["bands"].is_number_integer())
+    fail(ErrorKind::Format, "{}: \"bands\" must be an integer", what);
   int bands = j["bands"].get<int>();
-  if (bands < 1 || bands > kMaxBands) fail(ErrorKind::Value, "{}: \"bands\" must be in 1..{} (got {})", what, kMaxBands, bands);
+  if (bands < 1 || bands > kMaxBands)
+    fail(ErrorKind::Value, "{}: \"bands\" must be in 1..{} (got {})", what, kMaxBands, bands);
   if (!j.contains("coefficients") || !j["coefficients"].is_array())
     fail(ErrorKind::Format, "{}: \"coefficients\" must be an array", what);
   const auto& arr = j["coefficients"];
@@ -84,8 +87,6 @@ void write_coeffs(const std::string& path, const Coeffs& c) {
   write_file_atomically(path, to_json_text(c));
 }
 
-Coeffs read_coeffs(const std::string& path) {
-  return coeffs_from_json(read_json_file(path), path);
-}
+Coeffs read_coeffs(const std::string& path) { return coeffs_from_json(read_json_file(path), path); }
 
 }  // namespace ibl::sh

@@ -19,8 +19,10 @@ std::vector<double> clamped_cosine_zh(int bands) {
   check_bands(bands);
   std::vector<double> a(bands, 0.0);
   for (int l = 0; l < bands; ++l) {
-    if (l == 0) a[l] = kPi;
-    else if (l == 1) a[l] = 2.0 * kPi / 3.0;
+    if (l == 0)
+      a[l] = kPi;
+    else if (l == 1)
+      a[l] = 2.0 * kPi / 3.0;
     else if (l % 2 == 0) {
       // l! / (2^l ((l/2)!)²) through log-gamma.
       double r = std::exp(std::lgamma(l + 1.0) - l * std::log(2.0) - 2.0 * std::lgamma(l / 2 + 1.0));
@@ -70,8 +72,10 @@ Vec3 irradiance_at(const Coeffs& radiance, Vec3 n) {
 }
 
 namespace {
-constexpr EnumName<Window> kWindowNames[] = {
-    {Window::None, "none"}, {Window::Hanning, "hanning"}, {Window::Lanczos, "lanczos"}, {Window::Deringing, "deringing"}};
+constexpr EnumName<Window> kWindowNames[] = {{Window::None, "none"},
+                                             {Window::Hanning, "hanning"},
+                                             {Window::Lanczos, "lanczos"},
+                                             {Window::Deringing, "deringing"}};
 }  // namespace
 
 std::string window_name(Window w) { return name_of(kWindowNames, w); }
@@ -85,10 +89,16 @@ std::vector<double> window_weights(Window w, int bands, double width) {
   for (int l = 0; l < bands; ++l) {
     double t = l / W;
     switch (w) {
-      case Window::None: break;
-      case Window::Hanning: h[l] = t >= 1 ? 0.0 : 0.5 * (1.0 + std::cos(kPi * t)); break;
-      case Window::Lanczos: h[l] = l == 0 ? 1.0 : (t >= 1 ? 0.0 : std::sin(kPi * t) / (kPi * t)); break;
-      case Window::Deringing: fail(ErrorKind::Value, "the deringing window depends on the coefficients: use apply_window");
+      case Window::None:
+        break;
+      case Window::Hanning:
+        h[l] = t >= 1 ? 0.0 : 0.5 * (1.0 + std::cos(kPi * t));
+        break;
+      case Window::Lanczos:
+        h[l] = l == 0 ? 1.0 : (t >= 1 ? 0.0 : std::sin(kPi * t) / (kPi * t));
+        break;
+      case Window::Deringing:
+        fail(ErrorKind::Value, "the deringing window depends on the coefficients: use apply_window");
     }
   }
   return h;
@@ -108,7 +118,8 @@ namespace {
 
 // Minimum over test directions and channels of the irradiance of `radiance` windowed by h,
 // given the basis values at the directions (K per direction).
-double min_irradiance(const Coeffs& radiance, const std::vector<double>& h, const std::vector<double>& basis, int npts) {
+double min_irradiance(const Coeffs& radiance, const std::vector<double>& h, const std::vector<double>& basis,
+                      int npts) {
   const int K = coeff_count(radiance.bands);
   auto a = clamped_cosine_zh(radiance.bands);
   std::vector<Vec3> e(K);
@@ -151,8 +162,10 @@ Coeffs apply_window(const Coeffs& radiance, const WindowDesc& desc, WindowReport
       while (min_irradiance(radiance, filter(hi), basis, n) < 0 && hi < 1e12) hi *= 10;
       for (int it = 0; it < 60; ++it) {  // bisection on log λ to a relative 1e-5 or so
         double mid = std::sqrt(lo * hi);
-        if (min_irradiance(radiance, filter(mid), basis, n) < 0) lo = mid;
-        else hi = mid;
+        if (min_irradiance(radiance, filter(mid), basis, n) < 0)
+          lo = mid;
+        else
+          hi = mid;
         if (hi / lo < 1.00001) break;
       }
       lambda = hi;

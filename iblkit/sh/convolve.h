@@ -55,13 +55,13 @@ Window parse_window(const std::string& name);
 
 struct WindowDesc {
   Window kind = Window::None;
-  double width = 0;   // Hanning/Lanczos W; 0 picks W = bands (the last band keeps a small weight)
+  double width = 0;        // Hanning/Lanczos W; 0 picks W = bands (the last band keeps a small weight)
   int test_points = 4096;  // deringing: Fibonacci directions where irradiance must be ≥ 0
 };
 
 struct WindowReport {
-  std::vector<double> weights;  // w_l applied
-  double lambda = 0;            // deringing's λ (0 when nothing had to be smoothed)
+  std::vector<double> weights;       // w_l applied
+  double lambda = 0;                 // deringing's λ (0 when nothing had to be smoothed)
   double min_irradiance_before = 0;  // min over test points and channels of E(n)/mean E, before
   double min_irradiance_after = 0;   // … and after the window
 };

@@ -37,7 +37,12 @@ TEST(ShConvolve, ClampedCosineClosedForms) {
   const double expect[] = {kPi, 2 * kPi / 3, kPi / 4, 0, -kPi / 24, 0, kPi / 64};
   for (int l = 0; l < 7; ++l) EXPECT_NEAR(a[l], expect[l], kClosedTol) << l;
   // Funk–Hecke with a quadrature exact for the polynomial t·P_l(t) (degree ≤ 13).
-  for (int l = 0; l < 13; ++l) EXPECT_NEAR(a[l], funk_hecke(l, [](double t) { return t; }, 8), kClosedTol) << l;
+  for (int l = 0; l < 13; ++l)
+    EXPECT_NEAR(a[l],
+                funk_hecke(
+                    l, [](double t) { return t; }, 8),
+                kClosedTol)
+        << l;
 }
 
 TEST(ShConvolve, PhongMatchesQuadratureAndCosine) {
@@ -48,7 +53,11 @@ TEST(ShConvolve, PhongMatchesQuadratureAndCosine) {
     auto p = phong_zh(9, s);
     EXPECT_NEAR(p[0], 1.0, 1e-13);
     for (int l = 0; l < 9; ++l)
-      EXPECT_NEAR(p[l], funk_hecke(l, [&](double t) { return (s + 1) / kTwoPi * std::pow(t, s); }, 64), kPhongTol) << s << " " << l;
+      EXPECT_NEAR(p[l],
+                  funk_hecke(
+                      l, [&](double t) { return (s + 1) / kTwoPi * std::pow(t, s); }, 64),
+                  kPhongTol)
+          << s << " " << l;
   }
   EXPECT_THROW(phong_zh(3, -1), Error);
 }
@@ -118,7 +127,11 @@ TEST(ShWindow, HanningAndLanczosValues) {
 TEST(ShWindow, DeringingRemovesNegativeIrradiance) {
   const int bands = 3;
   Vec3 sun = normalize(Vec3{0.2, 0.9, 0.3});
-  Coeffs c = project_function([&](Vec3 d) { return dot(d, sun) > 0.995 ? Vec3{50, 45, 40} : Vec3{0.01, 0.01, 0.01}; }, bands, 200);
+  Coeffs c = project_function(
+      [&](Vec3 d) {
+        return dot(d, sun) > 0.995 ? Vec3{50, 45, 40} : Vec3{0.01, 0.01, 0.01};
+      },
+      bands, 200);
   WindowDesc wd;
   wd.kind = Window::Deringing;
   WindowReport rep;

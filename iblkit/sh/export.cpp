@@ -20,11 +20,20 @@ namespace {
 double poly_constant(int i) {
   const double sp = std::sqrt(kPi);
   switch (i) {
-    case 0: return 0.5 / sp;
-    case 1: case 2: case 3: return std::sqrt(3.0) / (2 * sp);
-    case 4: case 5: case 7: return std::sqrt(15.0) / (2 * sp);
-    case 6: return std::sqrt(5.0) / (4 * sp);
-    default: return std::sqrt(15.0) / (4 * sp);
+    case 0:
+      return 0.5 / sp;
+    case 1:
+    case 2:
+    case 3:
+      return std::sqrt(3.0) / (2 * sp);
+    case 4:
+    case 5:
+    case 7:
+      return std::sqrt(15.0) / (2 * sp);
+    case 6:
+      return std::sqrt(5.0) / (4 * sp);
+    default:
+      return std::sqrt(15.0) / (4 * sp);
   }
 }
 // Band and order of coefficient i < 9.
@@ -34,12 +43,16 @@ int order_of(int i) { return i - band_of(i) * (band_of(i) + 1); }
 }  // namespace
 
 namespace {
-constexpr EnumName<ExportFormat> kExportFormatNames[] = {
-    {ExportFormat::Iblkit, "iblkit"}, {ExportFormat::ThreeJs, "threejs"}, {ExportFormat::Filament, "filament"}, {ExportFormat::Gltf, "gltf"}};
+constexpr EnumName<ExportFormat> kExportFormatNames[] = {{ExportFormat::Iblkit, "iblkit"},
+                                                         {ExportFormat::ThreeJs, "threejs"},
+                                                         {ExportFormat::Filament, "filament"},
+                                                         {ExportFormat::Gltf, "gltf"}};
 }  // namespace
 
 std::string export_format_name(ExportFormat f) { return name_of(kExportFormatNames, f); }
-ExportFormat parse_export_format(const std::string& name) { return parse_enum(kExportFormatNames, name, "SH export format"); }
+ExportFormat parse_export_format(const std::string& name) {
+  return parse_enum(kExportFormatNames, name, "SH export format");
+}
 
 Coeffs to_threejs(const Coeffs& radiance) { return radiance.resized(3); }
 
@@ -47,7 +60,8 @@ Mat3 filament_from_iblkit() { return Mat3::rows({0, 0, -1}, {0, 1, 0}, {1, 0, 0}
 
 Mat3 filament_frame(sphere::MappingKind k) {
   using K = sphere::MappingKind;
-  if (k == K::CubeHCross || k == K::CubeVCross || k == K::CubeStrip) return Mat3::rows({-1, 0, 0}, {0, 1, 0}, {0, 0, 1});
+  if (k == K::CubeHCross || k == K::CubeVCross || k == K::CubeStrip)
+    return Mat3::rows({-1, 0, 0}, {0, 1, 0}, {0, 0, 1});
   return filament_from_iblkit();
 }
 
@@ -82,7 +96,8 @@ Coeffs from_gltf(const Coeffs& g) {
 std::string export_text(const Coeffs& radiance, ExportFormat f, const Mat3& filament_frame) {
   radiance.validate("SH coefficients");
   switch (f) {
-    case ExportFormat::Iblkit: return to_json_text(radiance);
+    case ExportFormat::Iblkit:
+      return to_json_text(radiance);
     case ExportFormat::ThreeJs: {
       Coeffs c = to_threejs(radiance);
       nlohmann::json arr = nlohmann::json::array();
@@ -97,11 +112,12 @@ std::string export_text(const Coeffs& radiance, ExportFormat f, const Mat3& fila
       Coeffs c = to_filament(radiance, filament_frame);
       std::string s;
       for (int i = 0; i < 9; ++i)
-        s += fmt::format("({:18.15f}, {:18.15f}, {:18.15f}); // L{}{}, irradiance, pre-scaled base\n", c.c[i].x, c.c[i].y,
-                         c.c[i].z, band_of(i), order_of(i));
+        s += fmt::format("({:18.15f}, {:18.15f}, {:18.15f}); // L{}{}, irradiance, pre-scaled base\n", c.c[i].x,
+                         c.c[i].y, c.c[i].z, band_of(i), order_of(i));
       return s;
     }
-    case ExportFormat::Gltf: return gltf_ibl_text(radiance);
+    case ExportFormat::Gltf:
+      return gltf_ibl_text(radiance);
   }
   return {};
 }
@@ -111,15 +127,18 @@ std::string gltf_ibl_text(const Coeffs& radiance, const GltfSpecular& specular) 
   Coeffs c = to_gltf(radiance);
   nlohmann::json arr = nlohmann::json::array();
   for (const Vec3& v : c.c) arr.push_back({v.x, v.y, v.z});
-  nlohmann::json light = {{"name", "iblkit"}, {"intensity", 1.0}, {"rotation", {0.0, 0.0, 0.0, 1.0}}, {"irradianceCoefficients", arr}};
-  nlohmann::json doc = {{"asset", {{"version", "2.0"}, {"generator", "iblkit sh"}}},
-                        {"extensionsUsed", {"EXT_lights_image_based"}},
-                        {"scene", 0},
-                        {"scenes", {{{"name", "iblkit"}, {"extensions", {{"EXT_lights_image_based", {{"light", 0}}}}}}}}};
+  nlohmann::json light = {
+      {"name", "iblkit"}, {"intensity", 1.0}, {"rotation", {0.0, 0.0, 0.0, 1.0}}, {"irradianceCoefficients", arr}};
+  nlohmann::json doc = {
+      {"asset", {{"version", "2.0"}, {"generator", "iblkit sh"}}},
+      {"extensionsUsed", {"EXT_lights_image_based"}},
+      {"scene", 0},
+      {"scenes", {{{"name", "iblkit"}, {"extensions", {{"EXT_lights_image_based", {{"light", 0}}}}}}}}};
   if (!specular.levels.empty()) {
     if (specular.size < 1 || (specular.size & (specular.size - 1)) != 0)
       fail(ErrorKind::Value, "EXT_lights_image_based: specular image size {} must be a power of two", specular.size);
-    if (specular.levels.size() > 31) fail(ErrorKind::Value, "EXT_lights_image_based: {} specular levels (at most 31)", specular.levels.size());
+    if (specular.levels.size() > 31)
+      fail(ErrorKind::Value, "EXT_lights_image_based: {} specular levels (at most 31)", specular.levels.size());
     nlohmann::json images = nlohmann::json::array(), levels = nlohmann::json::array();
     for (const auto& faces : specular.levels) {
       nlohmann::json idx = nlohmann::json::array();

@@ -67,9 +67,15 @@ TEST(ShExport, FilamentShaderGivesIrradianceOverPi) {
 // Condon–Shortley signs (−, +, − on band 1; +, −, +, −, + on band 2): that must be E(n).
 TEST(ShExport, GltfIrradianceInBabylonBasis) {
   const double sp = std::sqrt(kPi);
-  const double K[9] = {0.5 / sp, -std::sqrt(3.0) / (2 * sp), std::sqrt(3.0) / (2 * sp), -std::sqrt(3.0) / (2 * sp),
-                       std::sqrt(15.0) / (2 * sp), -std::sqrt(15.0) / (2 * sp), std::sqrt(5.0) / (4 * sp),
-                       -std::sqrt(15.0) / (2 * sp), std::sqrt(15.0) / (4 * sp)};
+  const double K[9] = {0.5 / sp,
+                       -std::sqrt(3.0) / (2 * sp),
+                       std::sqrt(3.0) / (2 * sp),
+                       -std::sqrt(3.0) / (2 * sp),
+                       std::sqrt(15.0) / (2 * sp),
+                       -std::sqrt(15.0) / (2 * sp),
+                       std::sqrt(5.0) / (4 * sp),
+                       -std::sqrt(15.0) / (2 * sp),
+                       std::sqrt(15.0) / (4 * sp)};
   Coeffs r = some_radiance(), g = to_gltf(r);
   for (Vec3 n : kNormals) {
     double p[9];
@@ -130,7 +136,9 @@ TEST(ShExport, GltfDocumentWithSpecularImages) {
   ASSERT_EQ(light["specularImages"].size(), 2u);
   EXPECT_EQ(light["specularImages"][1][5], 11);
   EXPECT_EQ(j["images"][11]["uri"], "spec_m1_5.png");
-  EXPECT_FALSE(nlohmann::json::parse(export_text(r, ExportFormat::Gltf))["extensions"]["EXT_lights_image_based"]["lights"][0].contains("specularImages"));
+  EXPECT_FALSE(
+      nlohmann::json::parse(export_text(r, ExportFormat::Gltf))["extensions"]["EXT_lights_image_based"]["lights"][0]
+          .contains("specularImages"));
   spec.size = 48;
   EXPECT_THROW(gltf_ibl_text(r, spec), Error);
 }

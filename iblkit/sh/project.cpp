@@ -19,9 +19,7 @@ void check_bands(int bands) {
   if (bands < 1 || bands > kMaxBands) fail(ErrorKind::Value, "SH bands must be in 1..{} (got {})", kMaxBands, bands);
 }
 
-Vec3 pixel_rgb(const float* p, int channels) {
-  return channels >= 3 ? Vec3{p[0], p[1], p[2]} : Vec3{p[0], p[0], p[0]};
-}
+Vec3 pixel_rgb(const float* p, int channels) { return channels >= 3 ? Vec3{p[0], p[1], p[2]} : Vec3{p[0], p[0], p[0]}; }
 
 // Partial sums of one chunk of rows: K RGB coefficients.
 struct Partial {
@@ -79,7 +77,7 @@ void row_dots(const float* ch, const float* tab, int n, int ld, double* out) {
 Coeffs project_latlong(const ImageView& img, int bands, const ProgressFn& progress) {
   const int W = img.width(), H = img.height(), C = img.channels(), K = coeff_count(bands);
   const int Wp = (W + kLanes - 1) / kLanes * kLanes;
-  const int J = 2 * bands - 1;            // tables: cos 0, then (Re, Im) w^m for m = 1..L
+  const int J = 2 * bands - 1;  // tables: cos 0, then (Re, Im) w^m for m = 1..L
   const int Jp = J;
   // Column tables {Re, Im} w(a_x)^m in float (unit magnitude).
   const double delta = kTwoPi / W;
@@ -125,7 +123,8 @@ Coeffs project_latlong(const ImageView& img, int bands, const ProgressFn& progre
             legendre_table(bands, z, P.data());
             double sm = 1.0;
             for (int m = 0; m < bands; ++m) {
-              for (int l = m; l < bands; ++l) G[l * bands + m] += w * colf[m] * norm[l * bands + m] * P[l * bands + m] * sm;
+              for (int l = m; l < bands; ++l)
+                G[l * bands + m] += w * colf[m] * norm[l * bands + m] * P[l * bands + m] * sm;
               sm *= s;
             }
           }
@@ -251,7 +250,8 @@ Coeffs project(const ImageView& img, const sphere::Mapping& m, int bands, const 
   check_bands(bands);
   if (img.width() == 0 || img.height() == 0) fail(ErrorKind::Value, "cannot project an empty image onto SH");
   if (img.width() != m.width() || img.height() != m.height())
-    fail(ErrorKind::Value, "SH projection: the image is {}x{} but its mapping {}x{}", img.width(), img.height(), m.width(), m.height());
+    fail(ErrorKind::Value, "SH projection: the image is {}x{} but its mapping {}x{}", img.width(), img.height(),
+         m.width(), m.height());
   if (m.kind() == MappingKind::LatLong) return project_latlong(img, bands, progress);
   return project_generic(img, m, bands, progress);
 }

@@ -22,20 +22,23 @@ using sphere::MappingKind;
 const char* kProbeDir = "/usr/share/blender/datafiles/studiolights/world/";
 
 std::vector<Mapping> every_mapping(int s) {
-  return {Mapping(MappingKind::LatLong, 2 * s, s),     Mapping(MappingKind::MirrorBall, s, s),
-          Mapping(MappingKind::Angular, s, s),         Mapping(MappingKind::CubeHCross, 4 * s / 4, 3 * s / 4),
-          Mapping(MappingKind::CubeVCross, 3 * s / 4, 4 * s / 4), Mapping(MappingKind::CubeStrip, 6 * s / 4, s / 4),
+  return {Mapping(MappingKind::LatLong, 2 * s, s),
+          Mapping(MappingKind::MirrorBall, s, s),
+          Mapping(MappingKind::Angular, s, s),
+          Mapping(MappingKind::CubeHCross, 4 * s / 4, 3 * s / 4),
+          Mapping(MappingKind::CubeVCross, 3 * s / 4, 4 * s / 4),
+          Mapping(MappingKind::CubeStrip, 6 * s / 4, s / 4),
           Mapping(MappingKind::Octahedral, s, s)};
 }
 
 // Unit radiance everywhere: c00 = √(4π) (the solid angles are exact), every other coefficient 0,
 // irradiance π in every direction.
 TEST(ShProject, WhiteFurnaceEveryMapping) {
-  constexpr double kLatLongTol = 1e-9;     // separable path: exact pixel integrals, rounding only
+  constexpr double kLatLongTol = 1e-9;        // separable path: exact pixel integrals, rounding only
   constexpr double kLatLongHigherTol = 1e-7;  // … of the float cos/sin column tables (2⁻²⁴ each)
-  constexpr double kC00Tol = 3e-5;         // mirror ball: disc-edge slivers no 8×8 sub-point lands in
-  constexpr double kHigherTol = 1e-3;      // l ≤ 4 by sub-pixel quadrature on 32-px cube faces / 128-px discs
-  constexpr double kIrradianceTol = 1e-4;  // the figure
+  constexpr double kC00Tol = 3e-5;            // mirror ball: disc-edge slivers no 8×8 sub-point lands in
+  constexpr double kHigherTol = 1e-3;         // l ≤ 4 by sub-pixel quadrature on 32-px cube faces / 128-px discs
+  constexpr double kIrradianceTol = 1e-4;     // the figure
   for (const Mapping& m : every_mapping(128)) {
     EnvMap env(Image(m.width(), m.height(), 3, 1.0f), m);
     // Pixels without data must not count: zero them so a wrong weight would show.

@@ -33,7 +33,9 @@ void EnvMap::sample(Vec3 d, float* out) const {
   }
   ImageView v = image.view();
   switch (mapping.kind()) {
-    case MappingKind::LatLong: v.bilinear(px, py, Wrap::LatLong, out); return;
+    case MappingKind::LatLong:
+      v.bilinear(px, py, Wrap::LatLong, out);
+      return;
     case MappingKind::CubeHCross:
     case MappingKind::CubeVCross:
     case MappingKind::CubeStrip: {
@@ -42,7 +44,9 @@ void EnvMap::sample(Vec3 d, float* out) const {
       v.sub(cx * f, cy * f, f, f).bilinear(px - cx * f, py - cy * f, Wrap::Clamp, out);
       return;
     }
-    default: v.bilinear(px, py, Wrap::Clamp, out); return;
+    default:
+      v.bilinear(px, py, Wrap::Clamp, out);
+      return;
   }
 }
 
@@ -87,8 +91,8 @@ namespace {
 // kNc > 0 fixes the channel count at compile time (the common RGB case); 0 reads it from the image.
 template <int kNc>
 // `rows[y]` points at row y's pixels (the image's own, or a pole-filtered copy).
-void latlong_lookup_batch(const Image& img, const float* const* rows, const float* dx, const float* dy, const float* dz, int count,
-                          float* u_buf, float* v_buf, float* out) {
+void latlong_lookup_batch(const Image& img, const float* const* rows, const float* dx, const float* dy, const float* dz,
+                          int count, float* u_buf, float* v_buf, float* out) {
   constexpr float kInv2Pi = 0.159154943091895f, kInvPi = 0.318309886183791f;
   const float fw = static_cast<float>(img.width()), fh = static_cast<float>(img.height());
   for (int k = 0; k < count; ++k) {
@@ -155,7 +159,8 @@ std::vector<const float*> prefilter_poles(const Image& src, std::vector<float>* 
       need += static_cast<size_t>(W) * nc;
     }
   storage->resize(need);
-  for (int y = 0; y < H; ++y) rows[y] = std::min(pole_filter_width(y, H), W) > 1 ? storage->data() + offset[y] : src.pixel(0, y);
+  for (int y = 0; y < H; ++y)
+    rows[y] = std::min(pole_filter_width(y, H), W) > 1 ? storage->data() + offset[y] : src.pixel(0, y);
   parallel_for(0, H, [&](int64_t yy) {
     int y = static_cast<int>(yy);
     int k = std::min(pole_filter_width(y, H), W);
@@ -205,7 +210,10 @@ Image resample(const EnvMap& src, const Mapping& dst, const ResampleDesc& desc) 
     std::vector<int>& owner = rb.owner;
     const size_t most = static_cast<size_t>(dst.width()) * desc.max_supersampling * desc.max_supersampling;
     if (dx.size() < most) {
-      dx.resize(most); dy.resize(most); dz.resize(most); owner.resize(most);
+      dx.resize(most);
+      dy.resize(most);
+      dz.resize(most);
+      owner.resize(most);
     }
     int count = 0;
     int nx = 1, ny = 1, footprint_at = -1000;
@@ -228,13 +236,17 @@ Image resample(const EnvMap& src, const Mapping& dst, const ResampleDesc& desc) 
         bool okx = dst.to_direction(x + 1.5, y + 0.5, &cx) || dst.to_direction(x - 0.5, y + 0.5, &cx);
         bool oky = dst.to_direction(x + 0.5, y + 1.5, &cy) || dst.to_direction(x + 0.5, y - 0.5, &cy);
         Vec3 cc = c;
-        if (rotate) { cc = inv * cc; cx = inv * cx; cy = inv * cy; }
+        if (rotate) {
+          cc = inv * cc;
+          cx = inv * cx;
+          cy = inv * cy;
+        }
         double p0x, p0y, p1x, p1y, p2x, p2y;
         src.mapping.to_pixel(cc, &p0x, &p0y);
         src.mapping.to_pixel(cx, &p1x, &p1y);
         src.mapping.to_pixel(cy, &p2x, &p2y);
         double u_scale = fast ? 1.0 / pole_filter_width(std::clamp(static_cast<int>(p0y), 0, src.mapping.height() - 1),
-                                                          src.mapping.height())
+                                                        src.mapping.height())
                               : 1.0;
         nx = okx ? supersampling(pixel_distance(src.mapping, p0x, p0y, p1x, p1y, u_scale), desc.max_supersampling) : 1;
         ny = oky ? supersampling(pixel_distance(src.mapping, p0x, p0y, p2x, p2y, u_scale), desc.max_supersampling) : 1;
@@ -246,11 +258,14 @@ Image resample(const EnvMap& src, const Mapping& dst, const ResampleDesc& desc) 
         const float inv_f = 2.0f / F;
         const float s0 = (static_cast<float>(x % F) + 0.5f / nx) * inv_f - 1.0f, sd = inv_f / nx;
         const float t0 = (static_cast<float>(y % F) + 0.5f / ny) * inv_f - 1.0f, td = inv_f / ny;
-        const Vec3 c0 = cube_face_point(face, 0, 0), cs = cube_face_point(face, 1, 0) - c0, ct = cube_face_point(face, 0, 1) - c0;
+        const Vec3 c0 = cube_face_point(face, 0, 0), cs = cube_face_point(face, 1, 0) - c0,
+                   ct = cube_face_point(face, 0, 1) - c0;
         const float sign = rot ? -1.0f : 1.0f;  // vcross −Z is turned 180°: (s, t) → (−s, −t)
         const float ax = static_cast<float>(c0.x), ay = static_cast<float>(c0.y), az = static_cast<float>(c0.z);
-        const float sx = sign * static_cast<float>(cs.x), sy = sign * static_cast<float>(cs.y), sz = sign * static_cast<float>(cs.z);
-        const float tx = sign * static_cast<float>(ct.x), ty = sign * static_cast<float>(ct.y), tz = sign * static_cast<float>(ct.z);
+        const float sx = sign * static_cast<float>(cs.x), sy = sign * static_cast<float>(cs.y),
+                    sz = sign * static_cast<float>(cs.z);
+        const float tx = sign * static_cast<float>(ct.x), ty = sign * static_cast<float>(ct.y),
+                    tz = sign * static_cast<float>(ct.z);
         for (int j = 0; j < ny; ++j) {
           const float t = t0 + j * td;
           for (int i = 0; i < nx; ++i) {
@@ -282,8 +297,12 @@ Image resample(const EnvMap& src, const Mapping& dst, const ResampleDesc& desc) 
     ub.resize(count);
     vb.resize(count);
     if (fast) {
-      if (nc == 3) latlong_lookup_batch<3>(src.image, rows.data(), dx.data(), dy.data(), dz.data(), count, ub.data(), vb.data(), vals.data());
-      else latlong_lookup_batch<0>(src.image, rows.data(), dx.data(), dy.data(), dz.data(), count, ub.data(), vb.data(), vals.data());
+      if (nc == 3)
+        latlong_lookup_batch<3>(src.image, rows.data(), dx.data(), dy.data(), dz.data(), count, ub.data(), vb.data(),
+                                vals.data());
+      else
+        latlong_lookup_batch<0>(src.image, rows.data(), dx.data(), dy.data(), dz.data(), count, ub.data(), vb.data(),
+                                vals.data());
     } else {
       for (int k = 0; k < count; ++k) src.sample({dx[k], dy[k], dz[k]}, vals.data() + static_cast<size_t>(k) * nc);
     }
@@ -293,11 +312,15 @@ Image resample(const EnvMap& src, const Mapping& dst, const ResampleDesc& desc) 
         float a0 = 0, a1 = 0, a2 = 0;
         for (; k < count && owner[k] == x; ++k, ++m) {
           const float* v = vals.data() + static_cast<size_t>(k) * 3;
-          a0 += v[0]; a1 += v[1]; a2 += v[2];
+          a0 += v[0];
+          a1 += v[1];
+          a2 += v[2];
         }
         float* o = out.pixel(x, y);
         float inv_m = 1.0f / m;
-        o[0] = a0 * inv_m; o[1] = a1 * inv_m; o[2] = a2 * inv_m;
+        o[0] = a0 * inv_m;
+        o[1] = a1 * inv_m;
+        o[2] = a2 * inv_m;
       }
       return;
     }

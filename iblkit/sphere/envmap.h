@@ -30,9 +30,9 @@ struct EnvMap {
 Image solid_angle_image(const Mapping& m);
 
 struct ResampleDesc {
-  int max_supersampling = 8;      // most sub-samples per axis for one output pixel
+  int max_supersampling = 8;         // most sub-samples per axis for one output pixel
   Mat3 rotation = Mat3::identity();  // output direction d looks up the input at rotationᵀ·d
-                                   // (i.e. the environment is rotated by `rotation`)
+                                     // (i.e. the environment is rotated by `rotation`)
 };
 
 // Resamples src into mapping dst (any size). Each output pixel averages n×n bilinear sub-samples,

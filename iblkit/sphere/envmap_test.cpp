@@ -21,11 +21,16 @@ constexpr double kRoundTripPowerTol = 1e-2;
 
 Mapping sized(MappingKind k, int n) {
   switch (k) {
-    case MappingKind::LatLong: return {k, 2 * n, n};
-    case MappingKind::CubeHCross: return {k, 4 * (n / 2), 3 * (n / 2)};
-    case MappingKind::CubeVCross: return {k, 3 * (n / 2), 4 * (n / 2)};
-    case MappingKind::CubeStrip: return {k, 6 * (n / 2), n / 2};
-    default: return {k, n, n};
+    case MappingKind::LatLong:
+      return {k, 2 * n, n};
+    case MappingKind::CubeHCross:
+      return {k, 4 * (n / 2), 3 * (n / 2)};
+    case MappingKind::CubeVCross:
+      return {k, 3 * (n / 2), 4 * (n / 2)};
+    case MappingKind::CubeStrip:
+      return {k, 6 * (n / 2), n / 2};
+    default:
+      return {k, n, n};
   }
 }
 
@@ -47,7 +52,8 @@ TEST(Resample, PowerConservedOnBlenderProbes) {
       EXPECT_NEAR(p1 / p0, 1.0, kPowerTol) << name << " → " << mapping_name(k);
       EnvMap back(resample(mid, src.mapping), src.mapping);
       auto q = back.integral();
-      EXPECT_NEAR(luminance(Vec3{q[0], q[1], q[2]}) / p0, 1.0, kRoundTripPowerTol) << name << " → " << mapping_name(k) << " → latlong";
+      EXPECT_NEAR(luminance(Vec3{q[0], q[1], q[2]}) / p0, 1.0, kRoundTripPowerTol)
+          << name << " → " << mapping_name(k) << " → latlong";
     }
   }
 }

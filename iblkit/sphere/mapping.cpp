@@ -13,14 +13,25 @@ namespace ibl::sphere {
 
 namespace {
 // Names first (in enum order), then aliases.
-constexpr EnumName<MappingKind> kMappingNames[] = {
-    {MappingKind::LatLong, "latlong"},       {MappingKind::MirrorBall, "mirrorball"}, {MappingKind::Angular, "angular"},
-    {MappingKind::CubeHCross, "hcross"},     {MappingKind::CubeVCross, "vcross"},     {MappingKind::CubeStrip, "cubestrip"},
-    {MappingKind::Octahedral, "octahedral"}, {MappingKind::LatLong, "equirect"},      {MappingKind::LatLong, "equirectangular"},
-    {MappingKind::MirrorBall, "ball"},       {MappingKind::MirrorBall, "chrome"},     {MappingKind::Angular, "probe"},
-    {MappingKind::Angular, "angularmap"},    {MappingKind::CubeHCross, "cubecross"},  {MappingKind::CubeHCross, "cube"},
-    {MappingKind::CubeHCross, "horizontal-cross"}, {MappingKind::CubeVCross, "vertical-cross"},
-    {MappingKind::CubeStrip, "strip"},       {MappingKind::Octahedral, "oct"}};
+constexpr EnumName<MappingKind> kMappingNames[] = {{MappingKind::LatLong, "latlong"},
+                                                   {MappingKind::MirrorBall, "mirrorball"},
+                                                   {MappingKind::Angular, "angular"},
+                                                   {MappingKind::CubeHCross, "hcross"},
+                                                   {MappingKind::CubeVCross, "vcross"},
+                                                   {MappingKind::CubeStrip, "cubestrip"},
+                                                   {MappingKind::Octahedral, "octahedral"},
+                                                   {MappingKind::LatLong, "equirect"},
+                                                   {MappingKind::LatLong, "equirectangular"},
+                                                   {MappingKind::MirrorBall, "ball"},
+                                                   {MappingKind::MirrorBall, "chrome"},
+                                                   {MappingKind::Angular, "probe"},
+                                                   {MappingKind::Angular, "angularmap"},
+                                                   {MappingKind::CubeHCross, "cubecross"},
+                                                   {MappingKind::CubeHCross, "cube"},
+                                                   {MappingKind::CubeHCross, "horizontal-cross"},
+                                                   {MappingKind::CubeVCross, "vertical-cross"},
+                                                   {MappingKind::CubeStrip, "strip"},
+                                                   {MappingKind::Octahedral, "oct"}};
 
 std::string lower(std::string_view s) {
   std::string n(s);
@@ -38,11 +49,16 @@ MappingKind parse_mapping(std::string_view name, std::string_view what) {
 
 double Mapping::aspect(MappingKind k) {
   switch (k) {
-    case MappingKind::LatLong: return 2.0;
-    case MappingKind::CubeHCross: return 4.0 / 3.0;
-    case MappingKind::CubeVCross: return 3.0 / 4.0;
-    case MappingKind::CubeStrip: return 6.0;
-    default: return 1.0;
+    case MappingKind::LatLong:
+      return 2.0;
+    case MappingKind::CubeHCross:
+      return 4.0 / 3.0;
+    case MappingKind::CubeVCross:
+      return 3.0 / 4.0;
+    case MappingKind::CubeStrip:
+      return 6.0;
+    default:
+      return 1.0;
   }
 }
 
@@ -68,27 +84,51 @@ MappingKind detect_mapping(int width, int height, std::string_view file_name) {
 
 Vec3 cube_face_point(int face, double s, double t) {
   switch (face) {
-    case 0: return {1, -t, -s};
-    case 1: return {-1, -t, s};
-    case 2: return {s, 1, t};
-    case 3: return {s, -1, -t};
-    case 4: return {s, -t, 1};
-    default: return {-s, -t, -1};
+    case 0:
+      return {1, -t, -s};
+    case 1:
+      return {-1, -t, s};
+    case 2:
+      return {s, 1, t};
+    case 3:
+      return {s, -1, -t};
+    case 4:
+      return {s, -t, 1};
+    default:
+      return {-s, -t, -1};
   }
 }
 
 int cube_face_of(Vec3 d, double* s, double* t) {
   double ax = std::abs(d.x), ay = std::abs(d.y), az = std::abs(d.z);
   if (ax >= ay && ax >= az) {
-    if (d.x > 0) { *s = -d.z / ax; *t = -d.y / ax; return 0; }
-    *s = d.z / ax; *t = -d.y / ax; return 1;
+    if (d.x > 0) {
+      *s = -d.z / ax;
+      *t = -d.y / ax;
+      return 0;
+    }
+    *s = d.z / ax;
+    *t = -d.y / ax;
+    return 1;
   }
   if (ay >= az) {
-    if (d.y > 0) { *s = d.x / ay; *t = d.z / ay; return 2; }
-    *s = d.x / ay; *t = -d.z / ay; return 3;
+    if (d.y > 0) {
+      *s = d.x / ay;
+      *t = d.z / ay;
+      return 2;
+    }
+    *s = d.x / ay;
+    *t = -d.z / ay;
+    return 3;
   }
-  if (d.z > 0) { *s = d.x / az; *t = -d.y / az; return 4; }
-  *s = -d.x / az; *t = -d.y / az; return 5;
+  if (d.z > 0) {
+    *s = d.x / az;
+    *t = -d.y / az;
+    return 4;
+  }
+  *s = -d.x / az;
+  *t = -d.y / az;
+  return 5;
 }
 
 namespace {
@@ -121,7 +161,7 @@ double rect_disc_area(double x0, double x1, double y0, double y1) {
     double a = std::max(xs[i], std::max(x0, -1.0)), b = std::min(xs[i + 1], std::min(x1, 1.0));
     if (b <= a) continue;
     double m = 0.5 * (a + b), h = std::sqrt(std::max(0.0, 1 - m * m));
-    bool top_is_h = h < y1, bottom_is_h = -h > y0;
+    bool top_is_h = h<y1, bottom_is_h = -h> y0;
     double top = top_is_h ? h : y1, bottom = bottom_is_h ? -h : y0;
     if (top <= bottom) continue;
     double c1 = (top_is_h ? 1.0 : 0.0) + (bottom_is_h ? 1.0 : 0.0);
@@ -181,13 +221,25 @@ Mapping::Mapping(MappingKind kind, int width, int height, double dead_angle_deg)
            height);
   };
   switch (kind) {
-    case MappingKind::LatLong: break;  // any aspect works; 2:1 gives square pixels at the equator
+    case MappingKind::LatLong:
+      break;  // any aspect works; 2:1 gives square pixels at the equator
     case MappingKind::MirrorBall:
     case MappingKind::Angular:
-    case MappingKind::Octahedral: need(width == height); break;
-    case MappingKind::CubeHCross: need(width % 4 == 0 && height * 4 == width * 3); face_ = width / 4; break;
-    case MappingKind::CubeVCross: need(width % 3 == 0 && height * 3 == width * 4); face_ = width / 3; break;
-    case MappingKind::CubeStrip: need(width == 6 * height); face_ = height; break;
+    case MappingKind::Octahedral:
+      need(width == height);
+      break;
+    case MappingKind::CubeHCross:
+      need(width % 4 == 0 && height * 4 == width * 3);
+      face_ = width / 4;
+      break;
+    case MappingKind::CubeVCross:
+      need(width % 3 == 0 && height * 3 == width * 4);
+      face_ = width / 3;
+      break;
+    case MappingKind::CubeStrip:
+      need(width == 6 * height);
+      face_ = height;
+      break;
   }
   if (kind == MappingKind::MirrorBall && dead_angle_deg > 0) cos_dead_ = std::cos(dead_angle_deg * kPi / 180.0);
 }
@@ -228,7 +280,10 @@ bool Mapping::to_direction(double px, double py, Vec3* d) const {
       double a = 2 * px / width_ - 1, b = 1 - 2 * py / height_;
       double r = std::sqrt(a * a + b * b);
       if (r > 1) return false;
-      if (r < 1e-300) { *d = {0, 0, 1}; return true; }
+      if (r < 1e-300) {
+        *d = {0, 0, 1};
+        return true;
+      }
       double th = kPi * r, s = std::sin(th) / r;
       *d = {s * a, s * b, std::cos(th)};
       return true;
@@ -244,7 +299,10 @@ bool Mapping::to_direction(double px, double py, Vec3* d) const {
       bool rot;
       if (!cell_face(cx, cy, &face, &rot)) return false;
       double s = 2 * (px - cx * face_) / face_ - 1, t = 2 * (py - cy * face_) / face_ - 1;
-      if (rot) { s = -s; t = -t; }
+      if (rot) {
+        s = -s;
+        t = -t;
+      }
       *d = normalize(cube_face_point(face, s, t));
       return true;
     }
@@ -279,7 +337,8 @@ bool Mapping::to_pixel(Vec3 d, double* px, double* py) const {
       double n = std::abs(d.x) + std::abs(d.y) + std::abs(d.z);
       double x = d.x / n, y = d.y / n, z = d.z / n, a, b;
       if (y >= 0) {
-        a = x; b = z;
+        a = x;
+        b = z;
       } else {
         a = (1 - std::abs(z)) * (x >= 0 ? 1 : -1);
         b = (1 - std::abs(x)) * (z >= 0 ? 1 : -1);
@@ -293,8 +352,14 @@ bool Mapping::to_pixel(Vec3 d, double* px, double* py) const {
       int face = cube_face_of(d, &s, &t);
       const auto* cells = kind_ == MappingKind::CubeHCross ? &kHCrossCells : &kVCrossCells;
       int cx = face, cy = 0;
-      if (kind_ != MappingKind::CubeStrip) { cx = (*cells)[face][0]; cy = (*cells)[face][1]; }
-      if (kind_ == MappingKind::CubeVCross && face == 5) { s = -s; t = -t; }
+      if (kind_ != MappingKind::CubeStrip) {
+        cx = (*cells)[face][0];
+        cy = (*cells)[face][1];
+      }
+      if (kind_ == MappingKind::CubeVCross && face == 5) {
+        s = -s;
+        t = -t;
+      }
       double fx = std::clamp((s + 1) * 0.5 * face_, 0.0, std::nextafter(static_cast<double>(face_), 0.0));
       double fy = std::clamp((t + 1) * 0.5 * face_, 0.0, std::nextafter(static_cast<double>(face_), 0.0));
       *px = cx * face_ + fx;
@@ -373,8 +438,10 @@ double Mapping::octahedral_solid_angle(int x, int y) const {
         std::vector<Vec3> v;
         for (auto pt : p) {
           double y3 = 1 - std::abs(pt.x) - std::abs(pt.y);
-          if (side == 0) v.push_back({pt.x, std::max(0.0, y3), pt.y});
-          else v.push_back({(1 - sb * pt.y) * sa, std::min(0.0, y3), (1 - sa * pt.x) * sb});
+          if (side == 0)
+            v.push_back({pt.x, std::max(0.0, y3), pt.y});
+          else
+            v.push_back({(1 - sb * pt.y) * sa, std::min(0.0, y3), (1 - sa * pt.x) * sb});
         }
         for (size_t i = 1; i + 1 < v.size(); ++i) total += triangle_solid_angle(v[0], v[i], v[i + 1]);
       }
@@ -384,7 +451,8 @@ double Mapping::octahedral_solid_angle(int x, int y) const {
 
 double Mapping::solid_angle_estimate(int x, int y) const {
   switch (kind_) {
-    case MappingKind::LatLong: return solid_angle(x, y);  // already cheap: two cosines
+    case MappingKind::LatLong:
+      return solid_angle(x, y);  // already cheap: two cosines
     case MappingKind::MirrorBall:
     case MappingKind::Angular: {
       double a = 2.0 * (x + 0.5) / width_ - 1, b = 1 - 2.0 * (y + 0.5) / height_;
@@ -393,7 +461,8 @@ double Mapping::solid_angle_estimate(int x, int y) const {
       if (kind_ == MappingKind::MirrorBall) return 4.0 * area;
       return area * (r < 1e-12 ? kPi * kPi : kPi * std::sin(kPi * r) / r);
     }
-    case MappingKind::Octahedral: return solid_angle(x, y);
+    case MappingKind::Octahedral:
+      return solid_angle(x, y);
     default: {
       int cx = x / face_, cy = y / face_, face;
       bool rot;
@@ -411,9 +480,12 @@ double Mapping::solid_angle(int x, int y) const {
       double t0 = kPi * y / height_, t1 = kPi * (y + 1) / height_;
       return (kTwoPi / width_) * (std::cos(t0) - std::cos(t1));
     }
-    case MappingKind::MirrorBall: return 4.0 * disc_area(x, y);
-    case MappingKind::Angular: return angular_solid_angle(x, y);
-    case MappingKind::Octahedral: return octahedral_solid_angle(x, y);
+    case MappingKind::MirrorBall:
+      return 4.0 * disc_area(x, y);
+    case MappingKind::Angular:
+      return angular_solid_angle(x, y);
+    case MappingKind::Octahedral:
+      return octahedral_solid_angle(x, y);
     default: {
       int cx = x / face_, cy = y / face_, face;
       bool rot;

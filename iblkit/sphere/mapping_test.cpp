@@ -166,7 +166,7 @@ TEST(Mapping, MirrorBallDeadAngle) {
   EXPECT_TRUE(m.to_pixel(normalize({0.5, 0, -1}), &px, &py));    // 26.6° from −Z
   Vec3 d;
   EXPECT_TRUE(m.to_direction(100, 100, &d));
-  EXPECT_NEAR(d.z, 1.0, 1e-3);  // centre reflects +Z, back towards the camera
+  EXPECT_NEAR(d.z, 1.0, 1e-3);                   // centre reflects +Z, back towards the camera
   EXPECT_FALSE(m.to_direction(199.9, 100, &d));  // rim: within the dead angle
 }
 

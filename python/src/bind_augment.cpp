@@ -23,8 +23,9 @@ namespace ag = ibl::augment;
 }  // namespace
 
 void init_augment(py::module_& m) {
-  py::class_<ag::LocalLight>(m, "LocalLight",
-                             "The captured light of a local scene as a composite uses it: a lat-long radiance map seen from `centre`.")
+  py::class_<ag::LocalLight>(
+      m, "LocalLight",
+      "The captured light of a local scene as a composite uses it: a lat-long radiance map seen from `centre`.")
       .def(py::init([](py::handle map, py::handle centre, py::object depth) {
              ag::LocalLight l;
              ibl::Image img = to_checked_image(map, "LocalLight: map");
@@ -34,7 +35,8 @@ void init_augment(py::module_& m) {
              ibl::require_point("LocalLight: centre", l.centre);
              if (!depth.is_none()) {
                l.depth = to_image(depth, "LocalLight: depth");
-               if (l.depth.width() != l.map.image.width() || l.depth.height() != l.map.image.height() || l.depth.channels() != 1)
+               if (l.depth.width() != l.map.image.width() || l.depth.height() != l.map.image.height() ||
+                   l.depth.channels() != 1)
                  throw py::value_error("LocalLight: depth must be (H, W) of the map's size");
              }
              l.source = "probe";
@@ -42,44 +44,60 @@ void init_augment(py::module_& m) {
            }),
            py::arg("map"), py::arg("centre"), py::arg("depth") = py::none(),
            "From a lat-long probe (H, 2H, 3) taken at `centre` and its optional (H, 2H) depth map (metres).")
-      .def_static("from_grid", [](const ibl::ilf::SHGrid& g, py::handle at, int size) {
-        return ag::light_from_grid(g, to_vec3(at, "from_grid: at"), size);
-      }, py::arg("grid"), py::arg("at"), py::arg("size") = 64, "An SH grid's radiance at `at` as a 2·size × size map.")
-      .def_static("from_probes", [](const ibl::fusion::ProbeSet& s, py::handle at, int size) {
-        ibl::Vec3 x = to_vec3(at, "from_probes: at");
-        py::gil_scoped_release nogil;
-        return ag::light_from_probes(s, x, size);
-      }, py::arg("probe_set"), py::arg("at"), py::arg("size") = 128, "A probe set fused at `at`.")
-      .def("as_median_cut", &ag::as_median_cut, py::arg("count"), "The baseline of `count` median-cut lights, each in one texel.")
-      .def_property_readonly("map", [](const ag::LocalLight& l) { return to_array(l.map.image); }, "(H, 2H, 3) lat-long radiance.")
+      .def_static(
+          "from_grid",
+          [](const ibl::ilf::SHGrid& g, py::handle at, int size) {
+            return ag::light_from_grid(g, to_vec3(at, "from_grid: at"), size);
+          },
+          py::arg("grid"), py::arg("at"), py::arg("size") = 64, "An SH grid's radiance at `at` as a 2·size × size map.")
+      .def_static(
+          "from_probes",
+          [](const ibl::fusion::ProbeSet& s, py::handle at, int size) {
+            ibl::Vec3 x = to_vec3(at, "from_probes: at");
+            py::gil_scoped_release nogil;
+            return ag::light_from_probes(s, x, size);
+          },
+          py::arg("probe_set"), py::arg("at"), py::arg("size") = 128, "A probe set fused at `at`.")
+      .def("as_median_cut", &ag::as_median_cut, py::arg("count"),
+           "The baseline of `count` median-cut lights, each in one texel.")
+      .def_property_readonly(
+          "map", [](const ag::LocalLight& l) { return to_array(l.map.image); }, "(H, 2H, 3) lat-long radiance.")
       .def_property_readonly("centre", [](const ag::LocalLight& l) { return vec3_tuple(l.centre); })
       .def_readonly("source", &ag::LocalLight::source);
 
   py::class_<ag::CompositeResult>(m, "CompositeResult", "The composite and its layers (float32 arrays) and statistics.")
-      .def_property_readonly("composite", [](const ag::CompositeResult& r) { return to_array(r.composite); }, "(H, W, 3) the photograph with the object.")
-      .def_property_readonly("mask", [](const ag::CompositeResult& r) { return to_array(r.mask, true); }, "(H, W) share of each pixel the object covers.")
-      .def_property_readonly("difference", [](const ag::CompositeResult& r) { return to_array(r.difference); }, "composite − photograph.")
-      .def_property_readonly("albedo", [](const ag::CompositeResult& r) { return to_array(r.albedo); }, "Estimated proxy albedo.")
+      .def_property_readonly(
+          "composite", [](const ag::CompositeResult& r) { return to_array(r.composite); },
+          "(H, W, 3) the photograph with the object.")
+      .def_property_readonly(
+          "mask", [](const ag::CompositeResult& r) { return to_array(r.mask, true); },
+          "(H, W) share of each pixel the object covers.")
+      .def_property_readonly(
+          "difference", [](const ag::CompositeResult& r) { return to_array(r.difference); }, "composite − photograph.")
+      .def_property_readonly(
+          "albedo", [](const ag::CompositeResult& r) { return to_array(r.albedo); }, "Estimated proxy albedo.")
       .def_property_readonly("render_without", [](const ag::CompositeResult& r) { return to_array(r.render_without); })
       .def_property_readonly("render_with", [](const ag::CompositeResult& r) { return to_array(r.render_with); })
-      .def_property_readonly("stats", [](const ag::CompositeResult& r) {
-        py::dict d;
-        d["proxy_pixels"] = r.stats.proxy_pixels;
-        d["object_pixels"] = r.stats.object_pixels;
-        d["changed_pixels"] = r.stats.changed_pixels;
-        d["albedo_over_one"] = r.stats.albedo_over_one;
-        d["unlit"] = r.stats.unlit;
-        d["seconds"] = r.stats.seconds;
-        return d;
-      })
+      .def_property_readonly("stats",
+                             [](const ag::CompositeResult& r) {
+                               py::dict d;
+                               d["proxy_pixels"] = r.stats.proxy_pixels;
+                               d["object_pixels"] = r.stats.object_pixels;
+                               d["changed_pixels"] = r.stats.changed_pixels;
+                               d["albedo_over_one"] = r.stats.albedo_over_one;
+                               d["unlit"] = r.stats.unlit;
+                               d["seconds"] = r.stats.seconds;
+                               return d;
+                             })
       .def_readonly("warnings", &ag::CompositeResult::warnings);
 
   static const ag::CompositeDesc kDefaults;  // the sample counts default to the library's (and the CLI's)
   m.def(
       "composite",
-      [](py::handle photo, ibl::geometry::Camera camera, const ibl::geometry::TriMesh& object, py::object probes, py::object light,
-         py::object proxy, py::object at_probe, const std::string& probe_depth, py::handle albedo, int median_cut, int light_samples,
-         int object_samples, int bounce_samples, int triangle_samples, int pixel_samples, int seed, bool shadows, py::object progress) {
+      [](py::handle photo, ibl::geometry::Camera camera, const ibl::geometry::TriMesh& object, py::object probes,
+         py::object light, py::object proxy, py::object at_probe, const std::string& probe_depth, py::handle albedo,
+         int median_cut, int light_samples, int object_samples, int bounce_samples, int triangle_samples,
+         int pixel_samples, int seed, bool shadows, py::object progress) {
         ibl::Image ph = to_checked_image(photo, "composite: photo");
         camera.width = ph.width();
         camera.height = ph.height();
@@ -93,7 +111,8 @@ void init_augment(py::module_& m) {
         if (!light.is_none() && py::isinstance<ag::LocalLight>(light)) {
           L = light.cast<ag::LocalLight>();
           if (proxy.is_none()) throw py::value_error("composite: a LocalLight needs proxy= (a TriMesh or a mesh file)");
-          prox = py::isinstance<py::str>(proxy) ? ibl::geometry::read_mesh(proxy.cast<std::string>()) : proxy.cast<ibl::geometry::TriMesh>();
+          prox = py::isinstance<py::str>(proxy) ? ibl::geometry::read_mesh(proxy.cast<std::string>())
+                                                : proxy.cast<ibl::geometry::TriMesh>();
         } else {  // files, as the CLI takes them
           ag::LightInput li;
           if (!probes.is_none()) li.probes = py::str(probes);
@@ -127,12 +146,13 @@ void init_augment(py::module_& m) {
         r.warnings.insert(r.warnings.begin(), warnings.begin(), warnings.end());
         return r;
       },
-      py::arg("photo"), py::arg("camera"), py::arg("object"), py::arg("probes") = py::none(), py::arg("light") = py::none(),
-      py::arg("proxy") = py::none(), py::arg("at_probe") = py::none(), py::arg("probe_depth") = "",
-      py::arg("albedo") = py::make_tuple(0.7, 0.7, 0.7), py::arg("median_cut") = 0, py::arg("light_samples") = kDefaults.light_samples,
-      py::arg("object_samples") = kDefaults.object_samples, py::arg("bounce_samples") = kDefaults.bounce_samples,
-      py::arg("triangle_samples") = kDefaults.triangle_samples, py::arg("pixel_samples") = kDefaults.pixel_samples,
-      py::arg("seed") = 1, py::arg("shadows") = true, py::arg("progress") = py::none(),
+      py::arg("photo"), py::arg("camera"), py::arg("object"), py::arg("probes") = py::none(),
+      py::arg("light") = py::none(), py::arg("proxy") = py::none(), py::arg("at_probe") = py::none(),
+      py::arg("probe_depth") = "", py::arg("albedo") = py::make_tuple(0.7, 0.7, 0.7), py::arg("median_cut") = 0,
+      py::arg("light_samples") = kDefaults.light_samples, py::arg("object_samples") = kDefaults.object_samples,
+      py::arg("bounce_samples") = kDefaults.bounce_samples, py::arg("triangle_samples") = kDefaults.triangle_samples,
+      py::arg("pixel_samples") = kDefaults.pixel_samples, py::arg("seed") = 1, py::arg("shadows") = true,
+      py::arg("progress") = py::none(),
       R"doc(Composites `object` (a TriMesh, e.g. TriMesh.object(at=…)) into the photograph (H, W, 3) seen by
 `camera` (its size becomes the photograph's), as `iblkit composite` (Debevec 1998): a CompositeResult
 with the composite, mask, difference, albedo and render layers.
@@ -146,8 +166,8 @@ pastes the object without its shadow. Releases the GIL; progress(stage, fraction
   m.def(
       "measure_composite",
       [](py::handle photo, py::handle composite, py::handle truth, py::handle mask, double threshold) {
-        auto e = ag::measure(to_image(photo, "photo", 3), to_image(composite, "composite", 3), to_image(truth, "truth", 3),
-                             to_image(mask, "mask", 1), threshold);
+        auto e = ag::measure(to_image(photo, "photo", 3), to_image(composite, "composite", 3),
+                             to_image(truth, "truth", 3), to_image(mask, "mask", 1), threshold);
         py::dict d;
         d["object"] = e.object;
         d["shadow"] = e.shadow;

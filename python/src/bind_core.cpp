@@ -29,7 +29,8 @@ void init_core(py::module_& m) {
       R"doc(Limits the threads one library call uses to n (0: all cores, the default). Calls from several
 Python threads run at once (each releases the GIL), each on up to n threads.)doc");
   m.def(
-      "threads", [] { return static_cast<int>(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism)); },
+      "threads",
+      [] { return static_cast<int>(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism)); },
       "The threads one library call may use now.");
 }
 

@@ -57,8 +57,10 @@ void init_geometry(py::module_& m) {
 (F, 3) vertex indices counter-clockwise seen from the front, optional unit vertex normals (V, 3) and
 UVs (V, 2). The array properties are copies.)doc")
       .def(py::init(&make_mesh), py::arg("positions"), py::arg("triangles"), py::arg("normals") = py::none(),
-           py::arg("uvs") = py::none(), "From (V, 3) positions and (F, 3) integer triangles (checked: indices in range, finite).")
-      .def_property_readonly("positions", [](const TriMesh& t) { return vec3_array(t.positions); }, "(V, 3) float64 positions.")
+           py::arg("uvs") = py::none(),
+           "From (V, 3) positions and (F, 3) integer triangles (checked: indices in range, finite).")
+      .def_property_readonly(
+          "positions", [](const TriMesh& t) { return vec3_array(t.positions); }, "(V, 3) float64 positions.")
       .def_property_readonly(
           "triangles",
           [](const TriMesh& t) {
@@ -67,62 +69,102 @@ UVs (V, 2). The array properties are copies.)doc")
             return a;
           },
           "(F, 3) uint32 vertex indices.")
-      .def_property_readonly("normals", [](const TriMesh& t) -> py::object {
-        if (!t.has_normals()) return py::none();
-        return vec3_array(t.normals);
-      }, "(V, 3) vertex normals, or None.")
-      .def_property_readonly("uvs", [](const TriMesh& t) -> py::object {
-        if (!t.has_uvs()) return py::none();
-        py::array_t<double> a({static_cast<py::ssize_t>(t.uvs.size()), py::ssize_t(2)});
-        for (size_t i = 0; i < t.uvs.size(); ++i) { a.mutable_at(i, 0) = t.uvs[i].x; a.mutable_at(i, 1) = t.uvs[i].y; }
-        return a;
-      }, "(V, 2) texture coordinates, or None.")
+      .def_property_readonly(
+          "normals",
+          [](const TriMesh& t) -> py::object {
+            if (!t.has_normals()) return py::none();
+            return vec3_array(t.normals);
+          },
+          "(V, 3) vertex normals, or None.")
+      .def_property_readonly(
+          "uvs",
+          [](const TriMesh& t) -> py::object {
+            if (!t.has_uvs()) return py::none();
+            py::array_t<double> a({static_cast<py::ssize_t>(t.uvs.size()), py::ssize_t(2)});
+            for (size_t i = 0; i < t.uvs.size(); ++i) {
+              a.mutable_at(i, 0) = t.uvs[i].x;
+              a.mutable_at(i, 1) = t.uvs[i].y;
+            }
+            return a;
+          },
+          "(V, 2) texture coordinates, or None.")
       .def_property_readonly("vertex_count", &TriMesh::vertex_count)
       .def_property_readonly("triangle_count", &TriMesh::triangle_count)
       .def("total_area", &TriMesh::total_area, "Σ of the triangle areas, m².")
-      .def("bounds", [](const TriMesh& t) {
-        ibl::Vec3 lo, hi;
-        t.bounds(&lo, &hi);
-        return py::make_tuple(vec3_tuple(lo), vec3_tuple(hi));
-      }, "(min, max) corners of the axis-aligned bounds.")
-      .def("with_normals", [](const TriMesh& t, double crease) { return ibl::geometry::with_normals(t, crease); },
-           py::arg("crease_deg") = 40.0, "A copy with vertex normals, smooth except across edges sharper than crease_deg.")
-      .def("transformed", [](const TriMesh& t, double scale, py::handle translation, py::object rotation) {
-        TriMesh c = t;
-        ibl::Mat3 R = rotation.is_none() ? ibl::Mat3::identity() : to_mat3(rotation, "transformed: rotation");
-        c.transform(R, scale, to_vec3(translation, "transformed: translation"));
-        return c;
-      }, py::arg("scale") = 1.0, py::arg("translation") = py::make_tuple(0, 0, 0), py::arg("rotation") = py::none(),
-      "A copy with p → rotation·(scale·p) + translation.")
-      .def("__repr__", [](const TriMesh& t) { return fmt::format("TriMesh({} vertices, {} triangles)", t.vertex_count(), t.triangle_count()); })
-      .def_static("load", [](const std::string& path) {
-        py::gil_scoped_release nogil;
-        return ibl::geometry::read_mesh(path);
-      }, py::arg("path"), "Reads a mesh file (OBJ, PLY, glTF, FBX … through assimp), every part joined, triangulated.")
-      .def("save_obj", [](const TriMesh& t, const std::string& path) { ibl::geometry::write_obj(path, t); }, py::arg("path"),
-           "Writes positions, UVs and triangles as Wavefront OBJ.")
-      .def_static("sphere", [](py::handle c, double r, int rings, int segments, bool inward) {
-        return ibl::geometry::make_sphere(to_vec3(c, "sphere: center"), ibl::require_number("sphere: radius", r, 1e-9, 1e6),
-                                          std::clamp(rings, 3, 4096), std::clamp(segments, 3, 8192), inward);
-      }, py::arg("center") = py::make_tuple(0, 0, 0), py::arg("radius") = 0.5, py::arg("rings") = 32, py::arg("segments") = 64,
-      py::arg("inward") = false, "A UV sphere with exact radial normals.")
-      .def_static("box", [](py::handle lo, py::handle hi, bool inward) {
-        ibl::Vec3 a = to_vec3(lo, "box: lo"), b = to_vec3(hi, "box: hi");
-        ibl::require_box("box", a, b, true);
-        return ibl::geometry::make_box(a, b, inward);
-      }, py::arg("lo"), py::arg("hi"), py::arg("inward") = false, "A closed axis-aligned box, front outwards (inwards: a room).")
-      .def_static("floor", [](double size, double height) { return ibl::geometry::make_floor(ibl::require_number("floor: size", size, 1e-9, 1e6), height); },
-                  py::arg("size"), py::arg("height") = 0.0, "A square of side `size` in the plane y = height facing +Y.")
-      .def_static("object", [](const std::string& kind, double size, int triangles, py::handle at) {
-        ibl::augment::ObjectDesc d;
-        d.kind = kind;
-        d.size = size;
-        d.triangles = triangles;
-        d.at = to_vec3(at, "object: at");
-        py::gil_scoped_release nogil;
-        return ibl::augment::make_object(d);
-      }, py::arg("kind") = "blob", py::arg("size") = 0.3, py::arg("triangles") = 20000, py::arg("at") = py::make_tuple(0, 0, 0),
-      R"doc(The object `iblkit composite` and `iblkit lab photograph --object` insert: "blob" (a bunny-sized
+      .def(
+          "bounds",
+          [](const TriMesh& t) {
+            ibl::Vec3 lo, hi;
+            t.bounds(&lo, &hi);
+            return py::make_tuple(vec3_tuple(lo), vec3_tuple(hi));
+          },
+          "(min, max) corners of the axis-aligned bounds.")
+      .def(
+          "with_normals", [](const TriMesh& t, double crease) { return ibl::geometry::with_normals(t, crease); },
+          py::arg("crease_deg") = 40.0,
+          "A copy with vertex normals, smooth except across edges sharper than crease_deg.")
+      .def(
+          "transformed",
+          [](const TriMesh& t, double scale, py::handle translation, py::object rotation) {
+            TriMesh c = t;
+            ibl::Mat3 R = rotation.is_none() ? ibl::Mat3::identity() : to_mat3(rotation, "transformed: rotation");
+            c.transform(R, scale, to_vec3(translation, "transformed: translation"));
+            return c;
+          },
+          py::arg("scale") = 1.0, py::arg("translation") = py::make_tuple(0, 0, 0), py::arg("rotation") = py::none(),
+          "A copy with p → rotation·(scale·p) + translation.")
+      .def("__repr__",
+           [](const TriMesh& t) {
+             return fmt::format("TriMesh({} vertices, {} triangles)", t.vertex_count(), t.triangle_count());
+           })
+      .def_static(
+          "load",
+          [](const std::string& path) {
+            py::gil_scoped_release nogil;
+            return ibl::geometry::read_mesh(path);
+          },
+          py::arg("path"), "Reads a mesh file (OBJ, PLY, glTF, FBX … through assimp), every part joined, triangulated.")
+      .def(
+          "save_obj", [](const TriMesh& t, const std::string& path) { ibl::geometry::write_obj(path, t); },
+          py::arg("path"), "Writes positions, UVs and triangles as Wavefront OBJ.")
+      .def_static(
+          "sphere",
+          [](py::handle c, double r, int rings, int segments, bool inward) {
+            return ibl::geometry::make_sphere(to_vec3(c, "sphere: center"),
+                                              ibl::require_number("sphere: radius", r, 1e-9, 1e6),
+                                              std::clamp(rings, 3, 4096), std::clamp(segments, 3, 8192), inward);
+          },
+          py::arg("center") = py::make_tuple(0, 0, 0), py::arg("radius") = 0.5, py::arg("rings") = 32,
+          py::arg("segments") = 64, py::arg("inward") = false, "A UV sphere with exact radial normals.")
+      .def_static(
+          "box",
+          [](py::handle lo, py::handle hi, bool inward) {
+            ibl::Vec3 a = to_vec3(lo, "box: lo"), b = to_vec3(hi, "box: hi");
+            ibl::require_box("box", a, b, true);
+            return ibl::geometry::make_box(a, b, inward);
+          },
+          py::arg("lo"), py::arg("hi"), py::arg("inward") = false,
+          "A closed axis-aligned box, front outwards (inwards: a room).")
+      .def_static(
+          "floor",
+          [](double size, double height) {
+            return ibl::geometry::make_floor(ibl::require_number("floor: size", size, 1e-9, 1e6), height);
+          },
+          py::arg("size"), py::arg("height") = 0.0, "A square of side `size` in the plane y = height facing +Y.")
+      .def_static(
+          "object",
+          [](const std::string& kind, double size, int triangles, py::handle at) {
+            ibl::augment::ObjectDesc d;
+            d.kind = kind;
+            d.size = size;
+            d.triangles = triangles;
+            d.at = to_vec3(at, "object: at");
+            py::gil_scoped_release nogil;
+            return ibl::augment::make_object(d);
+          },
+          py::arg("kind") = "blob", py::arg("size") = 0.3, py::arg("triangles") = 20000,
+          py::arg("at") = py::make_tuple(0, 0, 0),
+          R"doc(The object `iblkit composite` and `iblkit lab photograph --object` insert: "blob" (a bunny-sized
 procedural object), "sphere", or a mesh file, its largest extent `size` metres, centred at `at`.)doc");
 
   py::class_<Camera>(m, "Camera",
@@ -140,52 +182,82 @@ row 0 at the top.)doc")
              ibl::augment::validate_camera(c, "Camera");
              return c;
            }),
-           py::arg("eye") = py::make_tuple(0, 0.3, 1.2), py::arg("target") = py::make_tuple(0, 0, 0), py::arg("up") = py::make_tuple(0, 1, 0),
-           py::arg("fov_y_deg") = 40.0, py::arg("width") = 1024, py::arg("height") = 768, "Checked: distinct eye and target, up not along the view.")
-      .def_property("eye", [](const Camera& c) { return vec3_tuple(c.eye); }, [](Camera& c, py::handle v) { c.eye = to_vec3(v, "Camera.eye"); })
-      .def_property("target", [](const Camera& c) { return vec3_tuple(c.target); }, [](Camera& c, py::handle v) { c.target = to_vec3(v, "Camera.target"); })
-      .def_property("up", [](const Camera& c) { return vec3_tuple(c.up); }, [](Camera& c, py::handle v) { c.up = to_vec3(v, "Camera.up"); })
+           py::arg("eye") = py::make_tuple(0, 0.3, 1.2), py::arg("target") = py::make_tuple(0, 0, 0),
+           py::arg("up") = py::make_tuple(0, 1, 0), py::arg("fov_y_deg") = 40.0, py::arg("width") = 1024,
+           py::arg("height") = 768, "Checked: distinct eye and target, up not along the view.")
+      .def_property(
+          "eye", [](const Camera& c) { return vec3_tuple(c.eye); },
+          [](Camera& c, py::handle v) { c.eye = to_vec3(v, "Camera.eye"); })
+      .def_property(
+          "target", [](const Camera& c) { return vec3_tuple(c.target); },
+          [](Camera& c, py::handle v) { c.target = to_vec3(v, "Camera.target"); })
+      .def_property(
+          "up", [](const Camera& c) { return vec3_tuple(c.up); },
+          [](Camera& c, py::handle v) { c.up = to_vec3(v, "Camera.up"); })
       .def_readwrite("fov_y_deg", &Camera::fov_y_deg, "Vertical field of view, degrees.")
       .def_readwrite("width", &Camera::width, "Frame width, pixels.")
       .def_readwrite("height", &Camera::height, "Frame height, pixels.")
-      .def("ray_directions", [](const Camera& c) {
-        ibl::geometry::require_camera(c);
-        if (c.width < 1 || c.height < 1 || c.width > 16384 || c.height > 16384) ibl::fail(ibl::ErrorKind::Value, "Camera: frame size {}x{}", c.width, c.height);
-        py::array_t<double> a({py::ssize_t(c.height), py::ssize_t(c.width), py::ssize_t(3)});
-        double* p = a.mutable_data();
-        for (int y = 0; y < c.height; ++y)
-          for (int x = 0; x < c.width; ++x) {
-            ibl::Vec3 d = c.pixel_direction(x, y);
-            size_t i = (static_cast<size_t>(y) * c.width + x) * 3;
-            p[i] = d.x; p[i + 1] = d.y; p[i + 2] = d.z;
-          }
-        return a;
-      }, "(H, W, 3) unit world directions through every pixel centre.")
-      .def("view_matrix", [](const Camera& c) {
-        auto v = c.view();
-        py::array_t<float> a({4, 4});
-        for (int r = 0; r < 4; ++r) for (int col = 0; col < 4; ++col) a.mutable_at(r, col) = v[col * 4 + r];
-        return a;
-      }, "World → eye 4×4 matrix (GL lookAt; row-major here).")
-      .def("projection_matrix", [](const Camera& c) {
-        auto v = c.projection();
-        py::array_t<float> a({4, 4});
-        for (int r = 0; r < 4; ++r) for (int col = 0; col < 4; ++col) a.mutable_at(r, col) = v[col * 4 + r];
-        return a;
-      }, "Eye → clip 4×4 matrix (GL perspective; row-major here).")
-      .def("to_json", [](const Camera& c) { return ibl::augment::camera_to_json(c).dump(2); }, "The iblkit.camera/1 text (with the size).")
-      .def_static("from_json", [](const std::string& text) {
-        nlohmann::json j;
-        try { j = nlohmann::json::parse(text); } catch (const nlohmann::json::exception& e) {
-          ibl::fail(ibl::ErrorKind::Format, "Camera.from_json: not JSON ({})", e.what());
-        }
-        return ibl::augment::camera_from_json(j, "json");
-      }, py::arg("text"), "Parses iblkit.camera/1 text (width and height 0 when absent).")
-      .def("save", [](const Camera& c, const std::string& p) { ibl::augment::write_camera(p, c); }, py::arg("path"), "Writes an iblkit.camera/1 file.")
+      .def(
+          "ray_directions",
+          [](const Camera& c) {
+            ibl::geometry::require_camera(c);
+            if (c.width < 1 || c.height < 1 || c.width > 16384 || c.height > 16384)
+              ibl::fail(ibl::ErrorKind::Value, "Camera: frame size {}x{}", c.width, c.height);
+            py::array_t<double> a({py::ssize_t(c.height), py::ssize_t(c.width), py::ssize_t(3)});
+            double* p = a.mutable_data();
+            for (int y = 0; y < c.height; ++y)
+              for (int x = 0; x < c.width; ++x) {
+                ibl::Vec3 d = c.pixel_direction(x, y);
+                size_t i = (static_cast<size_t>(y) * c.width + x) * 3;
+                p[i] = d.x;
+                p[i + 1] = d.y;
+                p[i + 2] = d.z;
+              }
+            return a;
+          },
+          "(H, W, 3) unit world directions through every pixel centre.")
+      .def(
+          "view_matrix",
+          [](const Camera& c) {
+            auto v = c.view();
+            py::array_t<float> a({4, 4});
+            for (int r = 0; r < 4; ++r)
+              for (int col = 0; col < 4; ++col) a.mutable_at(r, col) = v[col * 4 + r];
+            return a;
+          },
+          "World → eye 4×4 matrix (GL lookAt; row-major here).")
+      .def(
+          "projection_matrix",
+          [](const Camera& c) {
+            auto v = c.projection();
+            py::array_t<float> a({4, 4});
+            for (int r = 0; r < 4; ++r)
+              for (int col = 0; col < 4; ++col) a.mutable_at(r, col) = v[col * 4 + r];
+            return a;
+          },
+          "Eye → clip 4×4 matrix (GL perspective; row-major here).")
+      .def(
+          "to_json", [](const Camera& c) { return ibl::augment::camera_to_json(c).dump(2); },
+          "The iblkit.camera/1 text (with the size).")
+      .def_static(
+          "from_json",
+          [](const std::string& text) {
+            nlohmann::json j;
+            try {
+              j = nlohmann::json::parse(text);
+            } catch (const nlohmann::json::exception& e) {
+              ibl::fail(ibl::ErrorKind::Format, "Camera.from_json: not JSON ({})", e.what());
+            }
+            return ibl::augment::camera_from_json(j, "json");
+          },
+          py::arg("text"), "Parses iblkit.camera/1 text (width and height 0 when absent).")
+      .def(
+          "save", [](const Camera& c, const std::string& p) { ibl::augment::write_camera(p, c); }, py::arg("path"),
+          "Writes an iblkit.camera/1 file.")
       .def_static("load", &ibl::augment::read_camera, py::arg("path"), "Reads an iblkit.camera/1 file.")
       .def("__repr__", [](const Camera& c) {
-        return fmt::format("Camera(eye=({:g}, {:g}, {:g}), target=({:g}, {:g}, {:g}), fov_y_deg={:g}, {}x{})", c.eye.x, c.eye.y, c.eye.z,
-                           c.target.x, c.target.y, c.target.z, c.fov_y_deg, c.width, c.height);
+        return fmt::format("Camera(eye=({:g}, {:g}, {:g}), target=({:g}, {:g}, {:g}), fov_y_deg={:g}, {}x{})", c.eye.x,
+                           c.eye.y, c.eye.z, c.target.x, c.target.y, c.target.z, c.fov_y_deg, c.width, c.height);
       });
 }
 

@@ -33,16 +33,20 @@ py::array coefficients_view(py::object self) {
 
 SHGrid make_grid(py::handle coefficients, py::handle lo, py::handle hi) {
   py::array a = py::array::ensure(coefficients);
-  if (!a || a.dtype().kind() != 'f') throw py::type_error("SHGrid: coefficients must be a float array (nz, ny, nx, K, 3)");
+  if (!a || a.dtype().kind() != 'f')
+    throw py::type_error("SHGrid: coefficients must be a float array (nz, ny, nx, K, 3)");
   if (a.ndim() != 5 || a.shape(4) != 3)
-    throw py::value_error(fmt::format("SHGrid: coefficients must have shape (nz, ny, nx, K, 3), got ndim {}", a.ndim()));
+    throw py::value_error(
+        fmt::format("SHGrid: coefficients must have shape (nz, ny, nx, K, 3), got ndim {}", a.ndim()));
   int nz = int(a.shape(0)), ny = int(a.shape(1)), nx = int(a.shape(2)), K = int(a.shape(3));
   int bands = static_cast<int>(std::lround(std::sqrt(double(K))));
   if (bands * bands != K || bands < 1 || bands > ibl::sh::kMaxBands)
     throw py::value_error(fmt::format("SHGrid: K = {} is not bands² with bands in 1..{}", K, ibl::sh::kMaxBands));
   if (nx < 2 || ny < 2 || nz < 2) throw py::value_error("SHGrid: at least 2 grid points per axis");
   ibl::ilf::GridDesc gd;
-  gd.nx = nx; gd.ny = ny; gd.nz = nz;
+  gd.nx = nx;
+  gd.ny = ny;
+  gd.nz = nz;
   gd.volume = {to_vec3(lo, "SHGrid: min"), to_vec3(hi, "SHGrid: max")};
   ibl::require_box("SHGrid volume", gd.volume.min, gd.volume.max, true);
   SHGrid g(gd, bands);
@@ -123,14 +127,18 @@ grid's storage (no copy); point (i, j, k) sits at min + (max − min)·(i/(nx−
       .def(py::init(&make_grid), py::arg("coefficients"), py::arg("min"), py::arg("max"),
            "From a (nz, ny, nx, K, 3) array (copied) and the volume's corners.")
       .def_property_readonly("coefficients", &coefficients_view, "(nz, ny, nx, K, 3) float32 view of the coefficients.")
-      .def_property_readonly("min", [](const SHGrid& g) { return vec3_tuple(g.grid().volume.min); }, "Volume corner (x, y, z), metres.")
-      .def_property_readonly("max", [](const SHGrid& g) { return vec3_tuple(g.grid().volume.max); }, "Opposite corner, metres.")
-      .def_property_readonly("resolution", [](const SHGrid& g) { return py::make_tuple(g.grid().nx, g.grid().ny, g.grid().nz); },
-                             "(nx, ny, nz) grid points.")
+      .def_property_readonly(
+          "min", [](const SHGrid& g) { return vec3_tuple(g.grid().volume.min); }, "Volume corner (x, y, z), metres.")
+      .def_property_readonly(
+          "max", [](const SHGrid& g) { return vec3_tuple(g.grid().volume.max); }, "Opposite corner, metres.")
+      .def_property_readonly(
+          "resolution", [](const SHGrid& g) { return py::make_tuple(g.grid().nx, g.grid().ny, g.grid().nz); },
+          "(nx, ny, nz) grid points.")
       .def_property_readonly("bands", &SHGrid::bands, "SH bands (K = bands²).")
-      .def("__repr__", [](const SHGrid& g) {
-        return fmt::format("SHGrid({}x{}x{}, bands={})", g.grid().nx, g.grid().ny, g.grid().nz, g.bands());
-      })
+      .def("__repr__",
+           [](const SHGrid& g) {
+             return fmt::format("SHGrid({}x{}x{}, bands={})", g.grid().nx, g.grid().ny, g.grid().nz, g.bands());
+           })
       .def(
           "eval",
           [](const SHGrid& g, py::handle points) {
@@ -143,15 +151,20 @@ grid's storage (no copy); point (i, j, k) sits at min + (max − min)·(i/(nx−
               for (size_t i = 0; i < p.size(); ++i) {
                 auto c = g.coeffs_at(p[i]);
                 for (py::ssize_t k = 0; k < K; ++k) {
-                  o[(i * K + k) * 3] = c.c[k].x; o[(i * K + k) * 3 + 1] = c.c[k].y; o[(i * K + k) * 3 + 2] = c.c[k].z;
+                  o[(i * K + k) * 3] = c.c[k].x;
+                  o[(i * K + k) * 3 + 1] = c.c[k].y;
+                  o[(i * K + k) * 3 + 2] = c.c[k].z;
                 }
               }
             }
             return out;
           },
-          py::arg("points"), "Trilinearly interpolated coefficients at each point ((N, 3), clamped to the volume): (N, K, 3).")
-      .def("coeffs_at", [](const SHGrid& g, py::handle p) { return g.coeffs_at(points_arg(p, "SHGrid.coeffs_at: point").at(0)); },
-           py::arg("point"), "The interpolated coefficients at one point as SHCoeffs.")
+          py::arg("points"),
+          "Trilinearly interpolated coefficients at each point ((N, 3), clamped to the volume): (N, K, 3).")
+      .def(
+          "coeffs_at",
+          [](const SHGrid& g, py::handle p) { return g.coeffs_at(points_arg(p, "SHGrid.coeffs_at: point").at(0)); },
+          py::arg("point"), "The interpolated coefficients at one point as SHCoeffs.")
       .def(
           "irradiance",
           [](const SHGrid& g, py::handle points, py::handle normals) {
@@ -164,7 +177,8 @@ grid's storage (no copy); point (i, j, k) sits at min + (max − min)·(i/(nx−
             }
             return vec3_array(e);
           },
-          py::arg("points"), py::arg("normals"), "Irradiance E(p, n), W/m², at each point and normal (one normal for all, or one each).")
+          py::arg("points"), py::arg("normals"),
+          "Irradiance E(p, n), W/m², at each point and normal (one normal for all, or one each).")
       .def(
           "radiance",
           [](const SHGrid& g, py::handle points, py::handle dirs) {
@@ -187,30 +201,39 @@ grid's storage (no copy); point (i, j, k) sits at min + (max − min)·(i/(nx−
           },
           py::arg("points"), py::arg("directions"), py::arg("exponent"),
           "Normalised Phong-lobe response around reflection directions r (Löw et al. §4).")
-      .def("save", [](const SHGrid& g, const std::string& p) { ibl::ilf::write_shgrid(p, g); }, py::arg("path"),
-           "Writes a .shgrid file (atomically).")
-      .def_static("load", [](const std::string& p) { return ibl::ilf::read_shgrid(p); }, py::arg("path"), "Reads a .shgrid file.");
+      .def(
+          "save", [](const SHGrid& g, const std::string& p) { ibl::ilf::write_shgrid(p, g); }, py::arg("path"),
+          "Writes a .shgrid file (atomically).")
+      .def_static(
+          "load", [](const std::string& p) { return ibl::ilf::read_shgrid(p); }, py::arg("path"),
+          "Reads a .shgrid file.");
 
   using ibl::ilf::AdaptiveGrid;
   py::class_<AdaptiveGrid>(m, "AdaptiveGrid",
                            R"doc(An adaptive SH grid (the library's ilf::AdaptiveGrid, the .shtree file): a dense grid's
 coefficients kept at full resolution only where coarser levels miss them by more than the tolerance
 (docs/ilf.md, "Adaptive storage"). Made by `ilf.adapt(grid, tolerance)`.)doc")
-      .def_property_readonly("resolution", [](const AdaptiveGrid& t) { return py::make_tuple(t.grid().nx, t.grid().ny, t.grid().nz); },
-                             "(nx, ny, nz) points of the fine grid (level 0).")
-      .def_property_readonly("min", [](const AdaptiveGrid& t) { return vec3_tuple(t.grid().volume.min); }, "Volume corner (x, y, z), metres.")
-      .def_property_readonly("max", [](const AdaptiveGrid& t) { return vec3_tuple(t.grid().volume.max); }, "Opposite corner, metres.")
+      .def_property_readonly(
+          "resolution", [](const AdaptiveGrid& t) { return py::make_tuple(t.grid().nx, t.grid().ny, t.grid().nz); },
+          "(nx, ny, nz) points of the fine grid (level 0).")
+      .def_property_readonly(
+          "min", [](const AdaptiveGrid& t) { return vec3_tuple(t.grid().volume.min); },
+          "Volume corner (x, y, z), metres.")
+      .def_property_readonly(
+          "max", [](const AdaptiveGrid& t) { return vec3_tuple(t.grid().volume.max); }, "Opposite corner, metres.")
       .def_property_readonly("bands", &AdaptiveGrid::bands, "SH bands (K = bands²).")
-      .def_property_readonly("levels", &AdaptiveGrid::levels, "Levels, 0 (the fine grid) to the top (2 points per axis).")
+      .def_property_readonly("levels", &AdaptiveGrid::levels,
+                             "Levels, 0 (the fine grid) to the top (2 points per axis).")
       .def_property_readonly("brick", &AdaptiveGrid::brick, "Points per brick axis.")
       .def_property_readonly("tolerance", &AdaptiveGrid::tolerance, "The tolerance it was made with (× rms).")
       .def_property_readonly("rms", &AdaptiveGrid::rms, "RMS over the fine points of the coefficient vector's L2 norm.")
       .def_property_readonly("stored_points", &AdaptiveGrid::stored_points, "Points stored over all levels.")
       .def_property_readonly("file_bytes", &AdaptiveGrid::file_bytes, "Bytes of its .shtree file.")
-      .def("__repr__", [](const AdaptiveGrid& t) {
-        return fmt::format("AdaptiveGrid({}x{}x{}, bands={}, {} points stored)", t.grid().nx, t.grid().ny, t.grid().nz, t.bands(),
-                           t.stored_points());
-      })
+      .def("__repr__",
+           [](const AdaptiveGrid& t) {
+             return fmt::format("AdaptiveGrid({}x{}x{}, bands={}, {} points stored)", t.grid().nx, t.grid().ny,
+                                t.grid().nz, t.bands(), t.stored_points());
+           })
       .def(
           "eval",
           [](const AdaptiveGrid& t, py::handle points) {
@@ -223,7 +246,9 @@ coefficients kept at full resolution only where coarser levels miss them by more
               for (size_t i = 0; i < p.size(); ++i) {
                 auto c = t.coeffs_at(p[i]);
                 for (py::ssize_t k = 0; k < K; ++k) {
-                  o[(i * K + k) * 3] = c.c[k].x; o[(i * K + k) * 3 + 1] = c.c[k].y; o[(i * K + k) * 3 + 2] = c.c[k].z;
+                  o[(i * K + k) * 3] = c.c[k].x;
+                  o[(i * K + k) * 3 + 1] = c.c[k].y;
+                  o[(i * K + k) * 3 + 2] = c.c[k].z;
                 }
               }
             }
@@ -249,16 +274,22 @@ coefficients kept at full resolution only where coarser levels miss them by more
               } else {
                 auto g = grid.cast<std::vector<int>>();
                 if (g.size() != 3) throw py::value_error("AdaptiveGrid.to_dense: grid must be n or (nx, ny, nz)");
-                n[0] = g[0]; n[1] = g[1]; n[2] = g[2];
+                n[0] = g[0];
+                n[1] = g[1];
+                n[2] = g[2];
               }
             }
             py::gil_scoped_release nogil;
             return t.to_dense(n[0], n[1], n[2]);
           },
-          py::arg("grid") = py::none(), "The dense SHGrid of n or (nx, ny, nz) points (default: the fine grid's), each looked up.")
-      .def("save", [](const AdaptiveGrid& t, const std::string& p) { ibl::ilf::write_adaptive(p, t); }, py::arg("path"),
-           "Writes a .shtree file (atomically).")
-      .def_static("load", [](const std::string& p) { return ibl::ilf::read_adaptive(p); }, py::arg("path"), "Reads a .shtree file.");
+          py::arg("grid") = py::none(),
+          "The dense SHGrid of n or (nx, ny, nz) points (default: the fine grid's), each looked up.")
+      .def(
+          "save", [](const AdaptiveGrid& t, const std::string& p) { ibl::ilf::write_adaptive(p, t); }, py::arg("path"),
+          "Writes a .shtree file (atomically).")
+      .def_static(
+          "load", [](const std::string& p) { return ibl::ilf::read_adaptive(p); }, py::arg("path"),
+          "Reads a .shtree file.");
 
   m.def(
       "adapt",
@@ -266,15 +297,16 @@ coefficients kept at full resolution only where coarser levels miss them by more
         py::gil_scoped_release nogil;
         return ibl::ilf::make_adaptive(g, {.tolerance = tolerance, .brick = brick});
       },
-      py::arg("grid"), py::arg("tolerance") = ibl::ilf::AdaptDesc{}.tolerance, py::arg("brick") = ibl::ilf::AdaptDesc{}.brick,
+      py::arg("grid"), py::arg("tolerance") = ibl::ilf::AdaptDesc{}.tolerance,
+      py::arg("brick") = ibl::ilf::AdaptDesc{}.brick,
       "The AdaptiveGrid of a dense SHGrid: within tolerance × rms of its lookup everywhere (`iblkit ilf adapt`).");
 
   m.def(
       "build",
-      [](py::object source, py::object positions, py::object grid, int bands, py::object volume, const std::string& mapping,
-         double dead_angle, py::object rotation, const std::string& repair, double kernel_cells, double raster_cells,
-         py::object directions, const std::string& memory, bool skip_bad, bool sanitize, py::object subsample,
-         const std::string& work_dir, py::object progress) {
+      [](py::object source, py::object positions, py::object grid, int bands, py::object volume,
+         const std::string& mapping, double dead_angle, py::object rotation, const std::string& repair,
+         double kernel_cells, double raster_cells, py::object directions, const std::string& memory, bool skip_bad,
+         bool sanitize, py::object subsample, const std::string& work_dir, py::object progress) {
         ibl::ilf::BuildDesc bd;
         // grid: n or (nx, ny, nz)
         if (py::isinstance<py::int_>(grid)) {
@@ -282,7 +314,9 @@ coefficients kept at full resolution only where coarser levels miss them by more
         } else {
           auto g = grid.cast<std::vector<int>>();
           if (g.size() != 3) throw py::value_error("ilf.build: grid must be n or (nx, ny, nz)");
-          bd.nx = g[0]; bd.ny = g[1]; bd.nz = g[2];
+          bd.nx = g[0];
+          bd.ny = g[1];
+          bd.nz = g[2];
         }
         bd.bands = bands;
         if (!volume.is_none()) {
@@ -299,16 +333,26 @@ coefficients kept at full resolution only where coarser levels miss them by more
           bd.buckets.octahedral = 0;
         } else {
           int n = directions.cast<int>();
-          if (n < 2 || n > 1024) ibl::fail(ibl::ErrorKind::Value, "ilf.build: directions must be 'auto', 'pixel' or N in [2, 1024]");
+          if (n < 2 || n > 1024)
+            ibl::fail(ibl::ErrorKind::Value, "ilf.build: directions must be 'auto', 'pixel' or N in [2, 1024]");
           bd.buckets.octahedral = n;
         }
         {  // memory: bytes, or "2G", "512M"
           double mult = 1;
           std::string s = memory;
-          if (!s.empty() && (s.back() == 'G' || s.back() == 'g')) { mult = 1 << 30; s.pop_back(); }
-          else if (!s.empty() && (s.back() == 'M' || s.back() == 'm')) { mult = 1 << 20; s.pop_back(); }
+          if (!s.empty() && (s.back() == 'G' || s.back() == 'g')) {
+            mult = 1 << 30;
+            s.pop_back();
+          } else if (!s.empty() && (s.back() == 'M' || s.back() == 'm')) {
+            mult = 1 << 20;
+            s.pop_back();
+          }
           double v = 0;
-          try { v = std::stod(s); } catch (...) { ibl::fail(ibl::ErrorKind::Value, "ilf.build: memory '{}': expected bytes, or e.g. 512M, 2G", memory); }
+          try {
+            v = std::stod(s);
+          } catch (...) {
+            ibl::fail(ibl::ErrorKind::Value, "ilf.build: memory '{}': expected bytes, or e.g. 512M, 2G", memory);
+          }
           if (!(v * mult >= (64 << 20))) ibl::fail(ibl::ErrorKind::Value, "ilf.build: memory '{}' below 64M", memory);
           bd.buckets.memory_bytes = static_cast<size_t>(v * mult);
         }
@@ -322,8 +366,10 @@ coefficients kept at full resolution only where coarser levels miss them by more
         ibl::ilf::Sequence seq;
         ibl::ilf::SequenceReport srep;
         std::optional<TempDir> tmp;
-        if (py::isinstance<py::str>(source) || py::isinstance(source, py::module_::import("pathlib").attr("PurePath"))) {
-          if (!positions.is_none()) throw py::value_error("ilf.build: positions go with probe images, not with a sequence file");
+        if (py::isinstance<py::str>(source) ||
+            py::isinstance(source, py::module_::import("pathlib").attr("PurePath"))) {
+          if (!positions.is_none())
+            throw py::value_error("ilf.build: positions go with probe images, not with a sequence file");
           std::string path = py::str(source);
           ibl::ilf::SequenceReadDesc rd;
           rd.skip_bad = skip_bad;
@@ -335,7 +381,8 @@ coefficients kept at full resolution only where coarser levels miss them by more
           if (positions.is_none()) throw py::value_error("ilf.build: probe images need positions=(N, 3)");
           auto pos = to_vec3s(positions, "ilf.build: positions");
           size_t n = py::len(source);
-          if (n != pos.size()) throw py::value_error(fmt::format("ilf.build: {} probe images but {} positions", n, pos.size()));
+          if (n != pos.size())
+            throw py::value_error(fmt::format("ilf.build: {} probe images but {} positions", n, pos.size()));
           if (n < 1) throw py::value_error("ilf.build: no probes");
           tmp.emplace(work_dir);
           fs::create_directories(tmp->path / "frames");
@@ -347,10 +394,12 @@ coefficients kept at full resolution only where coarser levels miss them by more
           for (size_t i = 0; i < n; ++i) {
             ibl::Image img = to_image(py::object(source[py::int_(i)]), "ilf.build: probe image");
             if (i == 0) {
-              w0 = img.width(); h0 = img.height();
+              w0 = img.width();
+              h0 = img.height();
               seq.mapping = mapping_of(mapping, w0, h0, dead_angle).kind();
             } else if (img.width() != w0 || img.height() != h0) {
-              ibl::fail(ibl::ErrorKind::Value, "ilf.build: probe {} is {}x{}, probe 0 {}x{}", i, img.width(), img.height(), w0, h0);
+              ibl::fail(ibl::ErrorKind::Value, "ilf.build: probe {} is {}x{}, probe 0 {}x{}", i, img.width(),
+                        img.height(), w0, h0);
             }
             ibl::require_point(fmt::format("ilf.build: probe {} position", i), pos[i]);
             std::string file = (tmp->path / "frames" / fmt::format("{:06d}.pfm", i)).string();
@@ -364,7 +413,10 @@ coefficients kept at full resolution only where coarser levels miss them by more
           wr.rethrow();
           ibl::Vec3 lo = pos[0], hi = pos[0];
           for (auto p : pos)
-            for (int a = 0; a < 3; ++a) { lo[a] = std::min(lo[a], p[a]); hi[a] = std::max(hi[a], p[a]); }
+            for (int a = 0; a < 3; ++a) {
+              lo[a] = std::min(lo[a], p[a]);
+              hi[a] = std::max(hi[a], p[a]);
+            }
           seq.volume = {lo, hi};
           ibl::ilf::write_sequence(seq.manifest, seq);
           ibl::ilf::SequenceReadDesc rd;
@@ -385,11 +437,12 @@ coefficients kept at full resolution only where coarser levels miss them by more
         for (auto& r : srep.reasons) rep.skip_reasons.insert(rep.skip_reasons.begin(), r);
         return py::make_tuple(std::move(g), report_dict(rep));
       },
-      py::arg("source"), py::arg("positions") = py::none(), py::arg("grid") = 16, py::arg("bands") = 5, py::arg("volume") = py::none(),
-      py::arg("mapping") = "auto", py::arg("dead_angle") = 0.0, py::arg("rotation") = py::none(), py::arg("repair") = "mip",
-      py::arg("kernel_cells") = 3.0, py::arg("raster_cells") = 0.5, py::arg("directions") = "auto", py::arg("memory") = "2G",
-      py::arg("skip_bad") = false, py::arg("sanitize") = false, py::arg("subsample") = py::none(), py::arg("work_dir") = "",
-      py::arg("progress") = py::none(),
+      py::arg("source"), py::arg("positions") = py::none(), py::arg("grid") = 16, py::arg("bands") = 5,
+      py::arg("volume") = py::none(), py::arg("mapping") = "auto", py::arg("dead_angle") = 0.0,
+      py::arg("rotation") = py::none(), py::arg("repair") = "mip", py::arg("kernel_cells") = 3.0,
+      py::arg("raster_cells") = 0.5, py::arg("directions") = "auto", py::arg("memory") = "2G",
+      py::arg("skip_bad") = false, py::arg("sanitize") = false, py::arg("subsample") = py::none(),
+      py::arg("work_dir") = "", py::arg("progress") = py::none(),
       R"doc(Builds an SH grid from a probe sequence, as `iblkit ilf build`; returns (SHGrid, report dict).
 
 source: an iblkit.sequence/1 manifest path (its buckets go to work_dir, default PATH.buckets, and are

@@ -22,18 +22,23 @@ using ibl::sphere::MappingKind;
 ibl::sphere::Mapping output_mapping(MappingKind k, int size, int in_w, int in_h) {
   if (size == 0) {
     double pixels = static_cast<double>(in_w) * in_h;
-    double per = k == MappingKind::LatLong ? 2
+    double per = k == MappingKind::LatLong                                                                       ? 2
                  : (k == MappingKind::CubeHCross || k == MappingKind::CubeVCross || k == MappingKind::CubeStrip) ? 6
-                                                                                                                  : 1;
+                                                                                                                 : 1;
     size = std::max(1, static_cast<int>(std::sqrt(pixels / per)));
   }
   if (size < 1 || size > 16384) ibl::fail(ibl::ErrorKind::Value, "size must be in 1..16384 (got {})", size);
   switch (k) {
-    case MappingKind::LatLong: return {k, 2 * size, size};
-    case MappingKind::CubeHCross: return {k, 4 * size, 3 * size};
-    case MappingKind::CubeVCross: return {k, 3 * size, 4 * size};
-    case MappingKind::CubeStrip: return {k, 6 * size, size};
-    default: return {k, size, size};
+    case MappingKind::LatLong:
+      return {k, 2 * size, size};
+    case MappingKind::CubeHCross:
+      return {k, 4 * size, 3 * size};
+    case MappingKind::CubeVCross:
+      return {k, 3 * size, 4 * size};
+    case MappingKind::CubeStrip:
+      return {k, 6 * size, size};
+    default:
+      return {k, size, size};
   }
 }
 
@@ -87,7 +92,8 @@ Raises IoError for a missing or unreadable file, FormatError for a corrupt one.)
         ibl::sphere::Mapping sm = mapping_of(src, in.width(), in.height(), dead_angle);
         ibl::sphere::Mapping out = output_mapping(k, size, in.width(), in.height());
         ibl::require_allocation(fmt::format("convert: a {} map of {}x{} pixels", dst, out.width(), out.height()),
-                                double(out.width()) * out.height(), 3 * 3 * sizeof(float) + sizeof(double), "choose a smaller size");
+                                double(out.width()) * out.height(), 3 * 3 * sizeof(float) + sizeof(double),
+                                "choose a smaller size");
         ibl::Image res;
         {
           py::gil_scoped_release nogil;
@@ -138,10 +144,14 @@ direction d looks up the input at rotationᵀ·d). dead_angle: degrees of a mirr
         d.exposure_stops = exposure;
         d.auto_exposure = auto_exposure;
         d.key = key;
-        if (curve == "aces") d.curve = ibl::io::ToneCurve::Aces;
-        else if (curve == "reinhard") d.curve = ibl::io::ToneCurve::Reinhard;
-        else if (curve == "clamp") d.curve = ibl::io::ToneCurve::Clamp;
-        else ibl::fail(ibl::ErrorKind::Value, "tonemap: unknown curve '{}' (use aces, reinhard, clamp)", curve);
+        if (curve == "aces")
+          d.curve = ibl::io::ToneCurve::Aces;
+        else if (curve == "reinhard")
+          d.curve = ibl::io::ToneCurve::Reinhard;
+        else if (curve == "clamp")
+          d.curve = ibl::io::ToneCurve::Clamp;
+        else
+          ibl::fail(ibl::ErrorKind::Value, "tonemap: unknown curve '{}' (use aces, reinhard, clamp)", curve);
         ibl::Image out;
         {
           py::gil_scoped_release nogil;

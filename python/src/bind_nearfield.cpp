@@ -28,26 +28,37 @@ nf::PlaneDesc plane_desc(double z, double half_extent, int resolution) {
   pd.z = ibl::require_number("z", z, 1e-6, 1e6);
   pd.half_extent = half_extent;
   pd.resolution = resolution;
-  if (resolution < 1 || resolution > 8192) ibl::fail(ibl::ErrorKind::Value, "resolution must be in 1..8192 (got {})", resolution);
+  if (resolution < 1 || resolution > 8192)
+    ibl::fail(ibl::ErrorKind::Value, "resolution must be in 1..8192 (got {})", resolution);
   return pd;
 }
 
 }  // namespace
 
 void init_nearfield(py::module_& top) {
-  py::module_ m = top.def_submodule("nearfield", "Near-field light of luminaires (Goesele et al. 2003, Granier et al. 2003).");
+  py::module_ m =
+      top.def_submodule("nearfield", "Near-field light of luminaires (Goesele et al. 2003, Granier et al. 2003).");
 
-  py::class_<nf::Dataset>(m, "Dataset", "A luminaire light field in the two-plane setup (the library's nearfield::Dataset, iblkit.nearfield/1).")
-      .def_static("load", [](const std::string& p) {
-        py::gil_scoped_release nogil;
-        return nf::read_dataset(p);
-      }, py::arg("path"), "Reads a manifest and its images.")
-      .def("save", [](const nf::Dataset& d, const std::string& p) {
-        py::gil_scoped_release nogil;
-        nf::write_dataset(p, d);
-      }, py::arg("path"), "Writes the manifest and its images (STEM_images/ beside it).")
+  py::class_<nf::Dataset>(
+      m, "Dataset",
+      "A luminaire light field in the two-plane setup (the library's nearfield::Dataset, iblkit.nearfield/1).")
+      .def_static(
+          "load",
+          [](const std::string& p) {
+            py::gil_scoped_release nogil;
+            return nf::read_dataset(p);
+          },
+          py::arg("path"), "Reads a manifest and its images.")
+      .def(
+          "save",
+          [](const nf::Dataset& d, const std::string& p) {
+            py::gil_scoped_release nogil;
+            nf::write_dataset(p, d);
+          },
+          py::arg("path"), "Writes the manifest and its images (STEM_images/ beside it).")
       .def_readonly("name", &nf::Dataset::name)
-      .def_readonly("luminaire", &nf::Dataset::luminaire, "The lab luminaire a simulated dataset came from ('' when measured).")
+      .def_readonly("luminaire", &nf::Dataset::luminaire,
+                    "The lab luminaire a simulated dataset came from ('' when measured).")
       .def_property_readonly("basis", [](const nf::Dataset& d) { return std::string(nf::basis_name(d.basis)); })
       .def_readonly("spacing", &nf::Dataset::spacing, "h, metres.")
       .def_readonly("filter_width", &nf::Dataset::filter_width)
@@ -56,35 +67,45 @@ void init_nearfield(py::module_& top) {
       .def_readonly("distance", &nf::Dataset::distance, "d between S and M, metres.")
       .def_property_readonly("m_min", [](const nf::Dataset& d) { return py::make_tuple(d.m_min.x, d.m_min.y); })
       .def_property_readonly("m_max", [](const nf::Dataset& d) { return py::make_tuple(d.m_max.x, d.m_max.y); })
-      .def_property_readonly("positive", [](const nf::Dataset& d) { return image_list(d.positive); }, "E⁺ images, index j·nx + i.")
-      .def_property_readonly("negative", [](const nf::Dataset& d) { return image_list(d.negative); }, "E⁻ images, index j·nx + i.")
-      .def("measurement", [](const nf::Dataset& d, int i, int j) {
-        if (i < 0 || j < 0 || i >= d.nx || j >= d.ny) throw py::index_error("filter position out of range");
-        return to_array(d.measurement(i, j));
-      }, py::arg("i"), py::arg("j"), "E_ij = gain·(E⁺ − E⁻) at filter position (i, j).")
-      .def("incoming_radiance", [](const nf::Dataset& d) {
-        std::vector<ibl::Image> e;
-        {
-          py::gil_scoped_release nogil;
-          e = nf::incoming_radiance(d);
-        }
-        return image_list(e);
-      }, "E'_mn textures of the shift-invariant reconstruction (Eqs. 7–11), index n·nx + m.")
+      .def_property_readonly(
+          "positive", [](const nf::Dataset& d) { return image_list(d.positive); }, "E⁺ images, index j·nx + i.")
+      .def_property_readonly(
+          "negative", [](const nf::Dataset& d) { return image_list(d.negative); }, "E⁻ images, index j·nx + i.")
+      .def(
+          "measurement",
+          [](const nf::Dataset& d, int i, int j) {
+            if (i < 0 || j < 0 || i >= d.nx || j >= d.ny) throw py::index_error("filter position out of range");
+            return to_array(d.measurement(i, j));
+          },
+          py::arg("i"), py::arg("j"), "E_ij = gain·(E⁺ − E⁻) at filter position (i, j).")
+      .def(
+          "incoming_radiance",
+          [](const nf::Dataset& d) {
+            std::vector<ibl::Image> e;
+            {
+              py::gil_scoped_release nogil;
+              e = nf::incoming_radiance(d);
+            }
+            return image_list(e);
+          },
+          "E'_mn textures of the shift-invariant reconstruction (Eqs. 7–11), index n·nx + m.")
       .def("__len__", &nf::Dataset::count)
-      .def("__repr__", [](const nf::Dataset& d) { return fmt::format("nearfield.Dataset('{}', {}x{})", d.name, d.nx, d.ny); });
+      .def("__repr__",
+           [](const nf::Dataset& d) { return fmt::format("nearfield.Dataset('{}', {}x{})", d.name, d.nx, d.ny); });
 
   m.def("luminaires", &nf::luminaire_names, "Names of the lab's virtual luminaires.");
 
   m.def(
       "simulate",
-      [](const std::string& luminaire, py::object grid, const std::string& basis, double spacing, double distance, int resolution,
-         double extent, py::object progress) {
+      [](const std::string& luminaire, py::object grid, const std::string& basis, double spacing, double distance,
+         int resolution, double extent, py::object progress) {
         auto lum = nf::make_luminaire(luminaire);
         nf::SimulateDesc d;
         auto g = grid.cast<std::pair<int, int>>();
         d.nx = g.first;
         d.ny = g.second;
-        if (d.nx < 1 || d.ny < 1 || d.nx > 64 || d.ny > 64) ibl::fail(ibl::ErrorKind::Value, "grid must be in 1..64 per axis");
+        if (d.nx < 1 || d.ny < 1 || d.nx > 64 || d.ny > 64)
+          ibl::fail(ibl::ErrorKind::Value, "grid must be in 1..64 per axis");
         d.basis = nf::parse_basis(basis, "basis");
         d.spacing = spacing;
         d.distance = distance;
@@ -143,7 +164,8 @@ spotlights, as `iblkit nearfield irradiance` (half_extent 0: where the dataset's
       "compare",
       [](py::handle approx, py::handle exact) {
         ibl::Image a = to_image(approx, "compare: approx", 3), e = to_image(exact, "compare: exact", 3);
-        if (a.width() != e.width() || a.height() != e.height()) throw py::value_error("compare: images of different sizes");
+        if (a.width() != e.width() || a.height() != e.height())
+          throw py::value_error("compare: images of different sizes");
         auto s = nf::compare(a, e);
         py::dict d;
         d["rel_rms"] = s.rel_rms;
@@ -152,7 +174,8 @@ spotlights, as `iblkit nearfield irradiance` (half_extent 0: where the dataset's
         d["power_ratio"] = s.power_ratio;
         return d;
       },
-      py::arg("approx"), py::arg("exact"), "Luminance errors of an approximation: rel_rms, rel_mean_abs, rel_max, power_ratio.");
+      py::arg("approx"), py::arg("exact"),
+      "Luminance errors of an approximation: rel_rms, rel_mean_abs, rel_max, power_ratio.");
 }
 
 }  // namespace iblpy

@@ -58,11 +58,14 @@ void add_lighting(py::handle light, int bands, int shadows, const std::string& m
 void init_render(py::module_& m) {
   m.def(
       "render",
-      [](py::handle light, py::object mesh, py::object camera, const std::string& object_kind, py::handle at, double size, int triangles, py::handle albedo,
-         double gloss, double exponent, const std::string& lobe, double floor_size, int shadows, int bands, int width, int height,
-         double fov, py::handle background, const std::string& mapping, bool coverage, py::object progress) -> py::object {
-        if (lobe != "phong" && lobe != "blinn") ibl::fail(ibl::ErrorKind::Value, "render: lobe must be phong or blinn (got {})", lobe);
-        if (shadows < 0 || shadows > 16) ibl::fail(ibl::ErrorKind::Value, "render: shadows must be in 0..16 (got {})", shadows);
+      [](py::handle light, py::object mesh, py::object camera, const std::string& object_kind, py::handle at,
+         double size, int triangles, py::handle albedo, double gloss, double exponent, const std::string& lobe,
+         double floor_size, int shadows, int bands, int width, int height, double fov, py::handle background,
+         const std::string& mapping, bool coverage, py::object progress) -> py::object {
+        if (lobe != "phong" && lobe != "blinn")
+          ibl::fail(ibl::ErrorKind::Value, "render: lobe must be phong or blinn (got {})", lobe);
+        if (shadows < 0 || shadows > 16)
+          ibl::fail(ibl::ErrorKind::Value, "render: shadows must be in 0..16 (got {})", shadows);
         if (bands < 1 || bands > 9) ibl::fail(ibl::ErrorKind::Value, "render: bands must be in 1..9 (got {})", bands);
         ibl::require_number("render: gloss", gloss, 0, 1);
         ibl::require_number("render: exponent", exponent, 1, 10000);
@@ -124,11 +127,13 @@ void init_render(py::module_& m) {
         if (coverage) return py::make_tuple(to_array(std::move(r.color)), to_array(std::move(r.coverage), true));
         return to_array(std::move(r.color));
       },
-      py::arg("light"), py::arg("mesh") = py::none(), py::arg("camera") = py::none(), py::arg("object") = "blob", py::arg("at") = py::make_tuple(0, 0, 0),
-      py::arg("size") = 0.8, py::arg("triangles") = 100000, py::arg("albedo") = py::make_tuple(0.75, 0.75, 0.75), py::arg("gloss") = 0.0,
-      py::arg("exponent") = 20.0, py::arg("lobe") = "phong", py::arg("floor_size") = 6.0, py::arg("shadows") = 4, py::arg("bands") = 5,
-      py::arg("width") = 1024, py::arg("height") = 768, py::arg("fov") = 40.0, py::arg("background") = py::make_tuple(0, 0, 0),
-      py::arg("mapping") = "latlong", py::arg("coverage") = false, py::arg("progress") = py::none(),
+      py::arg("light"), py::arg("mesh") = py::none(), py::arg("camera") = py::none(), py::arg("object") = "blob",
+      py::arg("at") = py::make_tuple(0, 0, 0), py::arg("size") = 0.8, py::arg("triangles") = 100000,
+      py::arg("albedo") = py::make_tuple(0.75, 0.75, 0.75), py::arg("gloss") = 0.0, py::arg("exponent") = 20.0,
+      py::arg("lobe") = "phong", py::arg("floor_size") = 6.0, py::arg("shadows") = 4, py::arg("bands") = 5,
+      py::arg("width") = 1024, py::arg("height") = 768, py::arg("fov") = 40.0,
+      py::arg("background") = py::make_tuple(0, 0, 0), py::arg("mapping") = "latlong", py::arg("coverage") = false,
+      py::arg("progress") = py::none(),
       R"doc(Renders an object under a lighting with the CPU reference renderer, as `iblkit render --backend cpu`:
 an (H, W, 3) float32 radiance array (with coverage=True also the (H, W) coverage).
 

@@ -30,7 +30,8 @@ Coeffs coeffs_from_array(py::handle obj, const char* what) {
   if (a.ndim() != 2 || a.shape(1) != 3 || a.shape(0) < 1)
     throw py::value_error(fmt::format("{}: expected shape (K, 3) with K = bands², got ndim {}", what, a.ndim()));
   int K = static_cast<int>(a.shape(0)), bands = static_cast<int>(std::lround(std::sqrt(double(K))));
-  if (bands * bands != K) throw py::value_error(fmt::format("{}: K = {} coefficients is not a square (bands²)", what, K));
+  if (bands * bands != K)
+    throw py::value_error(fmt::format("{}: K = {} coefficients is not a square (bands²)", what, K));
   auto d = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(a);
   Coeffs c;
   c.bands = bands;
@@ -55,9 +56,11 @@ ibl::Mat3 rotation_arg(py::handle obj, const char* what) {
   double err = 0;
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) err = std::max(err, std::abs(P.m[i][j] - (i == j ? 1.0 : 0.0)));
-  double det = R.m[0][0] * (R.m[1][1] * R.m[2][2] - R.m[1][2] * R.m[2][1]) - R.m[0][1] * (R.m[1][0] * R.m[2][2] - R.m[1][2] * R.m[2][0]) +
+  double det = R.m[0][0] * (R.m[1][1] * R.m[2][2] - R.m[1][2] * R.m[2][1]) -
+               R.m[0][1] * (R.m[1][0] * R.m[2][2] - R.m[1][2] * R.m[2][0]) +
                R.m[0][2] * (R.m[1][0] * R.m[2][1] - R.m[1][1] * R.m[2][0]);
-  if (!(err < 1e-6) || !(det > 0)) ibl::fail(ibl::ErrorKind::Value, "{}: not a rotation (R·Rᵀ off identity by {:g}, det {:g})", what, err, det);
+  if (!(err < 1e-6) || !(det > 0))
+    ibl::fail(ibl::ErrorKind::Value, "{}: not a rotation (R·Rᵀ off identity by {:g}, det {:g})", what, err, det);
   return R;
 }
 
@@ -90,7 +93,8 @@ supports the buffer protocol, so numpy.asarray(c) is the same view.)doc")
       .def(py::init([](py::array coefficients) { return coeffs_from_array(coefficients, "SHCoeffs: coefficients"); }),
            py::arg("coefficients"), "From a (K, 3) array, K = bands² (values copied, must be finite).")
       .def_buffer([](Coeffs& c) {
-        return py::buffer_info(reinterpret_cast<double*>(c.c.data()), sizeof(double), py::format_descriptor<double>::format(), 2,
+        return py::buffer_info(reinterpret_cast<double*>(c.c.data()), sizeof(double),
+                               py::format_descriptor<double>::format(), 2,
                                {static_cast<py::ssize_t>(c.c.size()), py::ssize_t(3)},
                                {static_cast<py::ssize_t>(sizeof(ibl::Vec3)), static_cast<py::ssize_t>(sizeof(double))});
       })
@@ -100,37 +104,47 @@ supports the buffer protocol, so numpy.asarray(c) is the same view.)doc")
           [](py::object self) {
             Coeffs& c = self.cast<Coeffs&>();
             static_assert(sizeof(ibl::Vec3) == 3 * sizeof(double));
-            return py::array_t<double>({static_cast<py::ssize_t>(c.c.size()), py::ssize_t(3)},
-                                       {static_cast<py::ssize_t>(sizeof(ibl::Vec3)), static_cast<py::ssize_t>(sizeof(double))},
-                                       reinterpret_cast<double*>(c.c.data()), self);
+            return py::array_t<double>(
+                {static_cast<py::ssize_t>(c.c.size()), py::ssize_t(3)},
+                {static_cast<py::ssize_t>(sizeof(ibl::Vec3)), static_cast<py::ssize_t>(sizeof(double))},
+                reinterpret_cast<double*>(c.c.data()), self);
           },
           [](Coeffs& c, py::array values) {
             Coeffs n = coeffs_from_array(values, "SHCoeffs.coefficients");
             if (n.bands != c.bands)
-              throw py::value_error(fmt::format("SHCoeffs.coefficients: expected ({}, 3), got {} coefficients", c.c.size(), n.c.size()));
+              throw py::value_error(
+                  fmt::format("SHCoeffs.coefficients: expected ({}, 3), got {} coefficients", c.c.size(), n.c.size()));
             c.c = n.c;  // same size: views handed out stay valid
           },
           "(K, 3) float64 view of the coefficients (RGB per coefficient, index order).")
       .def("__len__", [](const Coeffs& c) { return c.c.size(); })
-      .def("__repr__", [](const Coeffs& c) {
-        return fmt::format("SHCoeffs(bands={}, c00=({:.6g}, {:.6g}, {:.6g}))", c.bands, c.c.empty() ? 0.0 : c.c[0].x,
-                           c.c.empty() ? 0.0 : c.c[0].y, c.c.empty() ? 0.0 : c.c[0].z);
-      })
+      .def("__repr__",
+           [](const Coeffs& c) {
+             return fmt::format("SHCoeffs(bands={}, c00=({:.6g}, {:.6g}, {:.6g}))", c.bands,
+                                c.c.empty() ? 0.0 : c.c[0].x, c.c.empty() ? 0.0 : c.c[0].y,
+                                c.c.empty() ? 0.0 : c.c[0].z);
+           })
       .def("resized", &Coeffs::resized, py::arg("bands"), "The first `bands` bands (truncated, or zero-padded).")
-      .def("to_json", [](const Coeffs& c) { return ibl::sh::to_json_text(c); }, "The iblkit.sh/1 file text.")
+      .def(
+          "to_json", [](const Coeffs& c) { return ibl::sh::to_json_text(c); }, "The iblkit.sh/1 file text.")
       .def_static(
-          "from_json", [](const std::string& text) { return ibl::sh::coeffs_from_json(parse_json_text(text, "SHCoeffs.from_json"), "json"); },
+          "from_json",
+          [](const std::string& text) {
+            return ibl::sh::coeffs_from_json(parse_json_text(text, "SHCoeffs.from_json"), "json");
+          },
           py::arg("text"), "Parses iblkit.sh/1 text.")
-      .def("save", [](const Coeffs& c, const std::string& path) { ibl::sh::write_coeffs(path, c); }, py::arg("path"),
-           "Writes an iblkit.sh/1 file (atomically).")
+      .def(
+          "save", [](const Coeffs& c, const std::string& path) { ibl::sh::write_coeffs(path, c); }, py::arg("path"),
+          "Writes an iblkit.sh/1 file (atomically).")
       .def_static("load", &ibl::sh::read_coeffs, py::arg("path"), "Reads an iblkit.sh/1 file.")
-      .def(py::pickle([](const Coeffs& c) { return ibl::sh::to_json_text(c); },
-                      [](const std::string& t) { return ibl::sh::coeffs_from_json(nlohmann::json::parse(t), "pickle"); }));
+      .def(py::pickle(
+          [](const Coeffs& c) { return ibl::sh::to_json_text(c); },
+          [](const std::string& t) { return ibl::sh::coeffs_from_json(nlohmann::json::parse(t), "pickle"); }));
 
   m.def(
       "sh_project",
-      [](py::handle img, int bands, const std::string& mapping, py::object window, double window_width, double dead_angle,
-         py::object progress) {
+      [](py::handle img, int bands, const std::string& mapping, py::object window, double window_width,
+         double dead_angle, py::object progress) {
         py::array_t<float> a = image_array(img, "sh_project: img");
         ibl::ImageView v = view_of(a);
         ibl::sphere::Mapping mp = mapping_of(mapping, v.width(), v.height(), dead_angle);
@@ -197,7 +211,8 @@ projected as they are (the projection is linear); NaN/Inf raise InvalidValue nam
       "Irradiance E(n) = ∫ L(ω) max(n·ω, 0) dω (W/m²) of SH radiance at each normal ((N, 3)): an (N, 3) array.");
 
   m.def(
-      "sh_irradiance_coeffs", [](py::handle coeffs) { return ibl::sh::irradiance(coeffs_arg(coeffs, "sh_irradiance_coeffs: coeffs")); },
+      "sh_irradiance_coeffs",
+      [](py::handle coeffs) { return ibl::sh::irradiance(coeffs_arg(coeffs, "sh_irradiance_coeffs: coeffs")); },
       py::arg("coeffs"), "The irradiance as SH: radiance convolved with the clamped cosine (Â_l: π, 2π/3, π/4, …).");
 
   m.def(
@@ -239,10 +254,18 @@ threejs (SphericalHarmonics3 JSON), filament (cmgen's sh.txt), gltf (EXT_lights_
         Coeffs c = coeffs_arg(coeffs, "sh_layout: coeffs");
         Coeffs out;
         switch (ibl::sh::parse_export_format(format)) {
-          case ibl::sh::ExportFormat::ThreeJs: out = ibl::sh::to_threejs(c); break;
-          case ibl::sh::ExportFormat::Filament: out = ibl::sh::to_filament(c); break;
-          case ibl::sh::ExportFormat::Gltf: out = ibl::sh::to_gltf(c); break;
-          case ibl::sh::ExportFormat::Iblkit: out = c; break;
+          case ibl::sh::ExportFormat::ThreeJs:
+            out = ibl::sh::to_threejs(c);
+            break;
+          case ibl::sh::ExportFormat::Filament:
+            out = ibl::sh::to_filament(c);
+            break;
+          case ibl::sh::ExportFormat::Gltf:
+            out = ibl::sh::to_gltf(c);
+            break;
+          case ibl::sh::ExportFormat::Iblkit:
+            out = c;
+            break;
         }
         return vec3_array(out.c);
       },
@@ -254,9 +277,12 @@ threejs (SphericalHarmonics3 JSON), filament (cmgen's sh.txt), gltf (EXT_lights_
       [](py::handle values, const std::string& format) {
         Coeffs c = coeffs_from_array(values, "sh_from_layout: values");
         switch (ibl::sh::parse_export_format(format)) {
-          case ibl::sh::ExportFormat::Filament: return ibl::sh::from_filament(c);
-          case ibl::sh::ExportFormat::Gltf: return ibl::sh::from_gltf(c);
-          default: return c;  // threejs and iblkit store the coefficients themselves
+          case ibl::sh::ExportFormat::Filament:
+            return ibl::sh::from_filament(c);
+          case ibl::sh::ExportFormat::Gltf:
+            return ibl::sh::from_gltf(c);
+          default:
+            return c;  // threejs and iblkit store the coefficients themselves
         }
       },
       py::arg("values"), py::arg("format"), "Radiance coefficients back from a layout's (9, 3) values.");

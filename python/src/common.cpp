@@ -22,17 +22,21 @@ py::array as_numeric_array(py::handle obj, const char* what) {
     a = py::reinterpret_borrow<py::array>(obj);
   } else {
     if (obj.is_none() || py::isinstance<py::str>(obj) || py::isinstance<py::bytes>(obj))
-      throw py::type_error(fmt::format("{}: expected a numpy array, got {}", what, std::string(py::str(obj.get_type()))));
+      throw py::type_error(
+          fmt::format("{}: expected a numpy array, got {}", what, std::string(py::str(obj.get_type()))));
     try {
       a = py::array::ensure(obj);
     } catch (py::error_already_set&) {
       a = py::array();
     }
-    if (!a) throw py::type_error(fmt::format("{}: expected a numpy array, got {}", what, std::string(py::str(obj.get_type()))));
+    if (!a)
+      throw py::type_error(
+          fmt::format("{}: expected a numpy array, got {}", what, std::string(py::str(obj.get_type()))));
   }
   char kind = a.dtype().kind();
   if (kind != 'f' && kind != 'i' && kind != 'u')
-    throw py::type_error(fmt::format("{}: expected a real numeric array, got dtype {}", what, std::string(py::str(a.dtype()))));
+    throw py::type_error(
+        fmt::format("{}: expected a real numeric array, got dtype {}", what, std::string(py::str(a.dtype()))));
   return a;
 }
 
@@ -65,9 +69,8 @@ py::array to_array(ibl::Image img, bool squeeze) {
   owned->width = owned->img.width();
   owned->height = owned->img.height();
   owned->channels = owned->img.channels();
-  py::capsule base(owned, kOwnedName, [](PyObject* cap) {
-    delete static_cast<OwnedImage*>(PyCapsule_GetPointer(cap, kOwnedName));
-  });
+  py::capsule base(owned, kOwnedName,
+                   [](PyObject* cap) { delete static_cast<OwnedImage*>(PyCapsule_GetPointer(cap, kOwnedName)); });
   const py::ssize_t h = owned->height, w = owned->width, c = owned->channels;
   const py::ssize_t f = sizeof(float);
   if (squeeze && c == 1) return py::array_t<float>({h, w}, {w * f, f}, owned->data, base);
@@ -82,9 +85,9 @@ EnvArg::EnvArg(py::handle img, const std::string& mapping, double dead_angle, co
     if (base && PyCapsule_CheckExact(base) && PyCapsule_IsValid(base, kOwnedName)) {
       auto* o = static_cast<OwnedImage*>(PyCapsule_GetPointer(base, kOwnedName));
       const py::ssize_t f = sizeof(float);
-      bool whole = a.dtype().is(py::dtype::of<float>()) && a.data() == o->data && a.ndim() == 3 && a.shape(0) == o->height &&
-                   a.shape(1) == o->width && a.shape(2) == o->channels && a.strides(2) == f && a.strides(1) == o->channels * f &&
-                   a.strides(0) == o->width * o->channels * f;
+      bool whole = a.dtype().is(py::dtype::of<float>()) && a.data() == o->data && a.ndim() == 3 &&
+                   a.shape(0) == o->height && a.shape(1) == o->width && a.shape(2) == o->channels &&
+                   a.strides(2) == f && a.strides(1) == o->channels * f && a.strides(0) == o->width * o->channels * f;
       bool expected = false;
       std::optional<ibl::sphere::Mapping> m;
       if (whole) m = mapping_of(mapping, o->width, o->height, dead_angle);  // before the lend: it may throw
@@ -114,7 +117,8 @@ py::array_t<float> image_array(py::handle obj, const char* what, int channels) {
     throw py::type_error(fmt::format("{}: expected a float array (float32 or float64), got dtype {}", what,
                                      std::string(py::str(a.dtype()))));
   if (a.ndim() != 2 && a.ndim() != 3)
-    throw py::value_error(fmt::format("{}: expected an image of shape (H, W) or (H, W, C), got {}", what, shape_text(a)));
+    throw py::value_error(
+        fmt::format("{}: expected an image of shape (H, W) or (H, W, C), got {}", what, shape_text(a)));
   py::ssize_t c = a.ndim() == 3 ? a.shape(2) : 1;
   if (a.shape(0) < 1 || a.shape(1) < 1 || c < 1 || c > 4 || (channels > 0 && c != channels))
     throw py::value_error(fmt::format("{}: expected an image of shape (H, W, {}) with H, W ≥ 1, got {}", what,
@@ -125,8 +129,10 @@ py::array_t<float> image_array(py::handle obj, const char* what, int channels) {
   // strided. Anything else (float64, a transposed or column-sliced array) is copied once.
   bool ok = a.dtype().is(py::dtype::of<float>()) && reinterpret_cast<uintptr_t>(a.data()) % 4 == 0;
   if (ok) {
-    if (a.ndim() == 3) ok = a.strides(2) == 4 && a.strides(1) == 4 * c;
-    else ok = a.strides(1) == 4;
+    if (a.ndim() == 3)
+      ok = a.strides(2) == 4 && a.strides(1) == 4 * c;
+    else
+      ok = a.strides(1) == 4;
     ok = ok && a.strides(0) > 0 && a.strides(0) % 4 == 0 && a.strides(0) >= a.shape(1) * c * 4;
   }
   if (ok) return py::reinterpret_borrow<py::array_t<float>>(a);
@@ -198,7 +204,11 @@ ibl::Mat3 to_mat3(py::handle obj, const char* what) {
 py::array_t<double> vec3_array(const std::vector<ibl::Vec3>& v) {
   py::array_t<double> a({static_cast<py::ssize_t>(v.size()), py::ssize_t(3)});
   double* p = a.mutable_data();
-  for (size_t i = 0; i < v.size(); ++i) { p[3 * i] = v[i].x; p[3 * i + 1] = v[i].y; p[3 * i + 2] = v[i].z; }
+  for (size_t i = 0; i < v.size(); ++i) {
+    p[3 * i] = v[i].x;
+    p[3 * i + 1] = v[i].y;
+    p[3 * i + 2] = v[i].z;
+  }
   return a;
 }
 

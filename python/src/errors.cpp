@@ -25,11 +25,16 @@ PyObject* make_class(py::module_& m, const char* name, PyObject* bases, const ch
 
 const char* kind_name(ibl::ErrorKind k) {
   switch (k) {
-    case ibl::ErrorKind::Io: return "io";
-    case ibl::ErrorKind::Format: return "format";
-    case ibl::ErrorKind::Value: return "value";
-    case ibl::ErrorKind::Unsupported: return "unsupported";
-    case ibl::ErrorKind::Internal: return "internal";
+    case ibl::ErrorKind::Io:
+      return "io";
+    case ibl::ErrorKind::Format:
+      return "format";
+    case ibl::ErrorKind::Value:
+      return "value";
+    case ibl::ErrorKind::Unsupported:
+      return "unsupported";
+    case ibl::ErrorKind::Internal:
+      return "internal";
   }
   return "internal";
 }
@@ -44,14 +49,19 @@ void init_errors(py::module_& m) {
     py::tuple bases = py::make_tuple(py::handle(g_error), py::handle(builtin));
     return make_class(m, name, bases.ptr(), doc);
   };
-  g_kind[int(ibl::ErrorKind::Io)] = sub("IoError", PyExc_OSError, "A file is missing, unreadable or unwritable (an OSError).");
+  g_kind[int(ibl::ErrorKind::Io)] =
+      sub("IoError", PyExc_OSError, "A file is missing, unreadable or unwritable (an OSError).");
   g_kind[int(ibl::ErrorKind::Format)] =
-      sub("FormatError", PyExc_ValueError, "A file parses but is not what it claims: corrupt, truncated, unknown format (a ValueError).");
+      sub("FormatError", PyExc_ValueError,
+          "A file parses but is not what it claims: corrupt, truncated, unknown format (a ValueError).");
   g_kind[int(ibl::ErrorKind::Value)] =
-      sub("InvalidValue", PyExc_ValueError, "A value is out of range: NaN/Inf/negative pixels, a zero count, a wrong size (a ValueError).");
+      sub("InvalidValue", PyExc_ValueError,
+          "A value is out of range: NaN/Inf/negative pixels, a zero count, a wrong size (a ValueError).");
   g_kind[int(ibl::ErrorKind::Unsupported)] =
-      sub("Unsupported", PyExc_NotImplementedError, "A valid request this build cannot serve (an optional part not built).");
-  g_kind[int(ibl::ErrorKind::Internal)] = sub("InternalError", PyExc_RuntimeError, "A bug in iblkit: an invariant failed.");
+      sub("Unsupported", PyExc_NotImplementedError,
+          "A valid request this build cannot serve (an optional part not built).");
+  g_kind[int(ibl::ErrorKind::Internal)] =
+      sub("InternalError", PyExc_RuntimeError, "A bug in iblkit: an invariant failed.");
 
   py::register_exception_translator([](std::exception_ptr p) {
     try {

@@ -14,9 +14,9 @@
 // own so that the lean GL benchmark (bench/gl_frames_main.cpp, no Embree) builds compositor.cpp alone.
 namespace ibl::augment::gl {
 
-CompositeResult composite(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy, const LocalLight& light,
-                          const geometry::TriMesh& object, const render::Material& material, const GlCompositeDesc& desc,
-                          GlFrameTiming* timing) {
+CompositeResult composite(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy,
+                          const LocalLight& light, const geometry::TriMesh& object, const render::Material& material,
+                          const GlCompositeDesc& desc, GlFrameTiming* timing) {
   auto t0 = std::chrono::steady_clock::now();
   if (desc.visibility_samples < -1 || desc.visibility_samples > 65536)
     fail(ErrorKind::Value, "visibility samples {} must lie in 0..65536 (or -1: automatic)", desc.visibility_samples);
@@ -30,8 +30,11 @@ CompositeResult composite(const Image& photo, const geometry::Camera& cam, const
     Compositor comp(photo, cam, proxy, split, est.albedo, desc);
     std::vector<Vec3> vis;
     // The noise a pixel shows depends on the rays per unit of the object's area: a fixed budget over the triangles.
-    const int samples = desc.visibility_samples >= 0 ? desc.visibility_samples
-                        : static_cast<int>(std::clamp<int64_t>(GlCompositeDesc::kVisibilityRays / std::max<int64_t>(object.triangle_count(), 1), 16, 1024));
+    const int samples =
+        desc.visibility_samples >= 0
+            ? desc.visibility_samples
+            : static_cast<int>(std::clamp<int64_t>(
+                  GlCompositeDesc::kVisibilityRays / std::max<int64_t>(object.triangle_count(), 1), 16, 1024));
     if (samples > 0) {
       SoftVisibilityDesc vd;
       vd.samples = samples;
@@ -50,7 +53,8 @@ CompositeResult composite(const Image& photo, const geometry::Camera& cam, const
     for (int y = 0; y < H; ++y)
       for (int x = 0; x < W; ++x) {
         Vec3 rho = est.albedo.rgb(x, y), ph = photo.rgb(x, y), without;
-        for (int c = 0; c < 3; ++c) without[c] = rho[c] > 0 ? ph[c] * std::min(rho[c], 1.0) / rho[c] : 0.0;  // min(ρ,1)/π E₀
+        for (int c = 0; c < 3; ++c)
+          without[c] = rho[c] > 0 ? ph[c] * std::min(rho[c], 1.0) / rho[c] : 0.0;  // min(ρ,1)/π E₀
         Vec3 with = without + (proxy_comp.rgb(x, y) - ph);
         for (int c = 0; c < 3; ++c) with[c] = std::max(0.0, with[c]);
         double f = r.mask.at(x, y, 0);
@@ -66,12 +70,15 @@ CompositeResult composite(const Image& photo, const geometry::Camera& cam, const
   r.stats.unlit = est.unlit;
   r.stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (est.over_one > 0)
-    r.warnings.push_back(fmt::format("{} proxy pixels ({:.1f} %) have an estimated albedo > 1: the captured light is weaker there than "
-                                     "the photograph says; their change is limited to what a white surface would show",
-                                     est.over_one, 100.0 * est.over_one / std::max<int64_t>(1, est.proxy_pixels)));
+    r.warnings.push_back(
+        fmt::format("{} proxy pixels ({:.1f} %) have an estimated albedo > 1: the captured light is weaker there than "
+                    "the photograph says; their change is limited to what a white surface would show",
+                    est.over_one, 100.0 * est.over_one / std::max<int64_t>(1, est.proxy_pixels)));
   if (est.unlit > 0)
-    r.warnings.push_back(fmt::format("{} proxy pixels receive no captured light in some channel: they keep the photograph's value", est.unlit));
-  if (r.stats.object_pixels == 0) r.warnings.push_back("no pixel of the photograph sees the object: check at, the eye and the target");
+    r.warnings.push_back(fmt::format(
+        "{} proxy pixels receive no captured light in some channel: they keep the photograph's value", est.unlit));
+  if (r.stats.object_pixels == 0)
+    r.warnings.push_back("no pixel of the photograph sees the object: check at, the eye and the target");
   return r;
 }
 

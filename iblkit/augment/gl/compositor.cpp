@@ -19,11 +19,11 @@ namespace {
 
 using geometry::Mat4f;
 constexpr int kMaxLights = Compositor::kMaxLights;
-constexpr float kFar = 1e30f;   // a shadow-map texel nothing covers
+constexpr float kFar = 1e30f;  // a shadow-map texel nothing covers
 
 // Flat-shaded triangles: position, face normal, UV (0 for a mesh without UVs) and the soft light's factor
-// (composite.h's soft_visibility, smoothed over each vertex; 1 where none is given) per corner, 11 floats, so that both renders and the
-// CPU reference see the same per-triangle normals.
+// (composite.h's soft_visibility, smoothed over each vertex; 1 where none is given) per corner, 11 floats, so that both
+// renders and the CPU reference see the same per-triangle normals.
 struct Mesh {
   GLuint vao = 0, vbo = 0;
   GLsizei count = 0;
@@ -96,7 +96,8 @@ GLuint upload_rgb(const Image& img, bool latlong_filtered = false) {
   for (int y = 0; y < img.height(); ++y)
     for (int x = 0; x < img.width(); ++x)
       for (int c = 0; c < 4; ++c)
-        px[(static_cast<size_t>(y) * img.width() + x) * 4 + c] = c < 3 ? img.at(x, y, std::min(c, img.channels() - 1)) : 1.0f;
+        px[(static_cast<size_t>(y) * img.width() + x) * 4 + c] =
+            c < 3 ? img.at(x, y, std::min(c, img.channels() - 1)) : 1.0f;
   int levels = 1;
   if (latlong_filtered)
     for (int s = std::max(img.width(), img.height()); s > 1; s /= 2) ++levels;
@@ -123,7 +124,8 @@ GLuint framebuffer(std::initializer_list<GLuint> colors, GLuint depth_rb = 0) {
   glNamedFramebufferDrawBuffers(f, static_cast<GLsizei>(bufs.size()), bufs.data());
   if (depth_rb) glNamedFramebufferRenderbuffer(f, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth_rb);
   if (glCheckNamedFramebufferStatus(f, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-    fail(ErrorKind::Internal, "the compositor's framebuffer is incomplete (status 0x{:x})", glCheckNamedFramebufferStatus(f, GL_FRAMEBUFFER));
+    fail(ErrorKind::Internal, "the compositor's framebuffer is incomplete (status 0x{:x})",
+         glCheckNamedFramebufferStatus(f, GL_FRAMEBUFFER));
   return f;
 }
 
@@ -144,12 +146,17 @@ Mat4f camera_matrix(const geometry::Camera& cam) {
   return geometry::mul(p, cam.view());
 }
 
-void set_mat(GLuint prog, const char* name, const Mat4f& m) { glProgramUniformMatrix4fv(prog, glGetUniformLocation(prog, name), 1, GL_FALSE, m.data()); }
+void set_mat(GLuint prog, const char* name, const Mat4f& m) {
+  glProgramUniformMatrix4fv(prog, glGetUniformLocation(prog, name), 1, GL_FALSE, m.data());
+}
 void set_vec3(GLuint prog, const char* name, Vec3 v) {
-  glProgramUniform3f(prog, glGetUniformLocation(prog, name), static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z));
+  glProgramUniform3f(prog, glGetUniformLocation(prog, name), static_cast<float>(v.x), static_cast<float>(v.y),
+                     static_cast<float>(v.z));
 }
 void set_int(GLuint prog, const char* name, int v) { glProgramUniform1i(prog, glGetUniformLocation(prog, name), v); }
-void set_float(GLuint prog, const char* name, double v) { glProgramUniform1f(prog, glGetUniformLocation(prog, name), static_cast<float>(v)); }
+void set_float(GLuint prog, const char* name, double v) {
+  glProgramUniform1f(prog, glGetUniformLocation(prog, name), static_cast<float>(v));
+}
 
 Image read_texture(GLuint tex, int w, int h, int channels) {
   std::vector<float> px(static_cast<size_t>(w) * h * 4);
@@ -157,7 +164,8 @@ Image read_texture(GLuint tex, int w, int h, int channels) {
   Image img(w, h, channels);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x)
-      for (int c = 0; c < channels; ++c) img.at(x, y, c) = px[(static_cast<size_t>(y) * w + x) * 4 + (channels == 1 ? 3 : c)];
+      for (int c = 0; c < channels; ++c)
+        img.at(x, y, c) = px[(static_cast<size_t>(y) * w + x) * 4 + (channels == 1 ? 3 : c)];
   return img;
 }
 
@@ -176,15 +184,17 @@ struct Compositor::Impl {
   GLuint object_texture = 0, object_glossy = 0;  // the material's albedo texture and prefiltered soft map (or 0)
   GLuint facing_tex = 0;  // augment::facing_irradiance of the object (set_object): what its bounce sends back
   GLuint prog_gbuffer = 0, prog_depth = 0, prog_proxy = 0, prog_object = 0, prog_final = 0, empty_vao = 0;
-  GLuint photo_tex = 0, albedo_tex = 0, soft_tex = 0, irr_tex = 0, gpos = 0, gnormal = 0, proxy_comp = 0, object_tex = 0, color = 0, diff = 0;
+  GLuint photo_tex = 0, albedo_tex = 0, soft_tex = 0, irr_tex = 0, gpos = 0, gnormal = 0, proxy_comp = 0,
+         object_tex = 0, color = 0, diff = 0;
   GLuint object_map = 0, proxy_map = 0, map_depth = 0, depth_rb = 0, ms_color = 0, ms_depth = 0;
   GLuint fb_gbuffer = 0, fb_proxy = 0, fb_object_ms = 0, fb_object = 0, fb_final = 0, fb_map = 0, query = 0;
 
   void release() {
     for (GLuint p : {prog_gbuffer, prog_depth, prog_proxy, prog_object, prog_final})
       if (p) glDeleteProgram(p);
-    GLuint texs[] = {photo_tex, albedo_tex, soft_tex, irr_tex, gpos, gnormal, proxy_comp, object_tex, color, diff, object_map, proxy_map,
-                     object_texture, object_glossy, facing_tex};
+    GLuint texs[] = {photo_tex,  albedo_tex, soft_tex,       irr_tex,       gpos,
+                     gnormal,    proxy_comp, object_tex,     color,         diff,
+                     object_map, proxy_map,  object_texture, object_glossy, facing_tex};
     glDeleteTextures(static_cast<GLsizei>(std::size(texs)), texs);
     GLuint rbs[] = {map_depth, depth_rb, ms_color, ms_depth};
     glDeleteRenderbuffers(4, rbs);
@@ -243,13 +253,15 @@ struct Compositor::Impl {
       }
       const std::string i = fmt::format("[{}]", l);
       for (GLuint prog : {prog_proxy, prog_object}) {
-        glProgramUniform4f(prog, glGetUniformLocation(prog, ("u_light_dir" + i).c_str()), static_cast<float>(dir.x), static_cast<float>(dir.y),
-                           static_cast<float>(dir.z), h.distant ? 0.0f : 1.0f);
+        glProgramUniform4f(prog, glGetUniformLocation(prog, ("u_light_dir" + i).c_str()), static_cast<float>(dir.x),
+                           static_cast<float>(dir.y), static_cast<float>(dir.z), h.distant ? 0.0f : 1.0f);
         Vec3 off = h.position - light.centre;
-        glProgramUniform4f(prog, glGetUniformLocation(prog, ("u_light_pos" + i).c_str()), static_cast<float>(h.position.x),
-                           static_cast<float>(h.position.y), static_cast<float>(h.position.z), static_cast<float>(dot(off, off)));
-        glProgramUniform4f(prog, glGetUniformLocation(prog, ("u_light_e" + i).c_str()), static_cast<float>(h.irradiance.x),
-                           static_cast<float>(h.irradiance.y), static_cast<float>(h.irradiance.z), 0.0f);
+        glProgramUniform4f(prog, glGetUniformLocation(prog, ("u_light_pos" + i).c_str()),
+                           static_cast<float>(h.position.x), static_cast<float>(h.position.y),
+                           static_cast<float>(h.position.z), static_cast<float>(dot(off, off)));
+        glProgramUniform4f(prog, glGetUniformLocation(prog, ("u_light_e" + i).c_str()),
+                           static_cast<float>(h.irradiance.x), static_cast<float>(h.irradiance.y),
+                           static_cast<float>(h.irradiance.z), 0.0f);
         glProgramUniformMatrix4fv(prog, glGetUniformLocation(prog, ("u_light_vp" + i).c_str()), 1, GL_FALSE, vp.data());
         glProgramUniform4f(prog, glGetUniformLocation(prog, ("u_light_eye" + i).c_str()), static_cast<float>(lc.eye.x),
                            static_cast<float>(lc.eye.y), static_cast<float>(lc.eye.z), eye_w);
@@ -275,15 +287,18 @@ struct Compositor::Impl {
   }
 };
 
-Compositor::Compositor(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy, const SplitLight& light,
-                       const Image& albedo, const GlCompositeDesc& desc)
+Compositor::Compositor(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy,
+                       const SplitLight& light, const Image& albedo, const GlCompositeDesc& desc)
     : impl_(std::make_unique<Impl>()) {
   Impl& m = *impl_;
-  if (photo.width() != cam.width || photo.height() != cam.height || albedo.width() != cam.width || albedo.height() != cam.height)
-    fail(ErrorKind::Value, "the photograph ({}x{}), its albedo ({}x{}) and the camera's frame ({}x{}) must agree", photo.width(),
-         photo.height(), albedo.width(), albedo.height(), cam.width, cam.height);
-  if (photo.channels() < 3) fail(ErrorKind::Value, "the photograph has {} channels; an RGB image is needed", photo.channels());
-  if (desc.shadow_map_size < 16 || desc.shadow_map_size > 8192) fail(ErrorKind::Value, "shadow map size {} must lie in 16..8192", desc.shadow_map_size);
+  if (photo.width() != cam.width || photo.height() != cam.height || albedo.width() != cam.width ||
+      albedo.height() != cam.height)
+    fail(ErrorKind::Value, "the photograph ({}x{}), its albedo ({}x{}) and the camera's frame ({}x{}) must agree",
+         photo.width(), photo.height(), albedo.width(), albedo.height(), cam.width, cam.height);
+  if (photo.channels() < 3)
+    fail(ErrorKind::Value, "the photograph has {} channels; an RGB image is needed", photo.channels());
+  if (desc.shadow_map_size < 16 || desc.shadow_map_size > 8192)
+    fail(ErrorKind::Value, "shadow map size {} must lie in 16..8192", desc.shadow_map_size);
   if (desc.pcf < 0 || desc.pcf > 4) fail(ErrorKind::Value, "pcf radius {} must lie in 0..4", desc.pcf);
   if (desc.msaa < 1 || desc.msaa > 16) fail(ErrorKind::Value, "msaa {} must lie in 1..16", desc.msaa);
   if (!(desc.cut >= 0 && desc.cut < 1)) fail(ErrorKind::Value, "soft cut-off {} must lie in [0, 1)", desc.cut);
@@ -300,11 +315,16 @@ Compositor::Compositor(const Image& photo, const geometry::Camera& cam, const ge
   using render::gl::build_program;
   using render::gl::ShaderStage;
   const std::vector<std::string> common = {"augment_common.glsl"};
-  m.prog_gbuffer = build_program({{GL_VERTEX_SHADER, "augment_mesh.vert", ""}, {GL_FRAGMENT_SHADER, "augment_gbuffer.frag", ""}});
-  m.prog_depth = build_program({{GL_VERTEX_SHADER, "augment_mesh.vert", ""}, {GL_FRAGMENT_SHADER, "augment_depth.frag", ""}});
-  m.prog_proxy = build_program({{GL_VERTEX_SHADER, "augment_quad.vert", ""}, {GL_FRAGMENT_SHADER, "augment_proxy.frag", "", common}});
-  m.prog_object = build_program({{GL_VERTEX_SHADER, "augment_mesh.vert", ""}, {GL_FRAGMENT_SHADER, "augment_object.frag", "", common}});
-  m.prog_final = build_program({{GL_VERTEX_SHADER, "augment_quad.vert", ""}, {GL_FRAGMENT_SHADER, "augment_final.frag", ""}});
+  m.prog_gbuffer =
+      build_program({{GL_VERTEX_SHADER, "augment_mesh.vert", ""}, {GL_FRAGMENT_SHADER, "augment_gbuffer.frag", ""}});
+  m.prog_depth =
+      build_program({{GL_VERTEX_SHADER, "augment_mesh.vert", ""}, {GL_FRAGMENT_SHADER, "augment_depth.frag", ""}});
+  m.prog_proxy = build_program(
+      {{GL_VERTEX_SHADER, "augment_quad.vert", ""}, {GL_FRAGMENT_SHADER, "augment_proxy.frag", "", common}});
+  m.prog_object = build_program(
+      {{GL_VERTEX_SHADER, "augment_mesh.vert", ""}, {GL_FRAGMENT_SHADER, "augment_object.frag", "", common}});
+  m.prog_final =
+      build_program({{GL_VERTEX_SHADER, "augment_quad.vert", ""}, {GL_FRAGMENT_SHADER, "augment_final.frag", ""}});
   glCreateVertexArrays(1, &m.empty_vao);
   glCreateQueries(GL_TIME_ELAPSED, 1, &m.query);
   m.proxy.upload(proxy);
@@ -341,7 +361,8 @@ Compositor::Compositor(const Image& photo, const geometry::Camera& cam, const ge
   glNamedFramebufferRenderbuffer(m.fb_map, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, m.map_depth);
   for (GLuint f : {m.fb_object_ms, m.fb_map})
     if (glCheckNamedFramebufferStatus(f, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-      fail(ErrorKind::Internal, "the compositor's framebuffer is incomplete (status 0x{:x})", glCheckNamedFramebufferStatus(f, GL_FRAMEBUFFER));
+      fail(ErrorKind::Internal, "the compositor's framebuffer is incomplete (status 0x{:x})",
+           glCheckNamedFramebufferStatus(f, GL_FRAMEBUFFER));
 
   // The G-buffer: the proxy at every pixel's centre, once.
   const Mat4f vp = camera_matrix(cam);
@@ -395,14 +416,17 @@ Compositor::~Compositor() {
   if (impl_) impl_->release();
 }
 
-void Compositor::set_object(const geometry::TriMesh& object, const render::Material& material, const std::vector<Vec3>* soft_visibility) {
+void Compositor::set_object(const geometry::TriMesh& object, const render::Material& material,
+                            const std::vector<Vec3>* soft_visibility) {
   if (object.triangle_count() == 0) fail(ErrorKind::Value, "the object has no triangles");
   if (soft_visibility && soft_visibility->size() != object.triangle_count())
-    fail(ErrorKind::Value, "soft visibility for {} triangles given for an object of {}", soft_visibility->size(), object.triangle_count());
+    fail(ErrorKind::Value, "soft visibility for {} triangles given for an object of {}", soft_visibility->size(),
+         object.triangle_count());
   const Vec3 a = material.albedo, k = material.specular;
   for (int c = 0; c < 3; ++c)
     if (!(a[c] >= 0 && a[c] <= 1 && k[c] >= 0 && k[c] <= 1))
-      fail(ErrorKind::Value, "object albedo ({}, {}, {}) and gloss ({}, {}, {}) must lie in [0, 1]", a.x, a.y, a.z, k.x, k.y, k.z);
+      fail(ErrorKind::Value, "object albedo ({}, {}, {}) and gloss ({}, {}, {}) must lie in [0, 1]", a.x, a.y, a.z, k.x,
+           k.y, k.z);
   const bool glossy = max_component(k) > 0;
   if (glossy && !(material.exponent >= 1 && material.exponent <= 10000))
     fail(ErrorKind::Value, "glossy exponent {} must lie in 1..10000", material.exponent);
@@ -434,7 +458,8 @@ void Compositor::set_object(const geometry::TriMesh& object, const render::Mater
   }
   if (glossy) {
     // G_s of the soft map (the hard lights' lobe is evaluated per light in the shader): bilinear, u repeats, v clamps.
-    render::GlossyMap g = render::prefilter_phong(sphere::EnvMap::from_image(m.light.soft, sphere::MappingKind::LatLong), material.environment_exponent());
+    render::GlossyMap g = render::prefilter_phong(
+        sphere::EnvMap::from_image(m.light.soft, sphere::MappingKind::LatLong), material.environment_exponent());
     m.object_glossy = upload_rgb(g.latlong);
     glTextureParameteri(m.object_glossy, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
     glTextureParameteri(m.object_glossy, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
@@ -459,7 +484,8 @@ void Compositor::draw(Vec3 offset, bool gl_rows, GlFrameTiming* timing) {
   glDisable(GL_CULL_FACE);
   glDisable(GL_BLEND);
   m.shadow_maps(c);  // the object's own shadows need them even when the proxy's (desc.shadows) are off
-  const GLuint units[] = {m.photo_tex, m.albedo_tex, m.gpos, m.gnormal, m.soft_tex, m.irr_tex, m.object_map, m.proxy_map};
+  const GLuint units[] = {m.photo_tex, m.albedo_tex, m.gpos,       m.gnormal,
+                          m.soft_tex,  m.irr_tex,    m.object_map, m.proxy_map};
   glBindTextures(0, 8, units);
 
   // The proxy's pixels: photo + min(ρ, 1)/π ΔE.
@@ -468,8 +494,8 @@ void Compositor::draw(Vec3 offset, bool gl_rows, GlFrameTiming* timing) {
   glDisable(GL_DEPTH_TEST);
   glUseProgram(m.prog_proxy);
   glBindTextureUnit(10, m.facing_tex);
-  glProgramUniform4f(m.prog_proxy, glGetUniformLocation(m.prog_proxy, "u_sphere"), static_cast<float>(c.x), static_cast<float>(c.y),
-                     static_cast<float>(c.z), static_cast<float>(m.sphere.radius));
+  glProgramUniform4f(m.prog_proxy, glGetUniformLocation(m.prog_proxy, "u_sphere"), static_cast<float>(c.x),
+                     static_cast<float>(c.y), static_cast<float>(c.z), static_cast<float>(m.sphere.radius));
   set_vec3(m.prog_proxy, "u_object_albedo", m.object_albedo);
   glBindVertexArray(m.empty_vao);
   glDrawArrays(GL_TRIANGLES, 0, 3);

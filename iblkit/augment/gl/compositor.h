@@ -17,8 +17,9 @@
 //
 // Interreflection kept: proxy → object as captured, times the factor that turns it into what each triangle
 // receives when one is given (set_object's soft_visibility: its own occlusion, the proxy's, the floor under it
-// darkened by its shadow, and the parallax from the map's centre, ray traced once per placement on the CPU), object → proxy through the sphere (its face towards y lit by the soft irradiance and the hard
-// lights, unshadowed; diffuse, with the texture's mean albedo). Not kept: the object's light on itself.
+// darkened by its shadow, and the parallax from the map's centre, ray traced once per placement on the CPU), object →
+// proxy through the sphere (its face towards y lit by the soft irradiance and the hard lights, unshadowed; diffuse,
+// with the texture's mean albedo). Not kept: the object's light on itself.
 //
 // The object's material is render::Material's, as on the CPU: the albedo times the texture at the mesh's
 // UVs (bilinear, repeating), and the glossy lobe (Phong or Blinn-Phong, weight `specular`): from the hard
@@ -31,24 +32,24 @@
 #include <vector>
 
 #include "iblkit/augment/composite.h"
-#include "iblkit/augment/split_light.h"
 #include "iblkit/augment/sphere_occlusion.h"
+#include "iblkit/augment/split_light.h"
 #include "iblkit/render/shading.h"
 
 namespace ibl::augment::gl {
 
 struct GlCompositeDesc {
-  SplitDesc split;             // hard lights (≤ 16) and their threshold
-  int shadow_map_size = 512;   // texels per side of each light's two maps (fitted to the object's bounding sphere)
-  int pcf = 1;                 // (2·pcf + 1)² taps per shadow lookup
-  int msaa = 4;                // samples per pixel of the object pass (its coverage at edges)
-  double cut = 4e-3;           // the soft term is 0 where the sphere's cosine-weighted share is below this, whole above 2×
-  bool shadows = true;         // false: the object pasted without shadow or reflection (a baseline)
-  bool bounce = true;          // the object's light on the proxy
-  int albedo_samples = 64;     // composite(): light samples per pixel of the albedo estimate
-  int visibility_samples = -1; // composite(): patch samples per object triangle of its soft light's factor
-                               // (augment::soft_visibility); 0: the object's soft light as the map's centre
-                               // sees it; −1: kVisibilityRays over the triangles, 16 to 1024 each
+  SplitDesc split;            // hard lights (≤ 16) and their threshold
+  int shadow_map_size = 512;  // texels per side of each light's two maps (fitted to the object's bounding sphere)
+  int pcf = 1;                // (2·pcf + 1)² taps per shadow lookup
+  int msaa = 4;               // samples per pixel of the object pass (its coverage at edges)
+  double cut = 4e-3;    // the soft term is 0 where the sphere's cosine-weighted share is below this, whole above 2×
+  bool shadows = true;  // false: the object pasted without shadow or reflection (a baseline)
+  bool bounce = true;   // the object's light on the proxy
+  int albedo_samples = 64;      // composite(): light samples per pixel of the albedo estimate
+  int visibility_samples = -1;  // composite(): patch samples per object triangle of its soft light's factor
+                                // (augment::soft_visibility); 0: the object's soft light as the map's centre
+                                // sees it; −1: kVisibilityRays over the triangles, 16 to 1024 each
   static constexpr int64_t kVisibilityRays = int64_t(1) << 22;  // 209 a triangle for the 20k-triangle blob
   uint64_t seed = 1;
 };
@@ -72,7 +73,8 @@ class Compositor {
   // soft_visibility: per triangle, the factor on the soft irradiance (augment::soft_visibility, composite.h: its
   // own occlusion and the proxy's, the floor darkened by its shadow, the parallax); none: 1.
   // Throws ibl::Error on an empty mesh, a material out of range or a visibility of the wrong size.
-  void set_object(const geometry::TriMesh& object, const render::Material& material, const std::vector<Vec3>* soft_visibility = nullptr);
+  void set_object(const geometry::TriMesh& object, const render::Material& material,
+                  const std::vector<Vec3>* soft_visibility = nullptr);
   // A Lambertian object of albedo `albedo`.
   void set_object(const geometry::TriMesh& object, Vec3 albedo, const std::vector<Vec3>* soft_visibility = nullptr) {
     set_object(object, render::Material{albedo, {0, 0, 0}}, soft_visibility);
@@ -97,13 +99,13 @@ class Compositor {
 // The whole composite on the GPU (a headless context of its own): the albedo estimated on the CPU
 // (estimate_albedo), the light split, one frame read back. Throws ibl::Error (kind Unsupported) when no GL
 // context can be had, and as composite() does on bad input.
-CompositeResult composite(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy, const LocalLight& light,
-                          const geometry::TriMesh& object, const render::Material& material, const GlCompositeDesc& desc = {},
-                          GlFrameTiming* timing = nullptr);
+CompositeResult composite(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy,
+                          const LocalLight& light, const geometry::TriMesh& object, const render::Material& material,
+                          const GlCompositeDesc& desc = {}, GlFrameTiming* timing = nullptr);
 // A Lambertian object of albedo `albedo`.
-inline CompositeResult composite(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy, const LocalLight& light,
-                                 const geometry::TriMesh& object, Vec3 albedo, const GlCompositeDesc& desc = {},
-                                 GlFrameTiming* timing = nullptr) {
+inline CompositeResult composite(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy,
+                                 const LocalLight& light, const geometry::TriMesh& object, Vec3 albedo,
+                                 const GlCompositeDesc& desc = {}, GlFrameTiming* timing = nullptr) {
   return composite(photo, cam, proxy, light, object, render::Material{albedo, {0, 0, 0}}, desc, timing);
 }
 

@@ -9,9 +9,9 @@
 #include <cstdio>
 #include <memory>
 
-#include "iblkit/augment/testing.h"
 #include "iblkit/augment/gl/compositor.h"
 #include "iblkit/augment/object.h"
+#include "iblkit/augment/testing.h"
 #include "iblkit/core/error.h"
 #include "iblkit/render/gl/context.h"
 
@@ -22,9 +22,9 @@ constexpr int kW = 96, kH = 72;
 
 bool same(Vec3 a, Vec3 b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
 
-#define SKIP_WITHOUT_GL()                                                                 \
-  do {                                                                                    \
-    std::string why;                                                                      \
+#define SKIP_WITHOUT_GL()                                                                        \
+  do {                                                                                           \
+    std::string why;                                                                             \
     if (!render::gl::available(&why)) GTEST_SKIP() << "no OpenGL 4.5 through EGL here: " << why; \
   } while (0)
 
@@ -62,7 +62,8 @@ TEST(AugmentGl, PixelsTheObjectDoesNotTouchAreThePhotographBitForBit) {
   geometry::Camera cam = top_camera();
   cam.fov_y_deg = 90;
   const geometry::TriMesh floor = geometry::make_quad({0, 0, 0}, {0, 1, 0}, {0, 0, -1}, 12, 12);
-  auto r = augment::gl::composite(photo, cam, floor, sky({1, 1, 1}, {3000, 3000, 3000}, at), sphere_at(at, 0.3), {0.7, 0.7, 0.7});
+  auto r = augment::gl::composite(photo, cam, floor, sky({1, 1, 1}, {3000, 3000, 3000}, at), sphere_at(at, 0.3),
+                                  {0.7, 0.7, 0.7});
   int far_pixels = 0, changed_near = 0;
   for (int y = 0; y < kH; ++y)
     for (int x = 0; x < kW; ++x) {
@@ -84,7 +85,8 @@ TEST(AugmentGl, PixelsTheObjectDoesNotTouchAreThePhotographBitForBit) {
   // No shadows (the pasted baseline): only the object's pixels change.
   GlCompositeDesc none;
   none.shadows = false;
-  auto p = augment::gl::composite(photo, cam, floor, sky({1, 1, 1}, {3000, 3000, 3000}, at), sphere_at(at, 0.3), {0.7, 0.7, 0.7}, none);
+  auto p = augment::gl::composite(photo, cam, floor, sky({1, 1, 1}, {3000, 3000, 3000}, at), sphere_at(at, 0.3),
+                                  {0.7, 0.7, 0.7}, none);
   for (int y = 0; y < kH; ++y)
     for (int x = 0; x < kW; ++x)
       if (p.mask.at(x, y, 0) == 0) ASSERT_TRUE(same(p.composite.rgb(x, y), photo.rgb(x, y))) << x << "," << y;
@@ -121,7 +123,8 @@ TEST(AugmentGl, ObjectUnderAConstantSkyHasRadianceRhoL) {
   // below), so E = π L on every object normal and the object's radiance is ρ L exactly.
   geometry::TriMesh proxy = geometry::make_quad({5, -5, 0}, {0, 1, 0}, {0, 0, -1}, 0.5, 0.5);
   geometry::Camera cam = top_camera();
-  auto r = augment::gl::composite(constant_photo(0.1), cam, proxy, sky({2, 2, 2}, {}, {0, 0.3, 0}), sphere_at({0, 0.3, 0}, 0.6), {0.5, 0.5, 0.5});
+  auto r = augment::gl::composite(constant_photo(0.1), cam, proxy, sky({2, 2, 2}, {}, {0, 0.3, 0}),
+                                  sphere_at({0, 0.3, 0}, 0.6), {0.5, 0.5, 0.5});
   int full = 0;
   for (int y = 0; y < kH; ++y)
     for (int x = 0; x < kW; ++x)
@@ -142,7 +145,8 @@ TEST(AugmentGl, AWallInFrontHidesTheObjectAndTheFrameMovesWithIt) {
   cam.width = kW;
   cam.height = kH;
   const Vec3 at{0, 0.3, -0.5};
-  auto r = augment::gl::composite(constant_photo(0.3), cam, proxy, sky({1, 1, 1}, {}, at), sphere_at(at, 0.3), {0.7, 0.7, 0.7});
+  auto r = augment::gl::composite(constant_photo(0.3), cam, proxy, sky({1, 1, 1}, {}, at), sphere_at(at, 0.3),
+                                  {0.7, 0.7, 0.7});
   EXPECT_EQ(r.stats.object_pixels, 0);
 
   // The same scene without the wall, through a Compositor: moving the object moves its pixels.
@@ -187,8 +191,8 @@ geometry::Camera frame_camera(Vec3 eye, Vec3 target, double fov_deg) {
 }
 
 // The CPU composite over the floor with 4096 light samples per object pixel (its object nearly noise-free).
-CompositeResult cpu_reference(const Image& photo, const geometry::Camera& cam, const LocalLight& light, const geometry::TriMesh& object,
-                              const render::Material& m) {
+CompositeResult cpu_reference(const Image& photo, const geometry::Camera& cam, const LocalLight& light,
+                              const geometry::TriMesh& object, const render::Material& m) {
   CompositeDesc cd;
   cd.object_samples = 4096;
   return augment::composite(photo, cam, floor_mesh(), light, object, m, cd);
@@ -219,7 +223,8 @@ TEST(AugmentGl, GlossyLobeUnderAConstantSkyAddsKLWhereTheViewMeetsTheNormal) {
   cam.width = kW;
   cam.height = kH;
   render::Material m{{0.3, 0.3, 0.3}, {0.5, 0.25, 0.1}, 20};
-  auto r = augment::gl::composite(constant_photo(0.1), cam, proxy, sky({2, 2, 2}, {}, {0, 0.3, 0}), sphere_at({0, 0.3, 0}, 0.8), m);
+  auto r = augment::gl::composite(constant_photo(0.1), cam, proxy, sky({2, 2, 2}, {}, {0, 0.3, 0}),
+                                  sphere_at({0, 0.3, 0}, 0.8), m);
   const Vec3 c = r.composite.rgb(kW / 2, kH / 2);
   ASSERT_EQ(r.mask.at(kW / 2, kH / 2, 0), 1);
   EXPECT_NEAR(c.x, 0.3 * 2 + 0.5 * 2, 0.02);
@@ -228,7 +233,8 @@ TEST(AugmentGl, GlossyLobeUnderAConstantSkyAddsKLWhereTheViewMeetsTheNormal) {
   render::Material blinn = m;
   blinn.lobe = render::Lobe::BlinnPhong;
   blinn.exponent = 80;  // environment_exponent 20: the same prefiltered map
-  auto b = augment::gl::composite(constant_photo(0.1), cam, proxy, sky({2, 2, 2}, {}, {0, 0.3, 0}), sphere_at({0, 0.3, 0}, 0.8), blinn);
+  auto b = augment::gl::composite(constant_photo(0.1), cam, proxy, sky({2, 2, 2}, {}, {0, 0.3, 0}),
+                                  sphere_at({0, 0.3, 0}, 0.8), blinn);
   EXPECT_NEAR(b.composite.rgb(kW / 2, kH / 2).x, 0.3 * 2 + 0.5 * 2, 0.02);
 }
 
@@ -277,8 +283,8 @@ TEST(AugmentGl, TextureAndSunHighlightAgreeWithTheCpuReference) {
   auto [gx, gy] = brightest(gl);
   auto [cx, cy] = brightest(cpu);
   EXPECT_LE(std::abs(gx - cx) + std::abs(gy - cy), 3) << "GL " << gx << "," << gy << " CPU " << cx << "," << cy;
-  std::printf("textured glossy sphere, GL / CPU over %d pixels: %.4f %.4f %.4f; highlight GL (%d,%d) CPU (%d,%d)\n", s.pixels,
-              s.gl.x / s.cpu.x, s.gl.y / s.cpu.y, s.gl.z / s.cpu.z, gx, gy, cx, cy);
+  std::printf("textured glossy sphere, GL / CPU over %d pixels: %.4f %.4f %.4f; highlight GL (%d,%d) CPU (%d,%d)\n",
+              s.pixels, s.gl.x / s.cpu.x, s.gl.y / s.cpu.y, s.gl.z / s.cpu.z, gx, gy, cx, cy);
 }
 
 TEST(AugmentGl, SoftVisibilityDarkensTheUndersideAsTheCpuReferenceDoes) {
@@ -304,7 +310,10 @@ TEST(AugmentGl, SoftVisibilityDarkensTheUndersideAsTheCpuReferenceDoes) {
   auto gl = augment::gl::composite(photo, cam, floor_mesh(), light, object, {0.7, 0.7, 0.7}, with);
   auto gl0 = augment::gl::composite(photo, cam, floor_mesh(), light, object, {0.7, 0.7, 0.7}, without);
   const double py = kH / 2.0;  // the blob's centre is the camera's target: the frame's centre row
-  struct Half { double gl = 0, gl0 = 0, cpu = 0; int n = 0; } upper, lower;
+  struct Half {
+    double gl = 0, gl0 = 0, cpu = 0;
+    int n = 0;
+  } upper, lower;
   for (int y = 0; y < kH; ++y)
     for (int x = 0; x < kW; ++x)
       if (gl.mask.at(x, y, 0) == 1 && gl0.mask.at(x, y, 0) == 1 && cpu.mask.at(x, y, 0) == 1) {
@@ -316,8 +325,9 @@ TEST(AugmentGl, SoftVisibilityDarkensTheUndersideAsTheCpuReferenceDoes) {
       }
   ASSERT_GT(lower.n, 300);
   ASSERT_GT(upper.n, 300);
-  std::printf("blob over a floor, GL / CPU: lower half %.4f (unoccluded %.4f), upper half %.4f (%.4f), %d + %d pixels\n", lower.gl / lower.cpu,
-              lower.gl0 / lower.cpu, upper.gl / upper.cpu, upper.gl0 / upper.cpu, lower.n, upper.n);
+  std::printf(
+      "blob over a floor, GL / CPU: lower half %.4f (unoccluded %.4f), upper half %.4f (%.4f), %d + %d pixels\n",
+      lower.gl / lower.cpu, lower.gl0 / lower.cpu, upper.gl / upper.cpu, upper.gl0 / upper.cpu, lower.n, upper.n);
   EXPECT_NEAR(lower.gl / lower.cpu, 1.0, 0.015);
   EXPECT_NEAR(upper.gl / upper.cpu, 1.0, 0.015);
   // Without the factor the underside is lit by the floor as if the object cast no shadow on it.
@@ -343,7 +353,8 @@ TEST(AugmentGl, SoftVisibilityIsOneWhereNothingIsHidden) {
     // Alone: exactly 1 where every sample is a distant patch; the few triangles that sampled the quad's patches
     // (seen nearer or farther than from the centre: parallax) and rays grazing a neighbouring facet are near 1.
     // Pooled with their neighbours (the default) more are near 1 and fewer exactly.
-    std::printf("soft factor (pool %d rays) exactly 1 on %d of %zu triangles, at most %.5f from 1\n", d.pool_rays, exact, f.size(), worst);
+    std::printf("soft factor (pool %d rays) exactly 1 on %d of %zu triangles, at most %.5f from 1\n", d.pool_rays,
+                exact, f.size(), worst);
     if (d.pool_rays == 0) EXPECT_GE(exact, static_cast<int>(f.size() * 0.95));
     EXPECT_LT(worst, d.pool_rays == 0 ? 0.01 : 0.002);
   }

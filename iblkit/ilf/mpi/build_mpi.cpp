@@ -152,8 +152,10 @@ void sum_on_root(double* x, int64_t n) {
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
   for (int64_t off = 0; off < n; off += kReducePiece) {
     int m = int(std::min(kReducePiece, n - off));
-    if (rank == 0) MPI_Reduce(MPI_IN_PLACE, x + off, m, MPI_DOUBLE, MPI_SUM, 0, MPI_COMM_WORLD);
-    else MPI_Reduce(x + off, nullptr, m, MPI_DOUBLE, MPI_SUM, 0, MPI_COMM_WORLD);
+    if (rank == 0)
+      MPI_Reduce(MPI_IN_PLACE, x + off, m, MPI_DOUBLE, MPI_SUM, 0, MPI_COMM_WORLD);
+    else
+      MPI_Reduce(x + off, nullptr, m, MPI_DOUBLE, MPI_SUM, 0, MPI_COMM_WORLD);
   }
 }
 
@@ -161,7 +163,8 @@ void sum_on_root(double* x, int64_t n) {
 // (MPI_Allreduce need not give every rank the same rounding, and the ranks must make the same choice).
 void sum_on_every_rank(double* x, int64_t n) {
   sum_on_root(x, n);
-  for (int64_t off = 0; off < n; off += kReducePiece) MPI_Bcast(x + off, int(std::min(kReducePiece, n - off)), MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  for (int64_t off = 0; off < n; off += kReducePiece)
+    MPI_Bcast(x + off, int(std::min(kReducePiece, n - off)), MPI_DOUBLE, 0, MPI_COMM_WORLD);
 }
 
 SHGrid Job::build(const Sequence& seq_in, const BuildDesc& desc, const ProgressFn& progress, BuildReport* report,
@@ -200,9 +203,13 @@ SHGrid Job::build(const Sequence& seq_in, const BuildDesc& desc, const ProgressF
         counts[r] = int(int64_t(pairs) * (r + 1) / size_) - displs[r];
       }
       std::vector<double> mine;
-      agree([&] { mine = neighbour_energies(seq_in, sd, displs[rank_], displs[rank_] + counts[rank_], root ? progress : ProgressFn{}); });
+      agree([&] {
+        mine = neighbour_energies(seq_in, sd, displs[rank_], displs[rank_] + counts[rank_],
+                                  root ? progress : ProgressFn{});
+      });
       e.resize(static_cast<size_t>(pairs));
-      MPI_Allgatherv(mine.data(), counts[rank_], MPI_DOUBLE, e.data(), counts.data(), displs.data(), MPI_DOUBLE, MPI_COMM_WORLD);
+      MPI_Allgatherv(mine.data(), counts[rank_], MPI_DOUBLE, e.data(), counts.data(), displs.data(), MPI_DOUBLE,
+                     MPI_COMM_WORLD);
     }
     auto keep = keep_from_energies(n, e, sd.threshold);
     seq.probes.clear();
@@ -275,7 +282,8 @@ SHGrid Job::build(const Sequence& seq_in, const BuildDesc& desc, const ProgressF
     std::vector<std::pair<int, std::string>> skips;
     std::vector<uint16_t> sendbuf(size_t(d.chunk) * t.slots() * 3);
     std::vector<uint16_t> recvbuf(size_t(d.chunk) * size_ * my_slots * 3);
-    std::vector<int> scount(static_cast<size_t>(size_)), sdispl(static_cast<size_t>(size_)), rcount(static_cast<size_t>(size_)), rdispl(static_cast<size_t>(size_));
+    std::vector<int> scount(static_cast<size_t>(size_)), sdispl(static_cast<size_t>(size_)),
+        rcount(static_cast<size_t>(size_)), rdispl(static_cast<size_t>(size_));
     int64_t done_all = 0;
     for (int c = 0; c < d.rounds; ++c) {
       // Read this rank's chunk of the round.
@@ -293,7 +301,10 @@ SHGrid Job::build(const Sequence& seq_in, const BuildDesc& desc, const ProgressF
           if (!msg.empty()) {
             std::lock_guard lk(mu);
             if (!bd.skip_bad) {
-              if (bad_probe < 0 || p < bad_probe) { bad_probe = p; bad_msg = msg; }
+              if (bad_probe < 0 || p < bad_probe) {
+                bad_probe = p;
+                bad_msg = msg;
+              }
             } else {
               valid[p] = 0;
               skips.push_back({p, msg});
@@ -357,9 +368,9 @@ SHGrid Job::build(const Sequence& seq_in, const BuildDesc& desc, const ProgressF
     skipped = int(reasons.size());
     if (skipped == P) throw AgreedError(ErrorKind::Value, fmt::format("{}: every probe was skipped", seq.manifest));
     agree([&] {
-      json j = {{"key", key}, {"chunk", d.chunk}, {"valid", valid}, {"skipped", skipped}, {"reasons", reasons},
-                {"first_block", kb0}, {"end_block", kb1}, {"width", w}, {"height", h}, {"buckets", t.buckets()},
-                {"blocks", t.blocks()}, {"ranks", size_}};
+      json j = {{"key", key},         {"chunk", d.chunk},       {"valid", valid},       {"skipped", skipped},
+                {"reasons", reasons}, {"first_block", kb0},     {"end_block", kb1},     {"width", w},
+                {"height", h},        {"buckets", t.buckets()}, {"blocks", t.blocks()}, {"ranks", size_}};
       write_json_file(index, j, -1);
     });
   }
@@ -384,12 +395,14 @@ SHGrid Job::build(const Sequence& seq_in, const BuildDesc& desc, const ProgressF
   auto tcv = Clock::now();
   ProjectDesc pd = desc.project;
   int64_t cv_values = 0;
-  CvShare share{kb0, kb1, [this](const std::function<void()>& f) { agree(f); }, [&](double* x, size_t n) {
+  CvShare share{kb0, kb1, [this](const std::function<void()>& f) { agree(f); },
+                [&](double* x, size_t n) {
                   sum_on_every_rank(x, int64_t(n));
                   cv_values += int64_t(n);
                 }};
   cross_validate_build(*store, origins, desc, grid, pd, rep, share);
-  if (root && (grid.nx != out.grid().nx || grid.ny != out.grid().ny || grid.nz != out.grid().nz)) out = SHGrid(grid, desc.bands);
+  if (root && (grid.nx != out.grid().nx || grid.ny != out.grid().ny || grid.nz != out.grid().nz))
+    out = SHGrid(grid, desc.bands);
   rep.ball_radius = desc.ball_parallax && !t.start.empty() ? seq.ball.radius : 0.0;
   dr.t_crossval = since(tcv);
   dr.bytes_crossval = size_ > 1 ? cv_values * 8 : 0;
@@ -430,13 +443,22 @@ SHGrid Job::build(const Sequence& seq_in, const BuildDesc& desc, const ProgressF
   // The whole job's figures.
   MPI_Allreduce(MPI_IN_PLACE, counts, 2, MPI_INT64_T, MPI_SUM, MPI_COMM_WORLD);
   MPI_Allreduce(MPI_IN_PLACE, &rep.gemm_flops, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
-  double tmax[8] = {dr.t_read, dr.t_exchange, dr.t_project, dr.t_repair, dr.t_accumulate, dr.t_reduce, dr.t_subsample, dr.t_crossval};
+  double tmax[8] = {dr.t_read,       dr.t_exchange, dr.t_project,   dr.t_repair,
+                    dr.t_accumulate, dr.t_reduce,   dr.t_subsample, dr.t_crossval};
   MPI_Allreduce(MPI_IN_PLACE, tmax, 8, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
-  dr.t_read = tmax[0]; dr.t_exchange = tmax[1]; dr.t_project = tmax[2]; dr.t_repair = tmax[3];
-  dr.t_accumulate = tmax[4]; dr.t_reduce = tmax[5]; dr.t_subsample = tmax[6]; dr.t_crossval = tmax[7];
+  dr.t_read = tmax[0];
+  dr.t_exchange = tmax[1];
+  dr.t_project = tmax[2];
+  dr.t_repair = tmax[3];
+  dr.t_accumulate = tmax[4];
+  dr.t_reduce = tmax[5];
+  dr.t_subsample = tmax[6];
+  dr.t_crossval = tmax[7];
   int64_t bmax[4] = {dr.bytes_sent, dr.bytes_received, peak_rss_bytes(), 0};
   MPI_Allreduce(MPI_IN_PLACE, bmax, 4, MPI_INT64_T, MPI_MAX, MPI_COMM_WORLD);
-  dr.bytes_sent = bmax[0]; dr.bytes_received = bmax[1]; dr.peak_rss_bytes = bmax[2];
+  dr.bytes_sent = bmax[0];
+  dr.bytes_received = bmax[1];
+  dr.peak_rss_bytes = bmax[2];
   dr.blocks_min = t.blocks();
   dr.blocks_max = 0;
   for (int q = 0; q < size_; ++q) {

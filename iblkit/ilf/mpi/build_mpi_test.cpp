@@ -54,9 +54,10 @@ Run run(const std::string& cmd) {
 }
 
 Run mpirun(int ranks, const std::string& args) {
-  return run(fmt::format("timeout {} env OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1 "
-                         "mpirun --oversubscribe -np {} {} --quiet ilf build {}",
-                         kTimeout, ranks, iblkit_command(), args));
+  return run(fmt::format(
+      "timeout {} env OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1 "
+      "mpirun --oversubscribe -np {} {} --quiet ilf build {}",
+      kTimeout, ranks, iblkit_command(), args));
 }
 
 class IlfMpi : public ::testing::Test {
@@ -64,7 +65,10 @@ class IlfMpi : public ::testing::Test {
   void SetUp() override {
     if (!have_mpirun()) GTEST_SKIP() << "mpirun is absent (install openmpi-bin): the distributed build is not tested";
     if (iblkit_command().empty()) GTEST_SKIP() << "no iblkit command beside the test binary";
-    dir_ = (fs::temp_directory_path() / fmt::format("iblkit_mpi_{}_{}", ::testing::UnitTest::GetInstance()->current_test_info()->name(), ::getpid())).string();
+    dir_ =
+        (fs::temp_directory_path() /
+         fmt::format("iblkit_mpi_{}_{}", ::testing::UnitTest::GetInstance()->current_test_info()->name(), ::getpid()))
+            .string();
     fs::remove_all(dir_);
     fs::create_directories(dir_);
     SynthDesc sd;
@@ -97,14 +101,18 @@ class IlfMpi : public ::testing::Test {
       if (d > kRelTol * std::abs(x)) ++bad;
       if (x != 0) worst = std::max(worst, d / std::abs(x));
     }
-    EXPECT_EQ(bad, 0) << what << ": " << bad << " of " << a.data().size() << " coefficients differ by more than 1e-6 (worst " << worst << ")";
+    EXPECT_EQ(bad, 0) << what << ": " << bad << " of " << a.data().size()
+                      << " coefficients differ by more than 1e-6 (worst " << worst << ")";
     return worst;
   }
   std::string dir_, manifest_;
 };
 
 TEST_F(IlfMpi, SameGridAsSerialOnOneTwoThreeRanks) {
-  struct Case { std::string args; BuildDesc bd; };
+  struct Case {
+    std::string args;
+    BuildDesc bd;
+  };
   BuildDesc pixel;
   pixel.nx = pixel.ny = pixel.nz = 6;
   pixel.buckets.octahedral = 0;
@@ -115,9 +123,10 @@ TEST_F(IlfMpi, SameGridAsSerialOnOneTwoThreeRanks) {
   BuildDesc sub = pixel;
   sub.subsample = SubsampleDesc{0.5, 0.5};
   // A fixed kernel without cross-validation (the CLI's default cross-validates: next test).
-  std::vector<Case> cases = {{"--grid 6 --directions pixel --kernel 3 --cv-folds 0", pixel},
-                             {"--grid 6 --directions 6 --repair pullpush --bands 3 --kernel 3 --cv-folds 0", oct},
-                             {"--grid 6 --directions pixel --subsample 0.5 --subsample-distance 0.5 --kernel 3 --cv-folds 0", sub}};
+  std::vector<Case> cases = {
+      {"--grid 6 --directions pixel --kernel 3 --cv-folds 0", pixel},
+      {"--grid 6 --directions 6 --repair pullpush --bands 3 --kernel 3 --cv-folds 0", oct},
+      {"--grid 6 --directions pixel --subsample 0.5 --subsample-distance 0.5 --kernel 3 --cv-folds 0", sub}};
   for (const auto& c : cases) {
     SHGrid want = serial(c.bd);
     for (int n : {1, 2, 3}) {
@@ -131,11 +140,16 @@ TEST_F(IlfMpi, SameGridAsSerialOnOneTwoThreeRanks) {
 
 // The cross-validation under MPI (docs/ilf.md "On a cluster"): the CLI's default (--kernel auto, 5
 // folds), --grid auto (with the kernel), a fixed kernel's error, and --error-grid give the serial
-// build's trials, choice, error, error volume and grid on 1, 2 and 3 ranks. 120 probes of 24² (444 pixel buckets, 7 blocks: every
-// bucket is evaluated) and of 64² (3228 buckets of 51 blocks, over BuildDesc::auto_max_buckets: every
-// 2nd by its global index, whichever rank owns it).
+// build's trials, choice, error, error volume and grid on 1, 2 and 3 ranks. 120 probes of 24² (444 pixel buckets, 7
+// blocks: every bucket is evaluated) and of 64² (3228 buckets of 51 blocks, over BuildDesc::auto_max_buckets: every 2nd
+// by its global index, whichever rank owns it).
 TEST_F(IlfMpi, CrossValidationAndChoiceAsSerial) {
-  struct Case { int size; std::string args; BuildDesc bd; std::vector<int> ranks; };
+  struct Case {
+    int size;
+    std::string args;
+    BuildDesc bd;
+    std::vector<int> ranks;
+  };
   BuildDesc kauto;  // the CLI's defaults at --grid 6
   kauto.nx = kauto.ny = kauto.nz = 6;
   kauto.auto_kernel = true;
@@ -174,8 +188,8 @@ TEST_F(IlfMpi, CrossValidationAndChoiceAsSerial) {
       std::string what = fmt::format("{}² frames, {}, {} ranks", c.size, c.args, n);
       std::string out = fmt::format("{}/cv{}.shgrid", dir_, n), err = fmt::format("{}/cv{}.err.shgrid", dir_, n);
       auto t0 = std::chrono::steady_clock::now();
-      auto r = mpirun(n, fmt::format("{} {} --json --out {} --error-grid {} --buckets {}/cvb{}_{}", seqs[c.size], c.args, out, err,
-                                     dir_, c.size, n));
+      auto r = mpirun(n, fmt::format("{} {} --json --out {} --error-grid {} --buckets {}/cvb{}_{}", seqs[c.size],
+                                     c.args, out, err, dir_, c.size, n));
       ASSERT_EQ(r.status, 0) << what << ":\n" << r.out;
       double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       nlohmann::json j;
@@ -198,9 +212,11 @@ TEST_F(IlfMpi, CrossValidationAndChoiceAsSerial) {
         }
       }
       double dg = expect_same(grid, out, what), de = expect_same(ev, err, what + " (error volume)", true);
-      std::printf("[ilf] mpi cv: %s (kernel %g, %dx%dx%d): cv error %.9f, relative difference to serial %.1e; grid %.1e, "
-                  "error volume %.1e (worst value); %.1f s\n", what.c_str(), want.kernel_cells, want.nx, want.ny, want.nz,
-                  want.crossval->rel_error, std::abs(got - want.crossval->rel_error) / want.crossval->rel_error, dg, de, seconds);
+      std::printf(
+          "[ilf] mpi cv: %s (kernel %g, %dx%dx%d): cv error %.9f, relative difference to serial %.1e; grid %.1e, "
+          "error volume %.1e (worst value); %.1f s\n",
+          what.c_str(), want.kernel_cells, want.nx, want.ny, want.nz, want.crossval->rel_error,
+          std::abs(got - want.crossval->rel_error) / want.crossval->rel_error, dg, de, seconds);
     }
   }
 }
@@ -222,7 +238,8 @@ TEST_F(IlfMpi, BadFrameFailsOnceOrIsSkippedOnEveryRank) {
   EXPECT_NE(r.out.find(line), std::string::npos) << "serial: " << line << "\nmpi: " << r.out;
   size_t first = r.out.find("iblkit: error:");
   EXPECT_NE(first, std::string::npos) << r.out;
-  EXPECT_EQ(r.out.find("iblkit: error:", first + 1), std::string::npos) << "the error is printed more than once:\n" << r.out;
+  EXPECT_EQ(r.out.find("iblkit: error:", first + 1), std::string::npos) << "the error is printed more than once:\n"
+                                                                        << r.out;
   EXPECT_FALSE(fs::exists(out));
   // --skip-bad: the serial build's grid without probe 40.
   BuildDesc bd;

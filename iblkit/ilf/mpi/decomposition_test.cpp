@@ -33,7 +33,8 @@ TEST(IlfMpiDecomposition, EverySlotOneOwnerEveryProbeOneReader) {
           int g = d.chunk_of(r, c);
           for (int i = 0; i < d.chunk_probes(g); ++i) ++read[size_t(g) * d.chunk + i];
         }
-      for (int p = 0; p < probes; ++p) EXPECT_EQ(read[p], 1) << "probe " << p << " of " << probes << ", " << ranks << " ranks";
+      for (int p = 0; p < probes; ++p)
+        EXPECT_EQ(read[p], 1) << "probe " << p << " of " << probes << ", " << ranks << " ranks";
       // Balance: no rank reads more than one chunk more than another, and a rank's chunk is at most
       // its share of the probes.
       EXPECT_LE(d.chunk, (probes + ranks - 1) / ranks);

@@ -27,7 +27,8 @@ void keep_drivers_loaded_for_leak_checks() {
   std::vector<std::string> names;  // collected first: dlopen is not called under dl_iterate_phdr's lock
   dl_iterate_phdr(
       [](dl_phdr_info* info, size_t, void* out) {
-        if (info->dlpi_name && info->dlpi_name[0]) static_cast<std::vector<std::string>*>(out)->push_back(info->dlpi_name);
+        if (info->dlpi_name && info->dlpi_name[0])
+          static_cast<std::vector<std::string>*>(out)->push_back(info->dlpi_name);
         return 0;
       },
       &names);
@@ -47,8 +48,9 @@ Context::Context() {
     fail(ErrorKind::Unsupported, "no EGL display (eglInitialize failed, error 0x{:x})", eglGetError());
   keep_drivers_loaded_for_leak_checks();
   if (!eglBindAPI(EGL_OPENGL_API)) fail(ErrorKind::Unsupported, "EGL cannot bind the OpenGL API");
-  const EGLint attribs[] = {EGL_CONTEXT_MAJOR_VERSION, 4, EGL_CONTEXT_MINOR_VERSION, 5,
-                            EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
+  const EGLint attribs[] = {
+      EGL_CONTEXT_MAJOR_VERSION,           4,       EGL_CONTEXT_MINOR_VERSION, 5, EGL_CONTEXT_OPENGL_PROFILE_MASK,
+      EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
   EGLContext ctx = eglCreateContext(dpy, EGL_NO_CONFIG_KHR, EGL_NO_CONTEXT, attribs);
   if (ctx == EGL_NO_CONTEXT) {
     eglTerminate(dpy);

@@ -29,8 +29,8 @@ void Presenter::draw(unsigned texture, int width, int height, double scale, io::
   glProgramUniform1f(program_, glGetUniformLocation(program_, "u_scale"), static_cast<float>(scale));
   glProgramUniform1i(program_, glGetUniformLocation(program_, "u_curve"),
                      curve == io::ToneCurve::Clamp ? 0 : (curve == io::ToneCurve::Reinhard ? 1 : 2));
-  glProgramUniform3f(program_, glGetUniformLocation(program_, "u_luminance"), static_cast<float>(kLumR), static_cast<float>(kLumG),
-                     static_cast<float>(kLumB));
+  glProgramUniform3f(program_, glGetUniformLocation(program_, "u_luminance"), static_cast<float>(kLumR),
+                     static_cast<float>(kLumG), static_cast<float>(kLumB));
   glBindTextureUnit(0, texture);
   glViewport(0, 0, width, height);
   glDisable(GL_DEPTH_TEST);
@@ -64,8 +64,8 @@ void Overlay::set(const Image& img) {
     for (int x = 0; x < w_; ++x)
       for (int c = 0; c < 3; ++c) {
         const float v = img.at(x, y, c);
-        px[(static_cast<size_t>(h_ - 1 - y) * w_ + x) * 4 + c] =
-            static_cast<uint8_t>(std::lround(255.0 * std::clamp(std::isfinite(v) ? double(v) : 0.0, 0.0, 1.0)));  // GL rows go up
+        px[(static_cast<size_t>(h_ - 1 - y) * w_ + x) * 4 + c] = static_cast<uint8_t>(
+            std::lround(255.0 * std::clamp(std::isfinite(v) ? double(v) : 0.0, 0.0, 1.0)));  // GL rows go up
       }
   glTextureSubImage2D(texture_, 0, 0, 0, w_, h_, GL_RGBA, GL_UNSIGNED_BYTE, px.data());
 }
@@ -76,7 +76,8 @@ void Overlay::draw(int x, int y, int w, int h) const {
   glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &draw_fb);
   const GLboolean srgb = glIsEnabled(GL_FRAMEBUFFER_SRGB);
   glDisable(GL_FRAMEBUFFER_SRGB);
-  glBlitNamedFramebuffer(fbo_, static_cast<GLuint>(draw_fb), 0, 0, w_, h_, x, y, x + w, y + h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  glBlitNamedFramebuffer(fbo_, static_cast<GLuint>(draw_fb), 0, 0, w_, h_, x, y, x + w, y + h, GL_COLOR_BUFFER_BIT,
+                         GL_NEAREST);
   if (srgb) glEnable(GL_FRAMEBUFFER_SRGB);
 }
 

@@ -42,7 +42,8 @@ std::string annotate(const std::string& log, const std::string& file, const std:
       const long at = std::stol(m[2].matched ? m[2].str() : m[3].str()), block = at / kBlock, n = at % kBlock;
       std::string where = file + ":" + std::to_string(at);
       if (block == 1) where = file + " (generated prelude, line " + std::to_string(n) + ")";
-      if (block >= 2 && block - 2 < static_cast<long>(includes.size())) where = includes[block - 2] + ":" + std::to_string(n);
+      if (block >= 2 && block - 2 < static_cast<long>(includes.size()))
+        where = includes[block - 2] + ":" + std::to_string(n);
       line = where + ": " + line;
     }
     out += line + "\n";

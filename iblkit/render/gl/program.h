@@ -10,9 +10,9 @@ namespace ibl::render::gl {
 const std::string& shader_source(const std::string& name);
 
 struct ShaderStage {
-  unsigned type;        // GL_VERTEX_SHADER, GL_FRAGMENT_SHADER, …
-  std::string name;     // file name, for messages
-  std::string prelude;  // code inserted after the #version line (generated constants, defines)
+  unsigned type;                           // GL_VERTEX_SHADER, GL_FRAGMENT_SHADER, …
+  std::string name;                        // file name, for messages
+  std::string prelude;                     // code inserted after the #version line (generated constants, defines)
   std::vector<std::string> includes = {};  // embedded files inserted after the prelude (shading.glsl)
 };
 

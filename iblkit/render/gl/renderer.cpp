@@ -24,7 +24,8 @@ template <typename T>
 GLuint storage_buffer(const std::vector<T>& v, GLuint binding) {
   GLuint b = 0;
   glCreateBuffers(1, &b);
-  glNamedBufferStorage(b, static_cast<GLsizeiptr>(std::max<size_t>(1, v.size()) * sizeof(T)), v.empty() ? nullptr : v.data(), 0);
+  glNamedBufferStorage(b, static_cast<GLsizeiptr>(std::max<size_t>(1, v.size()) * sizeof(T)),
+                       v.empty() ? nullptr : v.data(), 0);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding, b);
   return b;
 }
@@ -42,7 +43,6 @@ GLuint shadow_map_array(int size, int layers) {
   glTextureParameteri(t, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
   return t;
 }
-
 
 void set_vec3(GLuint prog, const char* name, Vec3 v) {
   glProgramUniform3f(prog, glGetUniformLocation(prog, name), static_cast<float>(v.x), static_cast<float>(v.y),
@@ -108,8 +108,8 @@ struct FramePlan {
   std::vector<float> materials;
   // uniforms: the SH table (the Impl's) and the locations the draws set
   GLuint sh_table_tex = 0;
-  GLint loc_albedo = -1, loc_specular = -1, loc_exponent = -1, loc_glossy = -1, loc_glossy_layer = -1, loc_albedo_layer = -1,
-        loc_lobe = -1, loc_material = -1, loc_light_vp = -1;
+  GLint loc_albedo = -1, loc_specular = -1, loc_exponent = -1, loc_glossy = -1, loc_glossy_layer = -1,
+        loc_albedo_layer = -1, loc_lobe = -1, loc_material = -1, loc_light_vp = -1;
 
   FramePlan() = default;
   FramePlan(const FramePlan&) = delete;
@@ -154,12 +154,20 @@ struct Renderer::Impl {
     auto it = programs.find(key);
     if (it != programs.end()) return it->second;
     const int b = std::get<0>(key);
-    std::string defs = (desc.sh_table_size > 0 ? sh_table_glsl_source(b) : sh_glsl_source(b)) + (glossy ? "#define GLOSSY 1\n" : "#define GLOSSY 0\n");
+    std::string defs = (desc.sh_table_size > 0 ? sh_table_glsl_source(b) : sh_glsl_source(b)) +
+                       (glossy ? "#define GLOSSY 1\n" : "#define GLOSSY 0\n");
     GLuint p = 0;
     switch (kind) {
-      case Forward: p = build_program({{GL_VERTEX_SHADER, "mesh.vert", ""}, {GL_FRAGMENT_SHADER, "shade.frag", defs, {"shading.glsl"}}}); break;
-      case GBuffer: p = build_program({{GL_VERTEX_SHADER, "mesh.vert", ""}, {GL_FRAGMENT_SHADER, "visibility.frag", ""}}); break;
-      case Compute: p = build_program({{GL_COMPUTE_SHADER, "shade.comp", defs, {"shading.glsl"}}}); break;
+      case Forward:
+        p = build_program(
+            {{GL_VERTEX_SHADER, "mesh.vert", ""}, {GL_FRAGMENT_SHADER, "shade.frag", defs, {"shading.glsl"}}});
+        break;
+      case GBuffer:
+        p = build_program({{GL_VERTEX_SHADER, "mesh.vert", ""}, {GL_FRAGMENT_SHADER, "visibility.frag", ""}});
+        break;
+      case Compute:
+        p = build_program({{GL_COMPUTE_SHADER, "shade.comp", defs, {"shading.glsl"}}});
+        break;
     }
     programs[key] = p;
     return p;
@@ -191,7 +199,8 @@ Renderer::Renderer(const RendererDesc& desc) : impl_(std::make_unique<Impl>()) {
   impl_->desc = desc;
   if (desc.sh_table_size < 0 || desc.sh_table_size == 1 || desc.sh_table_size > kMaxShTableSize)
     fail(ErrorKind::Value, "SH table size {} is out of range (0 for none, 2..{})", desc.sh_table_size, kMaxShTableSize);
-  impl_->shadow_program = build_program({{GL_VERTEX_SHADER, "shadow.vert", ""}, {GL_FRAGMENT_SHADER, "shadow.frag", ""}});
+  impl_->shadow_program =
+      build_program({{GL_VERTEX_SHADER, "shadow.vert", ""}, {GL_FRAGMENT_SHADER, "shadow.frag", ""}});
   GLint vertex_ssbos = 0;  // the layered pass reads its matrices from a storage buffer (GL 4.5 may allow none)
   glGetIntegerv(GL_MAX_VERTEX_SHADER_STORAGE_BLOCKS, &vertex_ssbos);
   if (desc.layered_shadows && vertex_ssbos > 0 && epoxy_has_gl_extension("GL_ARB_shader_viewport_layer_array"))
@@ -206,7 +215,8 @@ unsigned Renderer::color_texture() const { return impl_->uploads.last_color_text
 void Renderer::Impl::plan_programs(const FrameDesc& d, FramePlan& p) {
   p.W = d.camera.width;
   p.H = d.camera.height;
-  if (p.W <= 0 || p.H <= 0 || p.W > 16384 || p.H > 16384) fail(ErrorKind::Value, "frame size {}x{} is invalid", p.W, p.H);
+  if (p.W <= 0 || p.H <= 0 || p.W > 16384 || p.H > 16384)
+    fail(ErrorKind::Value, "frame size {}x{} is invalid", p.W, p.H);
   check_objects(d);
   const Lighting& L = d.lighting;
   p.bands = L.grid ? L.grid->bands() : (L.environment ? L.environment->bands : 0);
@@ -223,7 +233,10 @@ void Renderer::Impl::plan_bounds(const FrameDesc& d, FramePlan& p) {
   for (const auto& o : d.objects) {
     Vec3 a, b;
     o.mesh->bounds(&a, &b);
-    for (int k = 0; k < 3; ++k) { lo[k] = std::min(lo[k], a[k]); hi[k] = std::max(hi[k], b[k]); }
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], a[k]);
+      hi[k] = std::max(hi[k], b[k]);
+    }
   }
   p.geometry = &uploads.geometry(d.objects, p.deferred);
   p.centre = (lo + hi) * 0.5;
@@ -241,9 +254,10 @@ void Renderer::Impl::plan_lights(const FrameDesc& d, FramePlan& p) {
       p.shadow_mats.push_back(light_view_projection(l.direction, p.centre, p.radius));
     }
     Vec3 dir = normalize(l.direction);
-    p.light_data.insert(p.light_data.end(), {static_cast<float>(dir.x), static_cast<float>(dir.y), static_cast<float>(dir.z), layer,
-                                             static_cast<float>(l.irradiance.x), static_cast<float>(l.irradiance.y),
-                                             static_cast<float>(l.irradiance.z), 0.0f});
+    p.light_data.insert(p.light_data.end(),
+                        {static_cast<float>(dir.x), static_cast<float>(dir.y), static_cast<float>(dir.z), layer,
+                         static_cast<float>(l.irradiance.x), static_cast<float>(l.irradiance.y),
+                         static_cast<float>(l.irradiance.z), 0.0f});
   }
   // Point lights: a perspective shadow map when they sit outside the objects' bounding sphere, else a
   // cube of six (layers of the same array). A light that finds no free layers is drawn unshadowed
@@ -267,9 +281,10 @@ void Renderer::Impl::plan_lights(const FrameDesc& d, FramePlan& p) {
         ++p.unshadowed;
       }
     }
-    p.point_data.insert(p.point_data.end(), {static_cast<float>(l.position.x), static_cast<float>(l.position.y),
-                                             static_cast<float>(l.position.z), layer, static_cast<float>(l.intensity.x),
-                                             static_cast<float>(l.intensity.y), static_cast<float>(l.intensity.z), cube});
+    p.point_data.insert(p.point_data.end(),
+                        {static_cast<float>(l.position.x), static_cast<float>(l.position.y),
+                         static_cast<float>(l.position.z), layer, static_cast<float>(l.intensity.x),
+                         static_cast<float>(l.intensity.y), static_cast<float>(l.intensity.z), cube});
   }
 }
 
@@ -293,7 +308,8 @@ void Renderer::Impl::plan_spotlights(const FrameDesc& d, FramePlan& p) {
     if (!sp.shadow) continue;
     for (size_t g = 0; g < group_seed.size() && group_of[i] < 0; ++g) {
       const auto& seed = L.spotlights[group_seed[g]];
-      if (d.spot_shadow_share > 0 && dot(seed.frame.n, sp.frame.n) > 0.99999 && length(seed.position - sp.position) <= d.spot_shadow_share)
+      if (d.spot_shadow_share > 0 && dot(seed.frame.n, sp.frame.n) > 0.99999 &&
+          length(seed.position - sp.position) <= d.spot_shadow_share)
         group_of[i] = static_cast<int>(g);
     }
     if (group_of[i] < 0) {
@@ -317,7 +333,8 @@ void Renderer::Impl::plan_spotlights(const FrameDesc& d, FramePlan& p) {
       // the group's spread.
       const Vec3 eye = group_sum[group_of[i]] * (1.0 / group_count[group_of[i]]);
       const double spread = group_count[group_of[i]] > 1 ? d.spot_shadow_share : 0.0;
-      const double pd = sp.plane_distance, margin = std::max((sp.tex_max.x - sp.tex_min.x) / tw, (sp.tex_max.y - sp.tex_min.y) / th) + spread;
+      const double pd = sp.plane_distance,
+                   margin = std::max((sp.tex_max.x - sp.tex_min.x) / tw, (sp.tex_max.y - sp.tex_min.y) / th) + spread;
       const double tx = (std::max(std::abs(sp.tex_min.x), std::abs(sp.tex_max.x)) + margin) / pd;
       const double ty = (std::max(std::abs(sp.tex_min.y), std::abs(sp.tex_max.y)) + margin) / pd;
       geometry::Camera c;
@@ -337,12 +354,30 @@ void Renderer::Impl::plan_spotlights(const FrameDesc& d, FramePlan& p) {
       p.spot_mats.push_back(mul(proj, c.view()));
     }
     const double texel = std::max((sp.tex_max.x - sp.tex_min.x) / tw, (sp.tex_max.y - sp.tex_min.y) / th);
-    const float row[24] = {static_cast<float>(sp.position.x), static_cast<float>(sp.position.y), static_cast<float>(sp.position.z), layer,
-                           static_cast<float>(sp.frame.t.x), static_cast<float>(sp.frame.t.y), static_cast<float>(sp.frame.t.z), static_cast<float>(sp.tex_min.x),
-                           static_cast<float>(sp.frame.b.x), static_cast<float>(sp.frame.b.y), static_cast<float>(sp.frame.b.z), static_cast<float>(sp.tex_min.y),
-                           static_cast<float>(sp.frame.n.x), static_cast<float>(sp.frame.n.y), static_cast<float>(sp.frame.n.z), static_cast<float>(sp.plane_distance),
-                           static_cast<float>(sp.tex_max.x), static_cast<float>(sp.tex_max.y), static_cast<float>(sp.support_area), static_cast<float>(sp.support_width),
-                           static_cast<float>(texel), static_cast<float>(st.levels), static_cast<float>(i), st.scale[i]};
+    const float row[24] = {static_cast<float>(sp.position.x),
+                           static_cast<float>(sp.position.y),
+                           static_cast<float>(sp.position.z),
+                           layer,
+                           static_cast<float>(sp.frame.t.x),
+                           static_cast<float>(sp.frame.t.y),
+                           static_cast<float>(sp.frame.t.z),
+                           static_cast<float>(sp.tex_min.x),
+                           static_cast<float>(sp.frame.b.x),
+                           static_cast<float>(sp.frame.b.y),
+                           static_cast<float>(sp.frame.b.z),
+                           static_cast<float>(sp.tex_min.y),
+                           static_cast<float>(sp.frame.n.x),
+                           static_cast<float>(sp.frame.n.y),
+                           static_cast<float>(sp.frame.n.z),
+                           static_cast<float>(sp.plane_distance),
+                           static_cast<float>(sp.tex_max.x),
+                           static_cast<float>(sp.tex_max.y),
+                           static_cast<float>(sp.support_area),
+                           static_cast<float>(sp.support_width),
+                           static_cast<float>(texel),
+                           static_cast<float>(st.levels),
+                           static_cast<float>(i),
+                           st.scale[i]};
     p.spot_data.insert(p.spot_data.end(), row, row + 24);
   }
 }
@@ -374,10 +409,12 @@ void Renderer::Impl::plan_sh_grid(const FrameDesc& d, FramePlan& p) {
   const ilf::GridDesc& gd = g.grid();
   const size_t values = static_cast<size_t>(gd.count()) * p.K * 3;
   if (g.data().size() != values)
-    fail(ErrorKind::Value, "SH grid {}x{}x{} with {} bands holds {} values, expected {}", gd.nx, gd.ny, gd.nz, g.bands(), g.data().size(), values);
+    fail(ErrorKind::Value, "SH grid {}x{}x{} with {} bands holds {} values, expected {}", gd.nx, gd.ny, gd.nz,
+         g.bands(), g.data().size(), values);
   GLint max3d = 0;
   glGetIntegerv(GL_MAX_3D_TEXTURE_SIZE, &max3d);
-  if (gd.nz * p.K > max3d) fail(ErrorKind::Unsupported, "SH grid needs a 3D texture {} deep; this GL allows {}", gd.nz * p.K, max3d);
+  if (gd.nz * p.K > max3d)
+    fail(ErrorKind::Unsupported, "SH grid needs a 3D texture {} deep; this GL allows {}", gd.nz * p.K, max3d);
   p.grid_tex = uploads.grid_texture(g);
 }
 
@@ -432,24 +469,25 @@ void Renderer::Impl::plan_materials(const FrameDesc& d, FramePlan& p) {
     const int gw = gmaps[0]->width(), gh = gmaps[0]->height();
     for (const Image* g : gmaps)
       if (g->width() != gw || g->height() != gh || g->channels() != 3)
-        fail(ErrorKind::Unsupported, "the GL renderer takes glossy maps of one size per frame ({}x{} and {}x{} given)", gw, gh, g->width(),
-             g->height());
+        fail(ErrorKind::Unsupported, "the GL renderer takes glossy maps of one size per frame ({}x{} and {}x{} given)",
+             gw, gh, g->width(), g->height());
     p.glossy_tex = rgb_texture_array(gmaps, 0.0f, GL_CLAMP_TO_EDGE);
   }
   if (!albedo_images.empty()) {
     const int aw = albedo_images[0]->width(), ah = albedo_images[0]->height();
     for (const Image* im : albedo_images)
       if (im->width() != aw || im->height() != ah || im->channels() < 3)
-        fail(ErrorKind::Unsupported, "the GL renderer takes RGB albedo textures of one size per frame ({}x{} and {}x{}x{} given)", aw, ah,
+        fail(ErrorKind::Unsupported,
+             "the GL renderer takes RGB albedo textures of one size per frame ({}x{} and {}x{}x{} given)", aw, ah,
              im->width(), im->height(), im->channels());
     p.albedo_tex = rgb_texture_array(albedo_images, 1.0f, GL_REPEAT);
   }
   for (size_t oi = 0; oi < d.objects.size(); ++oi) {
     const Material& m = d.objects[oi].material;
-    float row[kMaterialFloats] = {static_cast<float>(m.albedo.x),   static_cast<float>(m.albedo.y),   static_cast<float>(m.albedo.z),
-                                  static_cast<float>(p.material_layer[oi]),
-                                  static_cast<float>(m.specular.x), static_cast<float>(m.specular.y), static_cast<float>(m.specular.z),
-                                  static_cast<float>(m.exponent)};
+    float row[kMaterialFloats] = {static_cast<float>(m.albedo.x),   static_cast<float>(m.albedo.y),
+                                  static_cast<float>(m.albedo.z),   static_cast<float>(p.material_layer[oi]),
+                                  static_cast<float>(m.specular.x), static_cast<float>(m.specular.y),
+                                  static_cast<float>(m.specular.z), static_cast<float>(m.exponent)};
     if (p.bands > 0) {
       auto gz = sh::phong_zh(p.bands, m.environment_exponent());
       for (int l = 0; l < std::min(p.bands, 12); ++l) row[8 + l] = static_cast<float>(gz[l]);
@@ -479,7 +517,8 @@ void Renderer::Impl::plan_uniforms(const FrameDesc& d, FramePlan& p) {
     set_vec3(prog, "u_ray_dy", u * (-2 * t / p.H));
   }
   glProgramUniform1i(prog, glGetUniformLocation(prog, "u_light_count"), static_cast<GLint>(L.lights.size()));
-  glProgramUniform1i(prog, glGetUniformLocation(prog, "u_point_light_count"), static_cast<GLint>(L.point_lights.size()));
+  glProgramUniform1i(prog, glGetUniformLocation(prog, "u_point_light_count"),
+                     static_cast<GLint>(L.point_lights.size()));
   glProgramUniform1i(prog, glGetUniformLocation(prog, "u_spot_count"), static_cast<GLint>(L.spotlights.size()));
   glProgramUniform1i(prog, glGetUniformLocation(prog, "u_spot_textures"), 4);
   glProgramUniform1i(prog, glGetUniformLocation(prog, "u_spot_shadows"), 5);
@@ -523,7 +562,8 @@ void Renderer::Impl::plan_uniforms(const FrameDesc& d, FramePlan& p) {
   p.loc_light_vp = glGetUniformLocation(shadow_program, "u_light_view_projection");
 }
 
-void Renderer::Impl::shadow_passes(const FramePlan& p, GLuint tex, GLuint mats_ssbo, const std::vector<Mat4f>& mats, int size) {
+void Renderer::Impl::shadow_passes(const FramePlan& p, GLuint tex, GLuint mats_ssbo, const std::vector<Mat4f>& mats,
+                                   int size) {
   if (mats.empty()) return;
   glBindFramebuffer(GL_FRAMEBUFFER, p.shadow_fbo);
   glViewport(0, 0, size, size);
@@ -571,7 +611,8 @@ void Renderer::Impl::draw_frames(const FrameDesc& d, const FramePlan& p, int fra
     shadow_passes(p, p.spot_shadow_tex, p.spot_ssbo[1], p.spot_mats, p.SS);
     glBindFramebuffer(GL_FRAMEBUFFER, p.fbo);
     glViewport(0, 0, p.W, p.H);
-    glClearColor(static_cast<float>(d.background.x), static_cast<float>(d.background.y), static_cast<float>(d.background.z), 0.0f);
+    glClearColor(static_cast<float>(d.background.x), static_cast<float>(d.background.y),
+                 static_cast<float>(d.background.z), 0.0f);
     if (p.deferred) {
       const GLuint zero[4] = {0, 0, 0, 0};
       glClearBufferuiv(GL_COLOR, 0, zero);
@@ -595,8 +636,10 @@ void Renderer::Impl::draw_frames(const FrameDesc& d, const FramePlan& p, int fra
         glUniform1ui(p.loc_material, static_cast<GLuint>(i));
       } else {
         const Material& mat = d.objects[i].material;
-        glUniform3f(p.loc_albedo, static_cast<float>(mat.albedo.x), static_cast<float>(mat.albedo.y), static_cast<float>(mat.albedo.z));
-        glUniform3f(p.loc_specular, static_cast<float>(mat.specular.x), static_cast<float>(mat.specular.y), static_cast<float>(mat.specular.z));
+        glUniform3f(p.loc_albedo, static_cast<float>(mat.albedo.x), static_cast<float>(mat.albedo.y),
+                    static_cast<float>(mat.albedo.z));
+        glUniform3f(p.loc_specular, static_cast<float>(mat.specular.x), static_cast<float>(mat.specular.y),
+                    static_cast<float>(mat.specular.z));
         glUniform1f(p.loc_exponent, static_cast<float>(mat.exponent));
         glUniform1i(p.loc_glossy_layer, p.material_layer[i]);
         if (p.bands > 0) glUniform1fv(p.loc_glossy, p.bands, p.materials.data() + i * kMaterialFloats + 8);
@@ -663,7 +706,8 @@ RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing,
   r.draw_frames(d, p, frames, timing);
   RenderResult out{Image(), Image(), p.unshadowed};
   if (read_back) read_frame(p, out);
-  if (GLenum err = glGetError(); err != GL_NO_ERROR) fail(ErrorKind::Internal, "OpenGL error 0x{:x} while rendering", err);
+  if (GLenum err = glGetError(); err != GL_NO_ERROR)
+    fail(ErrorKind::Internal, "OpenGL error 0x{:x} while rendering", err);
   return out;
 }
 

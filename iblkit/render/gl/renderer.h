@@ -47,7 +47,7 @@ class Renderer {
   // valid until the next render() or the renderer's end; 0 before the first frame.
   unsigned color_texture() const;
 
-  static constexpr int kMaxShadowMaps = 16;  // shadow-casting lights per pass
+  static constexpr int kMaxShadowMaps = 16;     // shadow-casting lights per pass
   static constexpr int kMaxShTableSize = 1024;  // 7 layers × 6 faces × 1024² × 16 B = 704 MB at 5 bands
 
  private:

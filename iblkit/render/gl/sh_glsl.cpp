@@ -26,8 +26,10 @@ std::string sh_glsl_source(int bands) {
       s += fmt::format("  {{ float c = C * x - S * y; S = C * y + S * x; C = c; }} pmm *= {:.1f};\n", 2.0 * m - 1);
     }
     for (int l = m; l < bands; ++l) {
-      if (l == m) s += "  p0 = pmm;\n";
-      else if (l == m + 1) s += fmt::format("  p1 = p0; p0 = {:.1f} * z * pmm;\n", 2.0 * m + 1);
+      if (l == m)
+        s += "  p0 = pmm;\n";
+      else if (l == m + 1)
+        s += fmt::format("  p1 = p0; p0 = {:.1f} * z * pmm;\n", 2.0 * m + 1);
       else
         s += fmt::format("  p2 = p1; p1 = p0; p0 = ({:.1f} * z * p1 - {:.1f} * p2) * {:.17g};\n", 2.0 * l - 1,
                          static_cast<double>(l + m - 1), 1.0 / (l - m));
@@ -35,7 +37,8 @@ std::string sh_glsl_source(int bands) {
       if (m == 0) {
         s += fmt::format("  Y[{}] = {:.17g} * p0;\n", l * (l + 1), k);
       } else {
-        s += fmt::format("  Y[{}] = {:.17g} * p0 * C; Y[{}] = {:.17g} * p0 * S;\n", l * (l + 1) + m, k, l * (l + 1) - m, k);
+        s += fmt::format("  Y[{}] = {:.17g} * p0 * C; Y[{}] = {:.17g} * p0 * S;\n", l * (l + 1) + m, k, l * (l + 1) - m,
+                         k);
       }
     }
   }
@@ -56,7 +59,8 @@ std::string sh_table_glsl_source(int bands) {
       "void sh_eval(vec3 d, out float Y[SH_K]) {{\n"
       "  vec3 a = abs(d);\n"
       "  vec3 w = a.x >= a.y && a.x >= a.z ? vec3(1.0, u_sh_table_warp, u_sh_table_warp)\n"
-      "         : (a.y >= a.z ? vec3(u_sh_table_warp, 1.0, u_sh_table_warp) : vec3(u_sh_table_warp, u_sh_table_warp, 1.0));\n"
+      "         : (a.y >= a.z ? vec3(u_sh_table_warp, 1.0, u_sh_table_warp) : vec3(u_sh_table_warp, u_sh_table_warp, "
+      "1.0));\n"
       "  vec3 q = d * w;\n"
       "  for (int j = 0; j < {2}; ++j) {{\n"
       "    vec4 v = textureLod(u_sh_table, vec4(q, float(j)), 0.0);\n"
@@ -102,7 +106,8 @@ unsigned make_sh_table_texture(int bands, int size) {
 }
 
 std::vector<float> sh_eval_on_gl(int bands, const std::vector<Vec3>& directions, int table_size) {
-  GLuint prog = build_program({{GL_COMPUTE_SHADER, "sh_eval.comp", table_size > 0 ? sh_table_glsl_source(bands) : sh_glsl_source(bands)}});
+  GLuint prog = build_program(
+      {{GL_COMPUTE_SHADER, "sh_eval.comp", table_size > 0 ? sh_table_glsl_source(bands) : sh_glsl_source(bands)}});
   GLuint table = table_size > 0 ? make_sh_table_texture(bands, table_size) : 0;
   if (table) {
     glBindTextureUnit(7, table);
@@ -116,7 +121,8 @@ std::vector<float> sh_eval_on_gl(int bands, const std::vector<Vec3>& directions,
   GLuint buf[2];
   glCreateBuffers(2, buf);
   glNamedBufferStorage(buf[0], static_cast<GLsizeiptr>(dirs.size() * sizeof(float)), dirs.data(), 0);
-  glNamedBufferStorage(buf[1], static_cast<GLsizeiptr>(static_cast<size_t>(n) * K * sizeof(float)), nullptr, GL_MAP_READ_BIT);
+  glNamedBufferStorage(buf[1], static_cast<GLsizeiptr>(static_cast<size_t>(n) * K * sizeof(float)), nullptr,
+                       GL_MAP_READ_BIT);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, buf[0]);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, buf[1]);
   glUseProgram(prog);

@@ -46,10 +46,14 @@ MeshBuffers upload(const Packed& m) {
   glCreateVertexArrays(1, &b.vao);
   glCreateBuffers(3, b.vbo);
   glCreateBuffers(1, &b.ebo);
-  glNamedBufferStorage(b.vbo[0], static_cast<GLsizeiptr>(std::max<size_t>(1, m.positions.size()) * sizeof(float)), m.positions.data(), 0);
-  glNamedBufferStorage(b.vbo[1], static_cast<GLsizeiptr>(std::max<size_t>(1, m.normals.size()) * sizeof(float)), m.normals.data(), 0);
-  glNamedBufferStorage(b.vbo[2], static_cast<GLsizeiptr>(std::max<size_t>(1, m.uvs.size()) * sizeof(float)), m.uvs.data(), 0);
-  glNamedBufferStorage(b.ebo, static_cast<GLsizeiptr>(std::max<size_t>(1, m.indices.size()) * sizeof(uint32_t)), m.indices.data(), 0);
+  glNamedBufferStorage(b.vbo[0], static_cast<GLsizeiptr>(std::max<size_t>(1, m.positions.size()) * sizeof(float)),
+                       m.positions.data(), 0);
+  glNamedBufferStorage(b.vbo[1], static_cast<GLsizeiptr>(std::max<size_t>(1, m.normals.size()) * sizeof(float)),
+                       m.normals.data(), 0);
+  glNamedBufferStorage(b.vbo[2], static_cast<GLsizeiptr>(std::max<size_t>(1, m.uvs.size()) * sizeof(float)),
+                       m.uvs.data(), 0);
+  glNamedBufferStorage(b.ebo, static_cast<GLsizeiptr>(std::max<size_t>(1, m.indices.size()) * sizeof(uint32_t)),
+                       m.indices.data(), 0);
   for (int a = 0; a < 3; ++a) {
     const int n = a == 2 ? 2 : 3;
     glVertexArrayVertexBuffer(b.vao, a, b.vbo[a], 0, n * sizeof(float));
@@ -119,24 +123,32 @@ const Uploads::Geometry& Uploads::geometry(const std::vector<RenderObject>& obje
   }
   if (deferred && !geometry_.ssbo[0]) {
     // Geometry for the compute pass: all objects' vertices and indices, and where each starts.
-    if (objects.size() > 255) fail(ErrorKind::Value, "the deferred path draws at most 255 objects ({} given)", objects.size());
+    if (objects.size() > 255)
+      fail(ErrorKind::Value, "the deferred path draws at most 255 objects ({} given)", objects.size());
     std::vector<uint32_t> object_table;
     std::vector<float> pos, nrm, uvs;
     std::vector<uint32_t> idx;
     for (const Packed& p : packed) {
-      if (p.indices.size() / 3 >= (1u << 24)) fail(ErrorKind::Value, "a mesh of {} triangles is over the deferred path's 2^24", p.indices.size() / 3);
-      object_table.insert(object_table.end(), {static_cast<uint32_t>(pos.size() / 3), static_cast<uint32_t>(idx.size()), 0u, 0u});
+      if (p.indices.size() / 3 >= (1u << 24))
+        fail(ErrorKind::Value, "a mesh of {} triangles is over the deferred path's 2^24", p.indices.size() / 3);
+      object_table.insert(object_table.end(),
+                          {static_cast<uint32_t>(pos.size() / 3), static_cast<uint32_t>(idx.size()), 0u, 0u});
       pos.insert(pos.end(), p.positions.begin(), p.positions.end());
       nrm.insert(nrm.end(), p.normals.begin(), p.normals.end());
       uvs.insert(uvs.end(), p.uvs.begin(), p.uvs.end());
       idx.insert(idx.end(), p.indices.begin(), p.indices.end());
     }
     glCreateBuffers(5, geometry_.ssbo);
-    glNamedBufferStorage(geometry_.ssbo[0], static_cast<GLsizeiptr>(std::max<size_t>(4, object_table.size()) * 4), object_table.data(), 0);
-    glNamedBufferStorage(geometry_.ssbo[1], static_cast<GLsizeiptr>(std::max<size_t>(1, pos.size()) * 4), pos.data(), 0);
-    glNamedBufferStorage(geometry_.ssbo[2], static_cast<GLsizeiptr>(std::max<size_t>(1, nrm.size()) * 4), nrm.data(), 0);
-    glNamedBufferStorage(geometry_.ssbo[3], static_cast<GLsizeiptr>(std::max<size_t>(1, idx.size()) * 4), idx.data(), 0);
-    glNamedBufferStorage(geometry_.ssbo[4], static_cast<GLsizeiptr>(std::max<size_t>(1, uvs.size()) * 4), uvs.data(), 0);
+    glNamedBufferStorage(geometry_.ssbo[0], static_cast<GLsizeiptr>(std::max<size_t>(4, object_table.size()) * 4),
+                         object_table.data(), 0);
+    glNamedBufferStorage(geometry_.ssbo[1], static_cast<GLsizeiptr>(std::max<size_t>(1, pos.size()) * 4), pos.data(),
+                         0);
+    glNamedBufferStorage(geometry_.ssbo[2], static_cast<GLsizeiptr>(std::max<size_t>(1, nrm.size()) * 4), nrm.data(),
+                         0);
+    glNamedBufferStorage(geometry_.ssbo[3], static_cast<GLsizeiptr>(std::max<size_t>(1, idx.size()) * 4), idx.data(),
+                         0);
+    glNamedBufferStorage(geometry_.ssbo[4], static_cast<GLsizeiptr>(std::max<size_t>(1, uvs.size()) * 4), uvs.data(),
+                         0);
   }
   return geometry_;
 }
@@ -161,7 +173,8 @@ unsigned Uploads::grid_texture(const ilf::SHGrid& g) {
   glTextureSubImage3D(grid_tex_, 0, 0, 0, 0, gd.nx, gd.ny, gd.nz * K, GL_RGBA, GL_FLOAT, packed.data());
   glTextureParameteri(grid_tex_, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
   glTextureParameteri(grid_tex_, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-  for (GLenum w : {GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T, GL_TEXTURE_WRAP_R}) glTextureParameteri(grid_tex_, w, GL_CLAMP_TO_EDGE);
+  for (GLenum w : {GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T, GL_TEXTURE_WRAP_R})
+    glTextureParameteri(grid_tex_, w, GL_CLAMP_TO_EDGE);
   grid_key_ = g;
   return grid_tex_;
 }
@@ -178,8 +191,12 @@ const Uploads::SpotTextures& Uploads::spot_textures(const std::vector<nearfield:
   const int levels = static_cast<int>(first.mips->size());
   for (size_t i = 0; i < lights.size(); ++i) {
     const auto& sp = lights[i];
-    if (!sp.mips || sp.mips->size() != static_cast<size_t>(levels) || (*sp.mips)[0].width() != tw || (*sp.mips)[0].height() != th)
-      fail(ErrorKind::Unsupported, "the GL renderer takes textured spotlights of one texture size per frame (spotlight {} differs from spotlight 0)", i);
+    if (!sp.mips || sp.mips->size() != static_cast<size_t>(levels) || (*sp.mips)[0].width() != tw ||
+        (*sp.mips)[0].height() != th)
+      fail(ErrorKind::Unsupported,
+           "the GL renderer takes textured spotlights of one texture size per frame (spotlight {} differs from "
+           "spotlight 0)",
+           i);
     for (int lv = 0; lv < levels; ++lv)
       if ((*sp.mips)[lv].channels() != 3) fail(ErrorKind::Value, "spotlight {} mip {} is not RGB", i, lv);
   }
@@ -203,7 +220,8 @@ const Uploads::SpotTextures& Uploads::spot_textures(const std::vector<nearfield:
       rgba.assign(im.pixel_count() * 4, 0.0f);
       for (size_t k = 0; k < im.pixel_count(); ++k)
         for (int c = 0; c < 3; ++c) rgba[k * 4 + c] = im.data()[k * 3 + c] / scale;
-      glTextureSubImage3D(tex, lv, 0, 0, static_cast<GLint>(i), im.width(), im.height(), 1, GL_RGBA, GL_FLOAT, rgba.data());
+      glTextureSubImage3D(tex, lv, 0, 0, static_cast<GLint>(i), im.width(), im.height(), 1, GL_RGBA, GL_FLOAT,
+                          rgba.data());
     }
     spots_.keys.push_back(sp.mips);
   }
