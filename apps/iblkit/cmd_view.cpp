@@ -3,8 +3,10 @@
 // frame time. With --frames N it runs N frames on its own (orbiting) and exits: how the tests drive
 // it under Xvfb.
 #if defined(IBLKIT_HAVE_GL) && defined(IBLKIT_HAVE_GLFW)
-#include <GLFW/glfw3.h>
+// epoxy/gl.h must come before GLFW's header (which would include GL/gl.h): two blocks keep the order.
 #include <epoxy/gl.h>
+
+#include <GLFW/glfw3.h>
 
 #include <algorithm>
 #include <chrono>
