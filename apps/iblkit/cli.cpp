@@ -147,6 +147,25 @@ ibl::io::EnvReadDesc& add_probe_read_options(CLI::App& app) {
   return *desc;
 }
 
+std::vector<std::pair<std::string, std::string>> describe_options(const CLI::App& app) {
+  std::string path = app.get_name();
+  for (const CLI::App* p = app.get_parent(); p && p->get_parent(); p = p->get_parent())
+    path = p->get_name() + " " + path;
+  std::vector<std::pair<std::string, std::string>> d{{"the subcommand", path}};
+  for (const CLI::Option* o : app.get_options()) {
+    if (o->get_name() == "--help" || o->get_name() == "-h") continue;
+    std::string v;
+    if (o->count() == 0) {
+      v = o->get_default_str().empty() ? "(not given)" : o->get_default_str();
+    } else {
+      for (const auto& r : o->results()) v += (v.empty() ? "" : " ") + r;
+      if (v.empty()) v = "(given)";  // a flag
+    }
+    d.push_back({o->get_name(), v});
+  }
+  return d;
+}
+
 std::string default_probe() {
   const char* candidates[] = {
       "/usr/share/blender/datafiles/studiolights/world/forest.exr",

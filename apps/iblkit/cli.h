@@ -91,6 +91,10 @@ std::string unknown_subcommand(CLI::App& app, int argc, char** argv);
 // or are dropped where it has none.
 std::string for_command(CLI::App& app, const std::string& message);
 
+// The command line of the subcommand that runs: its path ("ilf build") and every option's and
+// positional's name with its value as given (or its default), for the ranks of an MPI job to compare.
+std::vector<std::pair<std::string, std::string>> describe_options(const CLI::App& app);
+
 // Path of a real probe to use when none is given: blender-data's, else shared/probes.
 std::string default_probe();
 
