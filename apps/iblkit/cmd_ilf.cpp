@@ -312,6 +312,7 @@ void setup_build(CLI::App& app) {
   app.add_option("--subsample-distance", o->subsample_dist, "… and whose neighbours lie within this many metres")
       ->capture_default_str();
   app.add_option("--vdb", o->vdb, "also write the grid as OpenVDB (one Vec3f grid per coefficient)");
+  iblcli::outputs(app, {"--error-grid", "--vdb", "--buckets"});  // besides --out (cli.h)
   app.add_flag("--skip-bad", bd0.buckets.skip_bad,
                "skip bad probes (missing/unreadable frames, wrong size, NaN, outside the volume, duplicates) and "
                "report how many");
