@@ -237,16 +237,18 @@ void check_outputs(const CLI::App& app) {
       }
     }
   }
+  // "--out X" for an option, "X" for a positional.
+  auto named = [](const File& f) { return f.option.rfind("-", 0) == 0 ? f.option + " " + f.path : f.path; };
   for (size_t i = 0; i < outs.size(); ++i) {
     for (const File& in : ins)
       if (in.dev == outs[i].dev && in.ino == outs[i].ino)
         ibl::fail(ibl::ErrorKind::Value,
-                  "{} {}: is the same file as the input {} {}; write the output elsewhere (nothing was written)",
-                  outs[i].option, outs[i].path, in.option, in.path);
+                  "{}: is the same file as the input {}; write the output elsewhere (nothing was written)",
+                  named(outs[i]), named(in));
     for (size_t k = 0; k < i; ++k)
       if (outs[k].dev == outs[i].dev && outs[k].ino == outs[i].ino)
-        ibl::fail(ibl::ErrorKind::Value, "{} {} and {} {} name the same file: give each output its own path",
-                  outs[k].option, outs[k].path, outs[i].option, outs[i].path);
+        ibl::fail(ibl::ErrorKind::Value, "{} and {} name the same file: give each output its own path", named(outs[k]),
+                  named(outs[i]));
   }
   for (size_t i = 0; i < new_outs.size(); ++i)
     for (size_t k = 0; k < i; ++k)

@@ -25,7 +25,7 @@ struct stat stat_or_fail(const std::string& path, const char* what) {
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0) {
     int e = errno;
-    if (e == ENOENT || e == ENOTDIR) fail(ErrorKind::Io, "{}: no such {}", path, what ? what : "file");
+    if (e == ENOENT || e == ENOTDIR) fail(ErrorKind::Io, "{}: no such file", path);
     fail(ErrorKind::Io, "{}: cannot read ({})", path, std::strerror(e));
   }
   return st;
@@ -34,8 +34,7 @@ struct stat stat_or_fail(const std::string& path, const char* what) {
 
 void require_input_file(const std::string& path, const char* what) {
   struct stat st = stat_or_fail(path, what);
-  if (S_ISDIR(st.st_mode))
-    fail(ErrorKind::Io, "{}: is a folder, not {}", path, what ? fmt::format("a file ({})", what) : "a file");
+  if (S_ISDIR(st.st_mode)) fail(ErrorKind::Io, "{}: is a folder, not {}", path, what ? what : "a file");
   if (!S_ISREG(st.st_mode))
     fail(ErrorKind::Io, "{}: is {}, not a regular file (iblkit reads {} from files only)", path,
          file_kind_name(st.st_mode), what ? what : "its inputs");
