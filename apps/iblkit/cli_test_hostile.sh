@@ -33,7 +33,7 @@ mkdir -p "$T/out"
 ln -s "$T/outside.txt" "$T/out/p.exr"
 check link-replaced ok "" -- "$BIN" convert "$T/probe.exr" "$T/out/p.exr" --mapping latlong --size 16
 if [ "$(cat "$T/outside.txt")" = outside ] && [ ! -L "$T/out/p.exr" ] && [ -f "$T/out/p.exr" ]; then pass=$((pass+1)); else echo "FAIL link-replaced: wrote through the link"; fail=$((fail+1)); fi
-if "$BIN" --help | grep -q "^  web" && "$BIN" web --out "$T/w0" >/dev/null 2>&1; then
+if "$BIN" web --out "$T/w0" --probe "$T/probe.exr" >/dev/null 2>&1; then
   mkdir -p "$T/site/data" "$T/elsewhere"
   ln -s "$T/outside.txt" "$T/site/index.html"
   ln -s "$T/elsewhere" "$T/site/three"
@@ -71,6 +71,16 @@ if "$BIN" --help | grep -q "^  lab"; then
   CAM=(--eye 0,1.3,2.2 --target 0,0.3,0 --fov 40 --width 24 --height 18 --samples 1)
   check photo-mask-out fail "name the same file" -- "$BIN" lab photograph low-scene2 "${CAM[@]}" --object blob --at 0,0.2,0 --object-size 0.3 --triangles 500 --mask "$T/m.exr" --out "$T/m.exr"
   [ ! -e "$T/m.exr" ] && pass=$((pass+1)) || { echo "FAIL photo-mask-out: wrote $T/m.exr"; fail=$((fail+1)); }
+  # composite --out naming its photograph, or a probe image named inside its probe set.
+  "$BIN" --quiet lab photograph low-scene2 "${CAM[@]}" --out "$T/photo.exr" >/dev/null
+  "$BIN" --quiet lab capture low-scene2 --fusion --probe 0,0.5,0 --size 16 --out "$T/fus" >/dev/null 2>&1
+  COMP=("$BIN" --quiet composite "$T/photo.exr" --eye 0,1.3,2.2 --target 0,0.3,0 --fov 40 --probes "$T/fus/probes.json"
+        --object blob --at 0,0.2,0 --object-size 0.3 --triangles 500 --samples 2 --object-samples 2)
+  psum=$(sum "$T/photo.exr"); qsum=$(sum "$T/fus/probes/p0.exr")
+  check composite-onto-photo fail "is the same file as the input" -- "${COMP[@]}" --out "$T/photo.exr"
+  check composite-onto-probe fail "is an input of this command" -- "${COMP[@]}" --out "$T/fus/probes/p0.exr"
+  [ "$(sum "$T/photo.exr")" = "$psum" ] && [ "$(sum "$T/fus/probes/p0.exr")" = "$qsum" ] && pass=$((pass+1)) \
+    || { echo "FAIL composite: an input was changed"; fail=$((fail+1)); }
 fi
 
 # §4: a .shtree whose counts, bricks or length lie.
