@@ -1,17 +1,21 @@
 #include "cli.h"
 
+#include <sys/stat.h>
 #include <unistd.h>
 #include <cmath>
 
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
+#include <map>
 #include <mutex>
 #include <sstream>
 
 #include <fmt/format.h>
 
+#include "iblkit/core/atomic_file.h"
 #include "iblkit/core/error.h"
 
 namespace iblcli {
@@ -54,8 +58,24 @@ Bar& bar() {
 ibl::ProgressFn progress_bar() { return progress_bar(isatty(STDERR_FILENO)); }
 
 ibl::ProgressFn progress_bar(bool terminal) {
-  if (globals().quiet || !terminal) return {};
+  if (globals().quiet) return {};
   bar().start = std::chrono::steady_clock::now();
+  bar().last = {};
+  if (!terminal)  // a log, not a terminal: a line every few seconds once the work takes that long
+    return [](std::string_view stage, double f) {
+      Bar& b = bar();
+      std::lock_guard<std::mutex> lock(b.mu);
+      auto now = std::chrono::steady_clock::now();
+      // A line per 5 s: readable in a log, no flood (IBLKIT_PROGRESS_EVERY=seconds for tests).
+      static const auto kEvery =
+          std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(
+              std::getenv("IBLKIT_PROGRESS_EVERY") ? std::atof(std::getenv("IBLKIT_PROGRESS_EVERY")) : 5.0));
+      if (now - b.start < kEvery || (b.last.time_since_epoch().count() != 0 && now - b.last < kEvery)) return;
+      b.last = now;
+      std::fprintf(stderr, "iblkit: %s %d%% (%.0f s)\n", std::string(stage).c_str(),
+                   static_cast<int>(std::clamp(f, 0.0, 1.0) * 100),
+                   std::chrono::duration<double>(now - b.start).count());
+    };
   return [](std::string_view stage, double f) {
     Bar& b = bar();
     std::lock_guard<std::mutex> lock(b.mu);
@@ -147,6 +167,96 @@ ibl::io::EnvReadDesc& add_probe_read_options(CLI::App& app) {
   return *desc;
 }
 
+std::vector<std::pair<std::string, std::string>> describe_options(const CLI::App& app) {
+  std::string path = app.get_name();
+  for (const CLI::App* p = app.get_parent(); p && p->get_parent(); p = p->get_parent())
+    path = p->get_name() + " " + path;
+  std::vector<std::pair<std::string, std::string>> d{{"the subcommand", path}};
+  for (const CLI::Option* o : app.get_options()) {
+    if (o->get_name() == "--help" || o->get_name() == "-h") continue;
+    std::string v;
+    if (o->count() == 0) {
+      v = o->get_default_str().empty() ? "(not given)" : o->get_default_str();
+    } else {
+      for (const auto& r : o->results()) v += (v.empty() ? "" : " ") + r;
+      if (v.empty()) v = "(given)";  // a flag
+    }
+    d.push_back({o->get_name(), v});
+  }
+  return d;
+}
+
+namespace {
+std::map<const CLI::App*, std::vector<std::string>>& extra_outputs() {
+  static std::map<const CLI::App*, std::vector<std::string>> m;
+  return m;
+}
+bool is_output(const CLI::App& app, const CLI::Option* o) {
+  if (o->check_name("--out") || o->check_name("output")) return true;
+  auto it = extra_outputs().find(&app);
+  if (it == extra_outputs().end()) return false;
+  return std::any_of(it->second.begin(), it->second.end(), [&](const std::string& n) { return o->check_name(n); });
+}
+}  // namespace
+
+void outputs(CLI::App& app, std::initializer_list<const char*> names) {
+  for (const char* n : names) {
+    if (!app.get_option_no_throw(n))
+      ibl::fail(ibl::ErrorKind::Internal, "iblcli::outputs: {} has no option {}", app.get_name(), n);
+    extra_outputs()[&app].push_back(n);
+  }
+}
+
+void check_outputs(const CLI::App& app) {
+  struct File {
+    std::string option, path;
+    dev_t dev;
+    ino_t ino;
+  };
+  std::vector<File> ins, outs;
+  std::vector<std::pair<std::string, std::string>> new_outs;  // (option, absolute path) of outputs not there yet
+  for (const CLI::Option* o : app.get_options()) {
+    const bool out = is_output(app, o);
+    std::vector<std::string> values = o->results();
+    if (o->count() == 0) {
+      if (!out || o->get_default_str().empty()) continue;
+      values = {o->get_default_str()};  // a default output is written too
+    }
+    for (const std::string& v : values) {
+      if (v.empty()) continue;
+      struct stat st {};
+      if (out) {
+        // The output as it will be replaced: a link itself (core/atomic_file.h replaces links).
+        if (::lstat(v.c_str(), &st) == 0)
+          outs.push_back({o->get_name(), v, st.st_dev, st.st_ino});
+        else
+          new_outs.push_back({o->get_name(), fs::absolute(v).lexically_normal().string()});
+      } else if (::stat(v.c_str(), &st) == 0 && (S_ISREG(st.st_mode) || S_ISDIR(st.st_mode))) {
+        ins.push_back({o->get_name(), v, st.st_dev, st.st_ino});
+        if (S_ISREG(st.st_mode)) ibl::note_input_file(v);
+      }
+    }
+  }
+  // "--out X" for an option, "X" for a positional.
+  auto named = [](const File& f) { return f.option.rfind("-", 0) == 0 ? f.option + " " + f.path : f.path; };
+  for (size_t i = 0; i < outs.size(); ++i) {
+    for (const File& in : ins)
+      if (in.dev == outs[i].dev && in.ino == outs[i].ino)
+        ibl::fail(ibl::ErrorKind::Value,
+                  "{}: is the same file as the input {}; write the output elsewhere (nothing was written)",
+                  named(outs[i]), named(in));
+    for (size_t k = 0; k < i; ++k)
+      if (outs[k].dev == outs[i].dev && outs[k].ino == outs[i].ino)
+        ibl::fail(ibl::ErrorKind::Value, "{} and {} name the same file: give each output its own path", named(outs[k]),
+                  named(outs[i]));
+  }
+  for (size_t i = 0; i < new_outs.size(); ++i)
+    for (size_t k = 0; k < i; ++k)
+      if (new_outs[k].second == new_outs[i].second)
+        ibl::fail(ibl::ErrorKind::Value, "{} and {} name the same file {}: give each output its own path",
+                  new_outs[k].first, new_outs[i].first, new_outs[i].second);
+}
+
 std::string default_probe() {
   const char* candidates[] = {
       "/usr/share/blender/datafiles/studiolights/world/forest.exr",
@@ -194,8 +304,29 @@ void replace_all(std::string& s, const std::string& from, const std::string& to)
 }
 }  // namespace
 
+std::string size_options(CLI::App& app) {
+  static const char* kSizeWords[] = {"size", "grid", "samples", "memory", "resolution", "rays", "bands", "frames"};
+  std::string out;
+  for (const CLI::Option* o : ran(app)->get_options()) {
+    if (o->count() == 0 || o->get_name().rfind("--", 0) != 0) continue;
+    const std::string n = o->get_name();
+    if (std::none_of(std::begin(kSizeWords), std::end(kSizeWords),
+                     [&](const char* w) { return n.find(w) != std::string::npos; }))
+      continue;
+    std::string v;
+    for (const auto& r : o->results()) v += (v.empty() ? "" : " ") + r;
+    out += (out.empty() ? "" : ", ") + n + " " + v;
+  }
+  return out;
+}
+
 std::string for_command(CLI::App& app, const std::string& message) {
   std::string m = message;
+  // Out of memory: which of the options given sets the size to lower.
+  if (m.find("out of memory") != std::string::npos || m.find("would allocate") != std::string::npos) {
+    const std::string sizes = size_options(app);
+    if (!sizes.empty()) m += fmt::format(" (lower {})", sizes);
+  }
   const bool has_sanitize = ran(app)->get_option_no_throw("--sanitize") != nullptr;
   if (has_sanitize) {
     replace_all(m, "with sanitize replaces", "with --sanitize replaces");

@@ -3,6 +3,7 @@
 #pragma once
 #include <deque>
 #include <functional>
+#include <initializer_list>
 #include <memory>
 #include <string>
 #include <vector>
@@ -72,6 +73,17 @@ ibl::ProgressFn progress_bar(bool terminal);
 // Ends the bar line (call when the work is done).
 void progress_done();
 
+// Outputs and inputs (docs/cli.md, "Outputs"): before a subcommand runs, main.cpp calls
+// check_outputs on it. The options "--out" (with "-o") and the positional "output" are outputs of
+// every subcommand; a subcommand with other outputs names them once in its setup:
+//   iblcli::outputs(app, {"--layers", "--mask"});
+// Every other option or positional value that names an existing file or folder is an input.
+void outputs(CLI::App& app, std::initializer_list<const char*> names);
+// Refuses (one line, nothing written) an output that is the same file (device and inode) as an input
+// or as another output, and notes every input in the open OutputTransaction, whose commits then never
+// replace one (core/atomic_file.h; files the readers open are noted there too).
+void check_outputs(const CLI::App& app);
+
 // Prints a result: JSON when --json, else the table callback writes human text.
 void emit(const nlohmann::json& j, const std::function<void()>& table);
 // A line of chatter on stderr (suppressed by --quiet).
@@ -90,6 +102,14 @@ std::string unknown_subcommand(CLI::App& app, int argc, char** argv);
 // ("sanitize replaces such values by 0") become the flag the command that ran has ("--sanitize …"),
 // or are dropped where it has none.
 std::string for_command(CLI::App& app, const std::string& message);
+
+// The command line of the subcommand that runs: its path ("ilf build") and every option's and
+// positional's name with its value as given (or its default), for the ranks of an MPI job to compare.
+std::vector<std::pair<std::string, std::string>> describe_options(const CLI::App& app);
+
+// The options of the subcommand that ran which set how much it allocates (sizes, grids, samples,
+// memory), as given: "--size 16384, --samples 4", or "" when none was given.
+std::string size_options(CLI::App& app);
 
 // Path of a real probe to use when none is given: blender-data's, else shared/probes.
 std::string default_probe();

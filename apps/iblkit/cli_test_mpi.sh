@@ -70,5 +70,50 @@ if [ ${#a[@]} = 2 ] && [ ${#b[@]} = 2 ] && awk -v a0="${a[0]}" -v a1="${a[1]}" -
      'function d(x, y) { return (x > y ? x - y : y - x) <= 1e-6 * (y > 0 ? y : -y) } BEGIN { exit !(b0 > 0 && d(a0, b0) && d(a1, b1)) }'; then
   pass=$((pass+1)); else echo "FAIL cv-error-grid: mpi ${a[*]}, serial ${b[*]}"; fail=$((fail+1)); fi
 
+# Ranks that disagree (issue 32 §5): started with different options, every rank ends within seconds
+# with one line naming the option, non-zero, no hang, no grid written.
+disagree() {  # NAME PATTERN -- OPTIONS-OF-RANK-0 -- OPTIONS-OF-RANK-1
+  local name="$1" pat="$2"; shift 3
+  local a=() b=()
+  while [ "$1" != -- ]; do a+=("$1"); shift; done; shift
+  b=("$@")
+  local out rc
+  out=$(timeout 60 "${MPIRUN[@]}" -np 1 "$BIN" --quiet ilf build --out "$T/dis.shgrid" --buckets "$T/db" "${a[@]}" : \
+        -np 1 "$BIN" --quiet ilf build --out "$T/dis.shgrid" --buckets "$T/db" "${b[@]}" 2>&1); rc=$?
+  local lines; lines=$(grep -c "^iblkit: error:" <<<"$out")
+  if [ $rc -ne 0 ] && [ $rc -ne 124 ] && [ "$lines" = 1 ] && grep -qE -- "$pat" <<<"$out" && [ ! -e "$T/dis.shgrid" ]; then
+    pass=$((pass+1)); else echo "FAIL $name: exit $rc, $lines error lines: $out"; fail=$((fail+1)); fi
+}
+disagree grid "disagree on --grid: rank 0 has 8, rank 1 has 6" -- "$S" --grid 8 -- "$S" --grid 6
+disagree bands "disagree on --bands" -- "$S" --grid 6 --bands 3 -- "$S" --grid 6 --bands 4
+disagree directions "disagree on --directions" -- "$S" --grid 6 --directions pixel -- "$S" --grid 6 --directions 8
+disagree kernel "disagree on --kernel" -- "$S" --grid 6 --kernel 2 -- "$S" --grid 6 --kernel 3
+disagree sequence "disagree on sequence" -- "$T/cv/sequence.json" --grid 6 -- "$S" --grid 6
+# The same command line over two different sequences (each rank in its own folder): the build's own
+# description (the sequence's fingerprint) differs.
+mkdir -p "$T/wa" "$T/wb"
+"$BIN" --quiet ilf synth --out "$T/wa/s" --probes 20 --size 8 >/dev/null && "$BIN" --quiet ilf synth --out "$T/wb/s" --probes 21 --size 8 >/dev/null
+out=$(cd "$T" && timeout 60 "${MPIRUN[@]}" -np 1 -wdir "$T/wa" "$BIN" --quiet ilf build s/sequence.json --grid 4 --out g.shgrid : \
+      -np 1 -wdir "$T/wb" "$BIN" --quiet ilf build s/sequence.json --grid 4 --out g.shgrid 2>&1); rc=$?
+if [ $rc -ne 0 ] && [ $rc -ne 124 ] && [ "$(grep -c '^iblkit: error:' <<<"$out")" = 1 ] && grep -q "disagree on sequence: rank 0 has s/sequence.json (20 probes" <<<"$out"; then
+  pass=$((pass+1)); else echo "FAIL sequence-content: exit $rc: $out"; fail=$((fail+1)); fi
+# A rank that is not iblkit: an MPI program that never comes to the handshake (named after
+# --mpi-timeout), and a program without MPI (MPI_Init itself waits: said so after the timeout).
+if command -v mpicc >/dev/null 2>&1; then
+  printf '#include <mpi.h>\n#include <unistd.h>\nint main(int c, char** v) { MPI_Init(&c, &v); sleep(120); MPI_Finalize(); return 0; }\n' > "$T/other.c"
+  if mpicc -o "$T/other" "$T/other.c" 2>/dev/null; then
+    t0=$(date +%s)
+    out=$(timeout 60 "${MPIRUN[@]}" -np 1 "$BIN" --quiet ilf build "$S" --grid 4 --out "$T/o.shgrid" --buckets "$T/ob" --mpi-timeout 3 : -np 1 "$T/other" 2>&1); rc=$?
+    took=$(( $(date +%s) - t0 ))
+    if [ $rc -ne 0 ] && [ $rc -ne 124 ] && [ $took -lt 30 ] && grep -q "^iblkit: error: rank 1 of this MPI job of 2 did not take part within --mpi-timeout 3 s" <<<"$out"; then
+      pass=$((pass+1)); else echo "FAIL not-iblkit: exit $rc after $took s: $out"; fail=$((fail+1)); fi
+  fi
+else
+  echo "cli_mpi: no mpicc: the rank that runs another MPI program is not tried"
+fi
+out=$(timeout 60 "${MPIRUN[@]}" -np 1 "$BIN" --quiet ilf build "$S" --grid 4 --out "$T/o.shgrid" --buckets "$T/ob" --mpi-timeout 3 : -np 1 sleep 100 2>&1); rc=$?
+if [ $rc -ne 0 ] && [ $rc -ne 124 ] && grep -q "^iblkit: error: MPI_Init did not complete within --mpi-timeout 3 s" <<<"$out"; then
+  pass=$((pass+1)); else echo "FAIL not-mpi: exit $rc: $out"; fail=$((fail+1)); fi
+
 echo "cli_mpi: $pass passed, $fail failed"
 [ $fail -eq 0 ]

@@ -61,7 +61,7 @@ check sphere-rings-1e20 fail "surfaces\[0\]\.rings: expected a whole number" -- 
 
 # Values that once passed and should not.
 cp "$T/tc/probes/p0.exr" same.exr
-check convert-onto-input fail "the output is the input file" -- "$BIN" convert same.exr ./same.exr --mapping mirrorball --size 16
+check convert-onto-input fail "is the same file as the input" -- "$BIN" convert same.exr ./same.exr --mapping mirrorball --size 16
 cmp -s same.exr "$T/tc/probes/p0.exr" || { echo "FAIL convert-onto-input: the input changed"; fail=$((fail + 1)); }
 check convert-size-16384 fail "would allocate .* GB.*choose a smaller --size" -- "$BIN" convert "$T/tc/probes/p0.exr" x.exr --mapping hcross --size 16384
 check ilf-kernel-1e9 fail "kernel.*would allocate.*kernel_cells" -- "$BIN" ilf build cap/sequence.json --grid 4 --bands 3 --kernel 1e9 --out k.shgrid

@@ -232,6 +232,7 @@ void setup(CLI::App& app) {
 #endif
   app.add_option("-o,--out", o->out, "the composite (.exr linear, .png tone mapped)")->capture_default_str();
   app.add_option("--layers", o->layers, "folder for mask, difference, albedo, render_with, render_without (.exr)");
+  iblcli::outputs(app, {"--layers"});  // besides --out (cli.h)
   app.add_option(
       "--truth", o->truth,
       "a photograph with the object really there (iblkit lab photograph): print the errors; repeat with other seeds to "

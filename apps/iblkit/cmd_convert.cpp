@@ -75,7 +75,10 @@ void setup(CLI::App& app) {
                                         dst.width(), dst.height()),
                             double(dst.width()) * dst.height(), 3 * 3 * sizeof(float) + sizeof(double),
                             "choose a smaller --size");
-    ibl::sphere::EnvMap out(ibl::sphere::resample(src, dst), dst);
+    ibl::sphere::ResampleDesc rs;
+    rs.progress = iblcli::progress_bar();
+    ibl::sphere::EnvMap out(ibl::sphere::resample(src, dst, rs), dst);
+    iblcli::progress_done();
     if (o->faces) {
       ibl::io::write_cube_faces(o->out, out);
     } else {

@@ -181,6 +181,7 @@ struct BuildOptions {
   bool no_reuse = !bd.buckets.reuse, drop_buckets = false;
   bool no_parallax = !bd.ball_parallax;
   bool mpi = false;
+  double mpi_timeout = ilf::MpiJobDesc{}.timeout_s;
 };
 
 // The build and its report; job: this rank of an MPI job (rank 0 writes and prints), or none.
@@ -311,6 +312,7 @@ void setup_build(CLI::App& app) {
   app.add_option("--subsample-distance", o->subsample_dist, "… and whose neighbours lie within this many metres")
       ->capture_default_str();
   app.add_option("--vdb", o->vdb, "also write the grid as OpenVDB (one Vec3f grid per coefficient)");
+  iblcli::outputs(app, {"--error-grid", "--vdb", "--buckets"});  // besides --out (cli.h)
   app.add_flag("--skip-bad", bd0.buckets.skip_bad,
                "skip bad probes (missing/unreadable frames, wrong size, NaN, outside the volume, duplicates) and "
                "report how many");
@@ -322,6 +324,10 @@ void setup_build(CLI::App& app) {
                "ignore the manifest's ball_radius: every ray through the probe position (single viewpoint)");
   app.add_flag("--mpi", o->mpi,
                "build as a rank of an MPI job (the default under mpirun): mpirun -np N iblkit ilf build …");
+  app.add_option("--mpi-timeout", o->mpi_timeout,
+                 "MPI: seconds the ranks wait for each other at the start before the job ends naming the missing one")
+      ->capture_default_str()
+      ->check(CLI::Range(1.0, 86400.0));
   app.footer(
       "Examples:\n  iblkit ilf build cap/sequence.json --grid 8 --bands 5 --out room8.shgrid\n"
       "  mpirun -np 4 iblkit ilf build captures/sequence.json --grid 32 --out room.shgrid   (docs/ilf.md, \"On a "
@@ -359,7 +365,9 @@ void setup_build(CLI::App& app) {
     ilf::SequenceReadDesc rd;
     rd.skip_bad = bd.buckets.skip_bad;
     if (o->mpi || ilf::launched_by_mpi()) {
-      ilf::run_mpi_job([&](ilf::MpiJob& job) { run_build(*o, rd, bd, &job); });
+      // The ranks first agree on the command line (every option's value) and then on the job itself.
+      ilf::MpiJobDesc job{iblcli::describe_options(app), o->mpi_timeout};
+      ilf::run_mpi_job(job, [&](ilf::MpiJob& job) { run_build(*o, rd, bd, &job); });
     } else {
       run_build(*o, rd, bd, nullptr);
     }

@@ -363,6 +363,7 @@ void setup(CLI::App& app) {
       ->capture_default_str();
   ph->add_option("--mask", po->mask, "also write the object's mask (1 where a pixel centre sees it)");
   ph->add_option("-o,--out", po->out, "output image (.exr)")->required();
+  iblcli::outputs(*ph, {"--mask"});  // besides --out (cli.h)
   ph->footer(
       "Example:\n  iblkit lab photograph low-scene2 --eye 0,1.2,2.4 --target 0,0.3,0 --fov 40 --object blob --at "
       "0,0.15,0 "

@@ -117,6 +117,7 @@ void setup_lights(CLI::App& app) {
                  "merge lights closer than this many degrees, then cut further (0: off)");
   app.add_option("-o,--out", o->out, "write the lights as iblkit.lights/1 JSON");
   app.add_option("--gltf", o->gltf, "write the lights as a glTF 2.0 scene (KHR_lights_punctual)");
+  iblcli::outputs(app, {"--gltf"});  // besides --out (cli.h)
   app.add_option("--lux-per-unit", o->gltf_desc.lux_per_unit, "glTF: lux per unit of probe irradiance")
       ->capture_default_str();
   app.add_option("--overlay", o->overlay, "write a PNG of the probe with every light and its region marked");

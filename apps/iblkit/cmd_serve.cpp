@@ -26,6 +26,10 @@ void setup(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::Range(0, 65535));
   app.add_option("--host", o->d.host, "loopback address to listen on (127.0.0.0/8 or ::1)")->capture_default_str();
+  app.add_option("--request-timeout", o->d.request_seconds,
+                 "seconds a client has to send a whole request (from connecting or the previous answer)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.5, 3600.0));
   app.add_option("--seconds", o->seconds, "stop after this many seconds (0: until interrupted)")
       ->check(CLI::Range(0.0, 1e7));
   app.footer(

@@ -47,6 +47,7 @@ void setup(CLI::App& app) {
   app.add_option("-o,--out", o->out, "write the coefficients here (default: print them on stdout)");
   app.add_option("--irradiance-map", o->irradiance_map,
                  "also render the SH irradiance E(n) as a lat-long image (.exr …)");
+  iblcli::outputs(app, {"--irradiance-map"});  // besides --out (cli.h)
   app.add_option("--irradiance-size", o->irradiance_size, "height of the irradiance map (width is twice)")
       ->capture_default_str();
   app.add_option(

@@ -47,6 +47,7 @@ void setup(CLI::App& app) {
   app.add_option("--irradiance-size", o->irradiance_size, "face size of the irradiance cube map")
       ->capture_default_str();
   app.add_option("--dfg", o->dfg, "write the split-sum DFG table (scale, bias) as .png, .exr or .ktx2");
+  iblcli::outputs(app, {"--faces", "--irradiance", "--dfg"});  // besides --out (cli.h)
   app.add_option("--dfg-size", o->dfg_size, "size of the DFG table")->capture_default_str();
   auto& rd = iblcli::add_probe_read_options(app);
   app.footer(

@@ -549,6 +549,7 @@ void setup(CLI::App& app) {
   app.add_option("--frames", o->frames, "run this many frames (one orbit) and exit; 0: interactive")
       ->check(CLI::Range(0, 100000));
   app.add_option("--screenshot", o->screenshot, "write the last frame here on exit (.png)");
+  iblcli::outputs(app, {"--screenshot"});  // cli.h
   app.add_option("--error-grid", o->error_grid,
                  "an error volume (ilf build --error-grid): its false-colour slice through the object, top left "
                  "(keys X / Y / Z: the plane's normal)");

@@ -30,6 +30,7 @@ void setup(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::Range(8, 8192));
   app.add_option("--screenshot", o->screenshot, "also take a headless-Chromium screenshot of the page into this PNG");
+  iblcli::outputs(app, {"--screenshot"});  // besides --out (cli.h)
   app.add_option("--view", o->query,
                  "viewer URL parameters for the screenshot (docs/web.md), e.g. mode=lights&shadows=4")
       ->capture_default_str();

@@ -8,8 +8,10 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
+#include <functional>
 #include <string_view>
 
+#include <fmt/format.h>
 #include <oneapi/tbb/global_control.h>
 #include <CLI/CLI.hpp>
 
@@ -138,6 +140,14 @@ int main(int argc, char** argv) {
       return 1;
     }
   }
+  // Before a subcommand runs: no output is one of its inputs (cli.h, check_outputs).
+  std::function<void(CLI::App*)> guard = [&](CLI::App* a) {
+    for (CLI::App* sub : a->get_subcommands({})) {
+      if (sub->get_subcommands({}).empty()) sub->parse_complete_callback([sub] { iblcli::check_outputs(*sub); });
+      guard(sub);
+    }
+  };
+  guard(&app);
   try {
     ibl::OutputTransaction outputs;  // a command that fails leaves its outputs as they were (atomic_file.h)
     app.parse(argc, argv);
@@ -149,6 +159,11 @@ int main(int argc, char** argv) {
     return app.exit(e);
   } catch (const ibl::Error& e) {
     return report(iblcli::for_command(app, e.what()));  // the library's parameter hints as this command's flags
+  } catch (const std::bad_alloc&) {
+    // An allocation the library did not check before it made it: what ran, and what to lower.
+    const std::string sizes = iblcli::size_options(app);
+    return report(fmt::format("out of memory (this process's memory limit or the machine's): {}",
+                              sizes.empty() ? "give the command smaller inputs or sizes" : "lower " + sizes));
   } catch (const std::exception& e) {
     return report(e.what());
   }

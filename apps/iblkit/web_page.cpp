@@ -43,10 +43,13 @@ namespace {
 
 std::string stem(const std::string& path) { return fs::path(path).stem().string(); }
 
-void copy_into(const fs::path& from, const fs::path& to) {
+// Files and folders inside the output folder are written as themselves: a link planted there (to a
+// file or a folder outside it) is replaced, never written through (issue 32).
+void copy_into(const fs::path& from, const fs::path& to) { copy_file_atomically(from.string(), to.string()); }
+void real_folder(const fs::path& dir) {
   std::error_code ec;
-  fs::copy_file(from, to, fs::copy_options::overwrite_existing, ec);
-  if (ec) fail(ErrorKind::Io, "{}: cannot copy to {} ({})", from.string(), to.string(), ec.message());
+  if (fs::is_symlink(fs::symlink_status(dir, ec))) fs::remove(dir, ec);
+  make_output_folders(dir.string());
 }
 
 }  // namespace
@@ -62,10 +65,17 @@ nlohmann::json write_web_page(const WebPageDesc& d) {
   if (d.probe_height < 8 || d.probe_height > 8192)
     fail(ErrorKind::Value, "probe height {} outside 8..8192", d.probe_height);
   fs::path out = d.out, data = out / "data";
+  make_output_folders(out.string());
+  real_folder(data);
   std::error_code ec;
-  fs::create_directories(data, ec);
-  if (ec) fail(ErrorKind::Io, "{}: cannot create the folder ({})", data.string(), ec.message());
-  fs::copy(page, out, fs::copy_options::recursive | fs::copy_options::overwrite_existing, ec);
+  for (auto it = fs::recursive_directory_iterator(page, ec); !ec && it != fs::recursive_directory_iterator();
+       it.increment(ec)) {
+    const fs::path to = out / fs::relative(it->path(), page);
+    if (it->is_directory())
+      real_folder(to);
+    else
+      copy_into(it->path(), to);
+  }
   if (ec) fail(ErrorKind::Io, "cannot copy the viewer from {} to {} ({})", page, out.string(), ec.message());
 
   nlohmann::json m = {{"format", "iblkit.web/1"},

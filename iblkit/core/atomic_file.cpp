@@ -9,11 +9,15 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <map>
 #include <mutex>
+#include <set>
 #include <unordered_set>
+#include <utility>
 #include <vector>
 
 #include "iblkit/core/error.h"
+#include "iblkit/core/input_file.h"
 
 namespace ibl {
 
@@ -118,6 +122,8 @@ struct OutputTransaction::State {
   std::mutex mutex;  // writers on several threads
   std::unordered_set<std::string> targets;
   size_t files = 0;
+  std::map<std::pair<dev_t, ino_t>, std::string> inputs;  // files the command reads (note_input_file)
+  std::set<std::pair<dev_t, ino_t>> written;              // files the command wrote (never inputs)
   ~State() {
     for (TxChunk* c = head.next.load(); c;) {
       TxChunk* n = c->next.load();
@@ -252,15 +258,11 @@ void make_output_folders(const std::string& dir) {
 }
 
 AtomicFile::AtomicFile(const std::string& path) : path_(path), target_(path) {
-  std::error_code ec;
-  auto st = fs::symlink_status(path, ec);
-  if (!ec && fs::is_symlink(st)) {
-    auto real = fs::canonical(path, ec);
-    if (!ec) target_ = real.string();
-    st = fs::status(target_, ec);
-  }
-  if (!ec && fs::exists(st) && !fs::is_regular_file(st) && !fs::is_directory(st)) {
-    direct_ = true;  // a device or FIFO: written in place, never replaced
+  // target_ is path itself, a link included: the rename replaces the link, never its target.
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode) && !S_ISDIR(st.st_mode)) {
+    if (S_ISBLK(st.st_mode)) fail(ErrorKind::Io, "{}: cannot write (it is a block device; iblkit writes files)", path);
+    direct_ = true;  // a FIFO, socket or character device (/dev/null, /dev/stdout): written in place
     temp_ = path;
     return;
   }
@@ -289,13 +291,57 @@ void AtomicFile::commit() {
     committed_ = true;
     return;
   }
-  if (auto* st = g_tx.load()) note_replacement(*st, target_);
+  auto* tx = g_tx.load();
+  if (tx) {
+    struct stat st {};
+    if (::lstat(target_.c_str(), &st) == 0) {
+      std::lock_guard<std::mutex> lock(tx->mutex);
+      auto id = std::make_pair(st.st_dev, st.st_ino);
+      auto in = tx->inputs.find(id);
+      if (in != tx->inputs.end() && !tx->written.count(id)) {
+        ::unlink(temp_.c_str());
+        fail(ErrorKind::Value,
+             "{}: is an input of this command ({}); write the output elsewhere (the input is left as it was)", path_,
+             in->second);
+      }
+    }
+    note_replacement(*tx, target_);
+  }
   if (std::rename(temp_.c_str(), target_.c_str()) != 0) {
     int err = errno;
     ::unlink(temp_.c_str());
     fail(ErrorKind::Io, "{}: cannot write ({})", path_, reason(err));
   }
   committed_ = true;
+  if (tx) {
+    struct stat st {};
+    if (::lstat(target_.c_str(), &st) == 0) {
+      std::lock_guard<std::mutex> lock(tx->mutex);
+      tx->written.insert({st.st_dev, st.st_ino});
+    }
+  }
+}
+
+void note_input_file(const std::string& path) {
+  auto* tx = g_tx.load();
+  struct stat st {};
+  if (!tx || ::stat(path.c_str(), &st) != 0) return;
+  std::lock_guard<std::mutex> lock(tx->mutex);
+  auto id = std::make_pair(st.st_dev, st.st_ino);
+  if (!tx->written.count(id)) tx->inputs.emplace(id, path);
+}
+
+void copy_file_atomically(const std::string& from, const std::string& to) {
+  require_input_file(from);
+  AtomicFile f(to);
+  std::error_code ec;
+  if (!f.temp_path().empty() && f.temp_path() != to) {
+    fs::copy_file(from, f.temp_path(), fs::copy_options::overwrite_existing, ec);
+  } else {
+    fs::copy_file(from, to, fs::copy_options::overwrite_existing, ec);  // a FIFO or device: in place
+  }
+  if (ec) fail(ErrorKind::Io, "{}: cannot copy to {} ({})", from, to, ec.message());
+  f.commit();
 }
 
 void write_file_atomically(const std::string& path, std::string_view bytes) {

@@ -17,9 +17,10 @@ class AtomicFile {
  public:
   // Chooses temp_path() beside `path` as "<stem>.tmp-<pid>-<n><extension>": unique in the process
   // and across processes, and with the output's extension so a writer that picks its format by
-  // extension still can. Where `path` is a symbolic link, its target is replaced, not the link.
-  // Where `path` is there and is not a regular file (/dev/null, a FIFO), temp_path() is `path`
-  // itself and commit() does nothing.
+  // extension still can. Where `path` is a symbolic link, the link is replaced, never its target (a
+  // link planted in an output folder cannot make a command write outside it). Where `path` is (or
+  // links to) a FIFO, a socket or a character device (/dev/null, /dev/stdout), temp_path() is that
+  // itself and commit() does nothing; a block device is refused.
   explicit AtomicFile(const std::string& path);
   ~AtomicFile();  // removes temp_path() unless committed
   AtomicFile(const AtomicFile&) = delete;
@@ -39,6 +40,15 @@ class AtomicFile {
 
 // Writes `bytes` to `path` through an AtomicFile; ErrorKind::Io "PATH: cannot write (reason)".
 void write_file_atomically(const std::string& path, std::string_view bytes);
+// Copies file `from` to `to` through an AtomicFile (a link at `to` is replaced, not written through).
+void copy_file_atomically(const std::string& from, const std::string& to);
+
+// Notes `path` (followed through links) as an input of the command while an OutputTransaction is open
+// (require_input_file does, for every file a reader opens; the CLI does for every file its options
+// name): from then on no AtomicFile of the command replaces that file (same device and inode), its
+// commit() fails "OUT: is an input of this command (IN); …" and the input stays as it was. Files
+// the command wrote itself are not inputs. Without an open transaction it does nothing.
+void note_input_file(const std::string& path);
 
 // Removes the temporary file of every AtomicFile alive in this process. Async-signal-safe: for a
 // signal handler.

@@ -89,14 +89,45 @@ TEST(AtomicFile, FailuresNameTheFileAndLeaveNothing) {
   fs::remove_all(d);
 }
 
+TEST(AtomicFile, NeverReplacesAnInput) {
+  auto d = fresh_dir("inputs");
+  write_file_atomically((d / "in.txt").string(), "input");
+  fs::create_hard_link(d / "in.txt", d / "same.txt");
+  {
+    OutputTransaction tx;
+    note_input_file((d / "in.txt").string());
+    EXPECT_THROW(write_file_atomically((d / "in.txt").string(), "x"), Error);
+    EXPECT_THROW(write_file_atomically((d / "same.txt").string(), "x"), Error);  // the same inode
+    write_file_atomically((d / "out.txt").string(), "1");
+    note_input_file((d / "out.txt").string());  // written by the command itself: not an input
+    write_file_atomically((d / "out.txt").string(), "2");
+    tx.commit();
+  }
+  EXPECT_EQ(slurp(d / "in.txt"), "input");
+  EXPECT_EQ(slurp(d / "out.txt"), "2");
+  EXPECT_EQ(listing(d), (std::vector<std::string>{"in.txt", "out.txt", "same.txt"}));
+  fs::remove_all(d);
+}
+
 TEST(AtomicFile, LinksAndDevices) {
   auto d = fresh_dir("links");
   write_file_atomically((d / "real.txt").string(), "old");
   fs::create_symlink("real.txt", d / "link.txt");
   write_file_atomically((d / "link.txt").string(), "new");
-  EXPECT_TRUE(fs::is_symlink(d / "link.txt"));  // the link stays a link; its target is replaced
-  EXPECT_EQ(slurp(d / "real.txt"), "new");
+  // The link is replaced, never written through (issue 32: a link planted in an output folder).
+  EXPECT_FALSE(fs::is_symlink(d / "link.txt"));
+  EXPECT_EQ(slurp(d / "link.txt"), "new");
+  EXPECT_EQ(slurp(d / "real.txt"), "old");
   EXPECT_EQ(listing(d), (std::vector<std::string>{"link.txt", "real.txt"}));
+  // A dangling link and a link to a folder are replaced too.
+  fs::create_symlink("nowhere.txt", d / "dangling.txt");
+  write_file_atomically((d / "dangling.txt").string(), "x");
+  EXPECT_FALSE(fs::exists(d / "nowhere.txt"));
+  EXPECT_EQ(slurp(d / "dangling.txt"), "x");
+  // A link to /dev/null (as /dev/stdout links to a pipe or a terminal) is written in place.
+  fs::create_symlink("/dev/null", d / "null.txt");
+  write_file_atomically((d / "null.txt").string(), "discarded");
+  EXPECT_TRUE(fs::is_symlink(d / "null.txt"));
   // A device is written in place, never replaced by a regular file.
   AtomicFile null("/dev/null");
   EXPECT_EQ(null.temp_path(), "/dev/null");

@@ -6,6 +6,8 @@
 #include "iblkit/core/check.h"
 #include "iblkit/core/error.h"
 
+#include <new>
+
 namespace ibl {
 
 Image::Image(int width, int height, int channels, float fill) : width_(width), height_(height), channels_(channels) {
@@ -13,7 +15,14 @@ Image::Image(int width, int height, int channels, float fill) : width_(width), h
     fail(ErrorKind::Value, "image size {}x{}x{} is invalid", width, height, channels);
   require_allocation(fmt::format("an image of {}x{} pixels, {} channels,", width, height, channels),
                      double(width) * height * channels, sizeof(float), "choose a smaller image size");
-  data_.assign(static_cast<size_t>(width) * height * channels, fill);
+  try {
+    data_.assign(static_cast<size_t>(width) * height * channels, fill);
+  } catch (const std::bad_alloc&) {
+    fail(ErrorKind::Value,
+         "out of memory: an image of {}x{} pixels, {} channels, needs {:.3g} GB more than this process can get (its "
+         "memory limit or the machine's); choose a smaller image size",
+         width, height, channels, double(width) * height * channels * sizeof(float) / 1e9);
+  }
 }
 
 Vec3 Image::rgb(int x, int y) const {

@@ -2,8 +2,11 @@
 // errors a user sees when a file is missing, is not JSON, or is another kind of iblkit file, and one
 // writer that reports failure and replaces the file whole (core/atomic_file.h).
 #pragma once
+#include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <string>
 #include <type_traits>
 
@@ -11,14 +14,14 @@
 
 #include "iblkit/core/atomic_file.h"
 #include "iblkit/core/error.h"
+#include "iblkit/core/input_file.h"
 
 namespace ibl {
 
 // The parsed file; ErrorKind::Io "PATH: no such file" or "PATH: cannot open" when it cannot be
 // read, ErrorKind::Format "PATH: not valid JSON (…)" when it does not parse.
 inline nlohmann::json read_json_file(const std::string& path) {
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) fail(ErrorKind::Io, "{}: no such file", path);
+  require_input_file(path);  // a FIFO or a device is refused before it is read (input_file.h)
   std::ifstream in(path);
   if (!in) fail(ErrorKind::Io, "{}: cannot open", path);
   try {
@@ -37,6 +40,34 @@ inline std::string json_error_text(const nlohmann::json::exception& e) {
     if (k != std::string::npos) s = s.substr(k + 2);
   }
   return s;
+}
+
+// A JSON number as an integer, checked before anything narrows it (the one rule for every integer
+// of every iblkit file): a JSON integer, or a number with an integral value, within [lo, hi]; else
+// ErrorKind::Format "WHERE: field "f" = V is not a whole number in [lo, hi]". (nlohmann's get<int>
+// reads 4294967360 as 64.)
+inline int64_t json_integer(const nlohmann::json& v, const std::string& where, const char* field, int64_t lo,
+                            int64_t hi) {
+  if (v.is_number_unsigned()) {
+    const uint64_t u = v.get<uint64_t>();
+    if (hi >= 0 && u <= static_cast<uint64_t>(hi) && static_cast<int64_t>(u) >= lo) return static_cast<int64_t>(u);
+  } else if (v.is_number_integer()) {
+    const int64_t i = v.get<int64_t>();
+    if (i >= lo && i <= hi) return i;
+  } else if (v.is_number_float()) {
+    const double d = v.get<double>();
+    if (std::isfinite(d) && d == std::floor(d) && d >= static_cast<double>(lo) && d <= static_cast<double>(hi))
+      return static_cast<int64_t>(d);
+  }
+  fail(ErrorKind::Format, "{}: field \"{}\" = {} is not a whole number in [{}, {}]", where, field, v.dump(), lo, hi);
+}
+// The same for integer type T's whole range.
+template <typename T>
+T json_integer(const nlohmann::json& v, const std::string& where, const char* field) {
+  static_assert(std::is_integral_v<T> && sizeof(T) <= 8);
+  constexpr int64_t hi = sizeof(T) == 8 && std::is_unsigned_v<T> ? std::numeric_limits<int64_t>::max()
+                                                                 : static_cast<int64_t>(std::numeric_limits<T>::max());
+  return static_cast<T>(json_integer(v, where, field, static_cast<int64_t>(std::numeric_limits<T>::min()), hi));
 }
 
 namespace detail {
@@ -74,7 +105,10 @@ T opt_field(const nlohmann::json& j, const std::string& where, const char* key, 
   if (it == j.end()) return def;
   if (!detail::json_is<T>(*it))
     fail(ErrorKind::Format, "{}: field \"{}\" must be {}, got {}", where, key, detail::json_kind<T>(), it->dump());
-  return it->template get<T>();
+  if constexpr (std::is_integral_v<T> && !std::is_same_v<T, bool>)
+    return json_integer<T>(*it, where, key);  // range-checked before narrowing
+  else
+    return it->template get<T>();
 }
 inline std::string opt_field(const nlohmann::json& j, const std::string& where, const char* key, const char* def) {
   return opt_field<std::string>(j, where, key, std::string(def));

@@ -152,7 +152,7 @@ TEST(Ktx2, RoundTripAndBadChains) {
   bad.levels[0] = std::vector<Image>(6, Image(4, 4, 3));
   bad.levels.push_back(std::vector<Image>(6, Image(4, 4, 3)));
   test_util::expect_error([&] { ktx2_bytes(bad); }, "level 1 is 4×4 (expected 2×2)");
-  test_util::expect_error([] { read_ktx2("/nonexistent.ktx2"); }, "cannot open");
+  test_util::expect_error([] { read_ktx2("/nonexistent.ktx2"); }, "no such file");
 }
 
 // A white furnace stays white at every roughness, by both methods: (1) is normalised.

@@ -1,4 +1,5 @@
 #include "iblkit/engine/ktx2.h"
+#include "iblkit/core/input_file.h"
 
 #include <Imath/half.h>
 
@@ -173,6 +174,7 @@ uint64_t get64(const std::string& s, size_t at, const std::string& path, const c
 }  // namespace
 
 Ktx2Texture read_ktx2(const std::string& path) {
+  require_input_file(path, "a KTX2 texture");
   std::ifstream in(path, std::ios::binary);
   if (!in) fail(ErrorKind::Io, "{}: cannot open", path);
   std::string s((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

@@ -1,4 +1,5 @@
 #include "iblkit/geometry/mesh_io.h"
+#include "iblkit/core/input_file.h"
 
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -87,7 +88,7 @@ void check_ply_header(const std::string& path) {
 }  // namespace
 
 TriMesh read_mesh(const std::string& path) {
-  if (!std::filesystem::exists(path)) fail(ErrorKind::Io, "{}: no such mesh file", path);
+  require_input_file(path, "a mesh");
   check_ply_header(path);
   Assimp::Importer imp;
   const aiScene* sc = imp.ReadFile(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |

@@ -1,4 +1,6 @@
 // The .shtree file (docs/formats.md, "Adaptive SH grids"): read_adaptive, write_adaptive, read_dense.
+#include <sys/stat.h>
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -20,8 +22,30 @@ constexpr const char* kMagic = "IBLKIT-SHTREE 1";
 constexpr const char* kLayout =
     "levels top first; per level: bricks int32 x,y,z, then each brick's values z,y,x,coefficient,channel";
 
+int64_t brick_points(const AdaptiveGrid::Brick& b) { return int64_t(b.extent[0]) * b.extent[1] * b.extent[2]; }
+
+// FNV-1a (64 bits) over the bytes after the header, in file order: the header's "checksum", so that a
+// brick moved or a value changed in the file is found (a count or a size is checked by the sizes).
+struct Fnv {
+  uint64_t h = 1469598103934665603ull;
+  void add(const void* p, size_t n) {
+    for (const unsigned char* c = static_cast<const unsigned char*>(p); n--; ++c) h = (h ^ *c) * 1099511628211ull;
+  }
+  std::string hex() const { return fmt::format("{:016x}", h); }
+};
+std::string body_checksum(const AdaptiveGrid& g) {
+  Fnv f;
+  const int KC = g.coeff_count() * 3;
+  for (int l = g.levels() - 1; l >= 0; --l) {
+    for (const auto& b : g.level(l).bricks) f.add(b.b, 12);
+    for (const auto& b : g.level(l).bricks) f.add(g.data().data() + b.offset, size_t(brick_points(b)) * KC * 4);
+  }
+  return f.hex();
+}
+
 // Lines 1 and 2, line 2 padded with spaces so that the data starts at a multiple of 64 bytes.
-std::string header_of(const AdaptiveGrid& g) {
+// `checksum` false: a placeholder of the same length (for the file's size).
+std::string header_of(const AdaptiveGrid& g, bool checksum = true) {
   const auto& gd = g.grid();
   json counts = json::array();
   for (int l = 0; l < g.levels(); ++l) counts.push_back(g.level(l).bricks.size());
@@ -35,6 +59,7 @@ std::string header_of(const AdaptiveGrid& g) {
               {"bricks", counts},
               {"tolerance", g.tolerance()},
               {"rms", g.rms()},
+              {"checksum", checksum ? body_checksum(g) : std::string(16, '0')},
               {"layout", kLayout}};
   std::string head = std::string(kMagic) + "\n" + hdr.dump();
   size_t total = ((head.size() + 1 + 63) / 64) * 64;
@@ -43,12 +68,10 @@ std::string header_of(const AdaptiveGrid& g) {
   return head;
 }
 
-int64_t brick_points(const AdaptiveGrid::Brick& b) { return int64_t(b.extent[0]) * b.extent[1] * b.extent[2]; }
-
 }  // namespace
 
 size_t AdaptiveGrid::file_bytes() const {
-  size_t n = header_of(*this).size();
+  size_t n = header_of(*this, false).size();
   for (const auto& L : levels_) n += L.bricks.size() * 12;
   return n + data_.size() * 4;
 }
@@ -77,6 +100,8 @@ void write_adaptive(const std::string& path, const AdaptiveGrid& g) {
 }
 
 bool is_adaptive_file(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return false;  // the reader then says what it is
   std::ifstream in(path, std::ios::binary);
   std::string magic;
   return in && std::getline(in, magic) && magic == kMagic;
@@ -94,7 +119,9 @@ AdaptiveGrid read_adaptive(const std::string& path) {
   int bands = 0, brick = 0, levels = 0;
   double tolerance = 0, rms = 0;
   std::vector<int64_t> counts;
+  std::string checksum;
   try {
+    if (h.contains("checksum")) checksum = need("checksum").get<std::string>();
     bands = static_cast<int>(grid_header_integer(need("bands"), path, "bands", 1, 16));
     brick = static_cast<int>(grid_header_integer(need("brick"), path, "brick", kMinBrick, kMaxBrick));
     levels = static_cast<int>(grid_header_integer(need("levels"), path, "levels", 1, 64));
@@ -162,6 +189,7 @@ AdaptiveGrid read_adaptive(const std::string& path) {
   const int KC = bands * bands * 3;
   double pos = double(off);
   in.seekg(std::streamoff(off));
+  Fnv fnv;
   for (int l = levels - 1; l >= 0; --l) {
     const auto& L = g.level(l);
     const int64_t count = counts[size_t(l)];
@@ -172,6 +200,7 @@ AdaptiveGrid read_adaptive(const std::string& path) {
     in.read(reinterpret_cast<char*>(table.data()), std::streamsize(table.size() * 4));
     if (size_t(in.gcount()) != table.size() * 4)
       fail(ErrorKind::Format, "{}: truncated in level {}'s brick table", path, l);
+    fnv.add(table.data(), table.size() * 4);
     pos += double(table.size()) * 4;
     double values = 0;
     std::vector<char> seen(L.map.size(), 0);
@@ -199,12 +228,24 @@ AdaptiveGrid read_adaptive(const std::string& path) {
       const size_t n = size_t(brick_points(br)) * KC;
       in.read(reinterpret_cast<char*>(dst), std::streamsize(n * 4));
       if (size_t(in.gcount()) != n * 4) fail(ErrorKind::Format, "{}: truncated in level {} brick {}", path, l, i);
+      fnv.add(dst, n * 4);
       for (size_t q = 0; q < n; ++q)
         if (!std::isfinite(dst[q]))
           fail(ErrorKind::Value, "{}: level {} brick {}: value {} is not finite", path, l, i, q);
       pos += double(n) * 4;
     }
   }
+  // Every byte accounted for: a count one short leaves bytes behind, and bytes appended are no part of it.
+  if (pos != file_bytes)
+    fail(ErrorKind::Format,
+         "{}: {:.0f} bytes after the last brick (the header's \"bricks\" counts {:.0f} bytes of "
+         "bricks; the file is longer): refused",
+         path, file_bytes - pos, pos - double(off));
+  if (!checksum.empty() && checksum != fnv.hex())
+    fail(ErrorKind::Format,
+         "{}: the bricks do not match the header's checksum {} (they hash to {}): the file was changed "
+         "after it was written",
+         path, checksum, fnv.hex());
   return g;
 }
 

@@ -222,11 +222,11 @@ TEST(Adaptive, HostileFilesGiveOneLineErrorsNamingTheFileAndField) {
   expect(with_header(bytes, replace(hdr, "\"tolerance\":0.01", "\"tolerance\":-1")), {bad, "\"tolerance\""});
   // Numbers that are not integers, or too large for one, are refused before any conversion (fuzz_shtree
   // found "bricks" holding 8.9e61, which reached a float-to-integer cast: undefined behaviour).
-  expect(with_header(bytes, replace(hdr, counts, "\"bricks\":[8.9e61")), {bad, "\"bricks\"", "not an integer"});
-  expect(with_header(bytes, replace(hdr, "\"bands\":2", "\"bands\":1e30")), {bad, "\"bands\"", "not an integer"});
-  expect(with_header(bytes, replace(hdr, "\"brick\":4", "\"brick\":4.5")), {bad, "\"brick\"", "not an integer"});
+  expect(with_header(bytes, replace(hdr, counts, "\"bricks\":[8.9e61")), {bad, "\"bricks\"", "not a whole number"});
+  expect(with_header(bytes, replace(hdr, "\"bands\":2", "\"bands\":1e30")), {bad, "\"bands\"", "not a whole number"});
+  expect(with_header(bytes, replace(hdr, "\"brick\":4", "\"brick\":4.5")), {bad, "\"brick\"", "not a whole number"});
   expect(with_header(bytes, replace(hdr, "\"resolution\":[33,17,25]", "\"resolution\":[33,1e40,25]")),
-         {bad, "\"resolution\"", "not an integer"});
+         {bad, "\"resolution\"", "not a whole number"});
   // The top level's brick at coordinates outside its one-brick grid.
   std::string moved = bytes;
   int32_t five = 5;

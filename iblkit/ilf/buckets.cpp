@@ -1,7 +1,12 @@
 #include "iblkit/ilf/buckets.h"
 
 #include <Imath/half.h>
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 
 #include <atomic>
 #include <chrono>
@@ -17,6 +22,7 @@
 #include "iblkit/core/error.h"
 #include "iblkit/core/json_file.h"
 #include "iblkit/core/parallel.h"
+#include "iblkit/ilf/collective.h"
 #include "iblkit/io/image_io.h"
 
 namespace ibl::ilf {
@@ -193,20 +199,6 @@ void scatter_probe_samples(const DirectionTable& t, const float* rgb, int pc, in
   }
 }
 
-BucketStore BucketStore::open(const std::string& dir, DirectionTable table, int probe_count, int chunk,
-                              std::vector<uint8_t> valid) {
-  if (probe_count < 1 || chunk < 1 || int(valid.size()) != probe_count)
-    fail(ErrorKind::Internal, "{}: bucket store of {} probes in chunks of {} with {} flags", dir, probe_count, chunk,
-         valid.size());
-  BucketStore st;
-  st.dir_ = dir;
-  st.table_ = std::move(table);
-  st.probe_count_ = probe_count;
-  st.chunk_ = chunk;
-  st.valid_ = std::move(valid);
-  return st;
-}
-
 void BucketStore::load_block(int k, std::vector<uint16_t>& buf) const {
   const auto& t = table_;
   int64_t s0 = t.bucket_begin[t.block_begin[k]], s1 = t.bucket_begin[t.block_begin[k + 1]];
@@ -229,94 +221,184 @@ const uint16_t* BucketStore::samples(const std::vector<uint16_t>& buf, int k, in
   return buf.data() + seg + size_t(pc) * size_t(t.bucket_begin[b] - s0) * 3 + size_t(p - c * chunk_) * nb * 3;
 }
 
+namespace {
+
+// Writes n halves at byte offset `offset` of file `path` (which exists).
+void write_at(const std::string& path, const uint16_t* data, size_t n, int64_t offset) {
+  int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
+  if (fd < 0) fail(ErrorKind::Io, "{}: cannot open bucket block ({})", path, std::strerror(errno));
+  const char* p = reinterpret_cast<const char*>(data);
+  size_t left = n * 2;
+  while (left > 0) {
+    ssize_t w = ::pwrite(fd, p, left, offset);
+    if (w <= 0) {
+      ::close(fd);
+      fail(ErrorKind::Io, "{}: write failed (disk full?)", path);
+    }
+    p += w;
+    left -= size_t(w);
+    offset += w;
+  }
+  ::close(fd);
+}
+
+// The index of an earlier run, when it describes complete block files of this plan: its valid flags,
+// skip count and reasons.
+bool read_index(const fs::path& index, const std::string& key, const DirectionTable& t, const SortPlan& plan,
+                int probes, std::vector<uint8_t>& valid, BucketReport& rep) {
+  if (!fs::exists(index)) return false;
+  try {
+    std::ifstream in(index);
+    json j = json::parse(in);
+    bool ok = j.value("key", "") == key && j.value("chunk", 0) == plan.chunk &&
+              j.value("first_block", 0) == plan.block_begin && j.value("end_block", t.blocks()) == plan.block_end;
+    for (int k = plan.block_begin; ok && k < plan.block_end; ++k) {
+      size_t expect = size_t(t.bucket_begin[t.block_begin[k + 1]] - t.bucket_begin[t.block_begin[k]]) * probes * 6;
+      auto path = BucketStore::block_path(index.parent_path().string(), k);
+      ok = fs::exists(path) && fs::file_size(path) == expect;
+    }
+    if (!ok) return false;
+    valid = j["valid"].get<std::vector<uint8_t>>();
+    rep.skipped = j.value("skipped", 0);
+    rep.reasons = j.value("reasons", std::vector<std::string>{});
+    return int(valid.size()) == probes;
+  } catch (const std::exception&) {
+    return false;  // an unreadable index means the files are rebuilt
+  }
+}
+
+}  // namespace
+
 BucketStore BucketStore::sort(const Sequence& seq, const BucketDesc& desc, const ProgressFn& progress,
-                              BucketReport* report) {
-  if (desc.dir.empty()) fail(ErrorKind::Value, "direction buckets: no folder given for the block files");
-  ibl::make_output_folders(desc.dir);
+                              BucketReport* report, Collective* team_in) {
+  Collective& team = team_in ? *team_in : serial_collective();
   BucketReport local;
   BucketReport& rep = report ? *report : local;
-  // The first frame with a readable header fixes the size (its pixels are checked with the others').
-  int w = 0, h = 0;
-  sequence_frame_size(seq, desc.skip_bad, &w, &h);
+  rep = {};
   BucketStore st;
   st.dir_ = desc.dir;
   st.probe_count_ = int(seq.probes.size());
-  st.table_ = make_direction_table(seq, w, h, desc, st.probe_count_);
+  const int P = st.probe_count_;
+  // The first frame with a readable header fixes the size (its pixels are checked with the others').
+  int w = 0, h = 0;
+  team.agree([&] {
+    if (desc.dir.empty()) fail(ErrorKind::Value, "direction buckets: no folder given for the block files");
+    ibl::make_output_folders(desc.dir);
+    sequence_frame_size(seq, desc.skip_bad, &w, &h);
+    st.table_ = make_direction_table(seq, w, h, desc, P);
+  });
   const auto& t = st.table_;
-  size_t per_probe = size_t(t.slots()) * 3 * 2;
-  st.chunk_ = int(std::clamp<size_t>(desc.memory_bytes / 4 / per_probe, 1, size_t(st.probe_count_)));
-  std::string key = bucket_cache_key(seq, desc, w, h);
-  fs::path index = fs::path(desc.dir) / "index.json";
-  if (desc.reuse && fs::exists(index)) {
-    try {
-      std::ifstream in(index);
-      json j = json::parse(in);
-      bool ok = j.value("key", "") == key && j.value("chunk", 0) == st.chunk_;
-      for (int k = 0; ok && k < t.blocks(); ++k) {
-        size_t expect =
-            size_t(t.bucket_begin[t.block_begin[k + 1]] - t.bucket_begin[t.block_begin[k]]) * st.probe_count_ * 6;
-        ok = fs::exists(block_path(desc.dir, k)) && fs::file_size(block_path(desc.dir, k)) == expect;
-      }
-      if (ok) {
-        st.valid_ = j["valid"].get<std::vector<uint8_t>>();
-        rep.reused = true;
-        rep.skipped = j.value("skipped", 0);
-        rep.reasons = j.value("reasons", std::vector<std::string>{});
-        ibl::report(progress, "sort", 1.0);
-        return st;
-      }
-    } catch (const std::exception&) {
-      // An unreadable index means the files are rebuilt.
-    }
+  const SortPlan plan = team.plan_sort(t, P, desc.memory_bytes);
+  st.chunk_ = plan.chunk;
+  st.block_begin_ = plan.block_begin;
+  st.block_end_ = plan.block_end;
+  const std::string key = bucket_cache_key(seq, desc, w, h) + plan.key_suffix;
+  const fs::path index = fs::path(desc.dir) / plan.index;
+  // Reuse: every process's blocks of an identical earlier run are complete.
+  std::vector<uint8_t> valid;
+  bool mine_ok = desc.reuse && read_index(index, key, t, plan, P, valid, rep);
+  if (team.all(mine_ok)) {
+    st.valid_ = std::move(valid);
+    rep.reused = true;
+    ibl::report(progress, "sort", 1.0);
+    return st;
   }
-  std::error_code ec;
-  fs::remove(index, ec);
-  for (int k = 0; k < t.blocks(); ++k) {
-    FILE* f = std::fopen(block_path(desc.dir, k).c_str(), "wb");
-    if (!f) fail(ErrorKind::Io, "{}: cannot create bucket block", block_path(desc.dir, k));
-    std::fclose(f);
-  }
-  st.valid_.assign(st.probe_count_, 1);
-  std::vector<uint16_t> chunk(size_t(st.chunk_) * t.slots() * 3);
-  std::mutex mu;
-  std::atomic<int64_t> done{0};
-  double read_s = 0;
-  for (int c0 = 0; c0 < st.probe_count_; c0 += st.chunk_) {
-    int pc = std::min(st.chunk_, st.probe_count_ - c0);
-    auto t0 = std::chrono::steady_clock::now();
-    parallel_for(0, pc, [&](int64_t i) {
-      int p = c0 + int(i);
-      std::vector<float> rgb;
-      std::string msg = read_probe_samples(seq, p, t, desc, rgb);
-      if (!msg.empty()) {
-        if (!desc.skip_bad) fail(ErrorKind::Value, "{} (skip_bad skips such probes)", msg);
-        std::lock_guard lk(mu);
-        st.valid_[p] = 0;
-        ++rep.skipped;
-        rep.reasons.push_back(msg);
-      }
-      scatter_probe_samples(t, rgb.data(), pc, int(i), chunk.data());
-      ibl::report(progress, "sort", 0.9 * double(++done) / st.probe_count_);
-    });
-    read_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    for (int k = 0; k < t.blocks(); ++k) {
-      int64_t s0 = t.bucket_begin[t.block_begin[k]], s1 = t.bucket_begin[t.block_begin[k + 1]];
-      FILE* f = std::fopen(block_path(desc.dir, k).c_str(), "ab");
-      size_t n = size_t(pc) * size_t(s1 - s0) * 3;
-      if (!f || std::fwrite(chunk.data() + size_t(pc) * s0 * 3, 2, n, f) != n) {
-        if (f) std::fclose(f);
-        fail(ErrorKind::Io, "{}: write failed (disk full?)", block_path(desc.dir, k));
-      }
+  rep = {};
+  team.agree([&] {
+    std::error_code ec;
+    fs::remove(index, ec);
+    for (int k = plan.block_begin; k < plan.block_end; ++k) {
+      FILE* f = std::fopen(block_path(desc.dir, k).c_str(), "wb");
+      if (!f) fail(ErrorKind::Io, "{}: cannot create bucket block", block_path(desc.dir, k));
       std::fclose(f);
-      rep.bytes_written += int64_t(n) * 2;
     }
+  });
+  st.valid_.assign(size_t(P), 1);
+  std::vector<std::pair<int, std::string>> skips;
+  std::vector<uint16_t> chunk(size_t(plan.chunk) * t.slots() * 3);
+  int64_t done_before = 0;
+  // Block k's share of a chunk g of pcs probes, in segment layout over the slots from slot0 on, goes
+  // to its offset in the block file: segments lie in chunk order.
+  auto write = [&](int g, int pcs, const uint16_t* segment, int64_t slot0) {
+    for (int k = plan.block_begin; k < plan.block_end; ++k) {
+      int64_t s0k = t.bucket_begin[t.block_begin[k]], nk = t.bucket_begin[t.block_begin[k + 1]] - s0k;
+      write_at(block_path(desc.dir, k), segment + size_t(pcs) * size_t(s0k - slot0) * 3, size_t(pcs) * nk * 3,
+               int64_t(g) * plan.chunk * nk * 6);
+      rep.bytes_written += int64_t(pcs) * nk * 6;
+    }
+  };
+  for (int c = 0; c < plan.rounds; ++c) {
+    // Read this process's chunk of the round.
+    auto t0 = std::chrono::steady_clock::now();
+    const int g = plan.chunk_of_round[c], pc = plan.chunk_probes(g, P), p0 = g < 0 ? 0 : g * plan.chunk;
+    int bad_probe = -1;
+    std::string bad_msg;
+    std::mutex mu;
+    std::atomic<int64_t> done{0};
+    team.agree([&] {
+      parallel_for(0, pc, [&](int64_t i) {
+        int p = p0 + int(i);
+        std::vector<float> rgb;
+        std::string msg = read_probe_samples(seq, p, t, desc, rgb);
+        if (!msg.empty()) {
+          std::lock_guard lk(mu);
+          if (!desc.skip_bad) {
+            if (bad_probe < 0 || p < bad_probe) bad_probe = p, bad_msg = msg;
+          } else {
+            st.valid_[p] = 0;
+            skips.push_back({p, msg});
+          }
+        }
+        scatter_probe_samples(t, rgb.data(), pc, int(i), chunk.data());
+        ibl::report(progress, "sort", 0.9 * double(done_before + ++done) / P);
+      });
+      if (bad_probe >= 0) fail(ErrorKind::Value, "{} (skip_bad skips such probes)", bad_msg);
+    });
+    rep.read_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    // Deliver every block's samples to the process that writes it, and write them there.
+    std::string write_error;
+    ErrorKind write_kind = ErrorKind::Io;
+    team.exchange(plan, t, c, chunk.data(), pc, [&](int gs, int pcs, const uint16_t* segment, int64_t slot0) {
+      if (!write_error.empty() || pcs == 0) return;
+      try {
+        write(gs, pcs, segment, slot0);
+      } catch (const Error& e) {
+        write_error = e.what();
+        write_kind = e.kind();
+      }
+    });
+    team.agree([&] {
+      if (!write_error.empty()) throw Error(write_kind, write_error);
+    });
+    int64_t n = pc;
+    team.sum(&n, 1);
+    done_before += n;
   }
-  rep.read_seconds = read_s;
-  if (rep.skipped == st.probe_count_) fail(ErrorKind::Value, "{}: every probe was skipped", seq.manifest);
-  json j = {
-      {"key", key}, {"chunk", st.chunk_}, {"valid", st.valid_},     {"skipped", rep.skipped}, {"reasons", rep.reasons},
-      {"width", w}, {"height", h},        {"buckets", t.buckets()}, {"blocks", t.blocks()}};
-  write_json_file(index.string(), j, -1);
+  // Frames skipped anywhere: every process learns them, in probe order.
+  team.min(st.valid_.data(), P);
+  std::sort(skips.begin(), skips.end());
+  std::vector<std::string> mine;
+  for (auto& s : skips) mine.push_back(s.second);
+  rep.reasons = team.gather(mine);
+  rep.skipped = int(rep.reasons.size());
+  team.agree([&] {
+    if (rep.skipped == P) fail(ErrorKind::Value, "{}: every probe was skipped", seq.manifest);
+  });
+  team.agree([&] {
+    json j = {{"key", key},
+              {"chunk", plan.chunk},
+              {"valid", st.valid_},
+              {"skipped", rep.skipped},
+              {"reasons", rep.reasons},
+              {"first_block", plan.block_begin},
+              {"end_block", plan.block_end},
+              {"width", w},
+              {"height", h},
+              {"buckets", t.buckets()},
+              {"blocks", t.blocks()},
+              {"ranks", team.size()}};
+    write_json_file(index.string(), j, -1);
+  });
   ibl::report(progress, "sort", 1.0);
   return st;
 }

@@ -18,6 +18,8 @@
 
 namespace ibl::ilf {
 
+class Collective;  // collective.h
+
 struct BucketDesc {
   std::string dir;                        // folder for the block files and index.json (created if missing)
   int octahedral = 0;                     // 0: one bucket per probe pixel; n > 0: n×n octahedral direction cells
@@ -64,6 +66,9 @@ class BucketStore {
  public:
   const DirectionTable& table() const { return table_; }
   int probe_count() const { return probe_count_; }
+  // The blocks this process holds: all of them, or its share of a sort split between processes.
+  int block_begin() const { return block_begin_; }
+  int block_end() const { return block_end_; }
   // valid[p]: probe p's frame was read (false: skipped; its samples are zeros and must be ignored).
   const std::vector<uint8_t>& valid() const { return valid_; }
   // Reads block k into buf (half floats).
@@ -72,12 +77,12 @@ class BucketStore {
   // for probe p.
   const uint16_t* samples(const std::vector<uint16_t>& buf, int k, int b, int p) const;
 
+  // Sorts every frame of seq into the block files of desc.dir (reusing those of an identical earlier
+  // run). Split between the processes of a job by `team` (collective.h; none: this process alone):
+  // each writes and then holds its share of the blocks (Collective::plan_sort), and every process
+  // gets the same valid flags and skip reasons.
   static BucketStore sort(const Sequence& seq, const BucketDesc& desc, const ProgressFn& progress = {},
-                          BucketReport* report = nullptr);
-  // A store over block files that another driver wrote in this layout with `chunk` probes per segment
-  // (ilf/mpi/ writes each rank's blocks so); valid as above.
-  static BucketStore open(const std::string& dir, DirectionTable table, int probe_count, int chunk,
-                          std::vector<uint8_t> valid);
+                          BucketReport* report = nullptr, Collective* team = nullptr);
   // The file of block k in folder dir.
   static std::string block_path(const std::string& dir, int k);
 
@@ -85,10 +90,10 @@ class BucketStore {
   std::string dir_;
   DirectionTable table_;
   int probe_count_ = 0, chunk_ = 0;
+  int block_begin_ = 0, block_end_ = 0;
   std::vector<uint8_t> valid_;
 };
 
-// The pieces of BucketStore::sort, for drivers that split the frames between processes (ilf/mpi/):
 // The frame size every probe must have: the first probe whose header reads. Throws the sort's error
 // when that fails for a probe and skip_bad is off, or when no header reads.
 void sequence_frame_size(const Sequence& seq, bool skip_bad, int* width, int* height);
@@ -102,11 +107,11 @@ void scatter_probe_samples(const DirectionTable& t, const float* rgb, int pc, in
 // The key of index.json: the frames (path, size, modification time), mapping and settings.
 std::string bucket_cache_key(const Sequence& seq, const BucketDesc& desc, int width, int height);
 
-// Half-float conversion helpers (IEEE binary16).
 // Removes the bucket cache a sort wrote into `dir` (its block_NNNNN.bin files and index.json), and
 // `dir` itself once nothing else is in it; what else is there stays. Nothing to remove is no error.
 void remove_bucket_cache(const std::string& dir);
 
+// Half-float conversion helpers (IEEE binary16).
 void halves_to_floats(const uint16_t* in, float* out, size_t n);
 void floats_to_halves(const float* in, uint16_t* out, size_t n);
 

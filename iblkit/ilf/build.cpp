@@ -10,6 +10,7 @@
 #include "iblkit/core/check.h"
 #include "iblkit/core/error.h"
 #include "iblkit/core/parallel.h"
+#include "iblkit/ilf/collective.h"
 #include "iblkit/io/image_io.h"
 #include "iblkit/sh/basis.h"
 
@@ -190,31 +191,102 @@ void store_coefficients(const double* C, SHGrid& out) {
       1024);
 }
 
-SHGrid build_shgrid(const Sequence& seq_in, const BuildDesc& desc, const ProgressFn& progress, BuildReport* report) {
+namespace {
+
+// Step 1: the probes kept by sub-sampling, each process computing the energies of its share of the
+// pairs of neighbours.
+Sequence subsample_shared(const Sequence& seq_in, const BuildDesc& desc, const ProgressFn& progress, BuildReport& rep,
+                          Collective& team) {
+  if (!desc.subsample) return seq_in;
+  auto t0 = Clock::now();
+  SubsampleDesc sd = *desc.subsample;
+  sd.skip_bad = sd.skip_bad || desc.buckets.skip_bad;
+  team.agree([&] { check_subsample_desc(sd); });
+  const int n = int(seq_in.probes.size());
+  std::vector<double> e;
+  if (n > 2) {
+    const std::vector<int> begin = split_evenly(n - 1, team.size());
+    std::vector<int> counts(size_t(team.size()));
+    for (int r = 0; r < team.size(); ++r) counts[r] = begin[r + 1] - begin[r];
+    std::vector<double> mine;
+    const int r = team.rank();
+    team.agree(
+        [&] { mine = neighbour_energies(seq_in, sd, begin[r], begin[r + 1], r == 0 ? progress : ProgressFn{}); });
+    e = team.gather(mine, counts);
+  }
+  auto keep = keep_from_energies(n, e, sd.threshold);
+  Sequence seq = seq_in;
+  seq.probes.clear();
+  for (int i : keep) seq.probes.push_back(seq_in.probes[i]);
+  rep.subsampled_out = n - int(keep.size());
+  rep.t_subsample = since(t0);
+  return seq;
+}
+
+}  // namespace
+
+std::vector<DescribedValue> describe_build(const Sequence& seq, const BuildDesc& desc) {
+  const BucketDesc& b = desc.buckets;
+  const ProjectDesc& p = desc.project;
+  std::string volume = desc.volume
+                           ? fmt::format("{},{},{},{},{},{}", desc.volume->min.x, desc.volume->min.y,
+                                         desc.volume->min.z, desc.volume->max.x, desc.volume->max.y, desc.volume->max.z)
+                           : "the sequence's";
+  std::string subsample =
+      desc.subsample ? fmt::format("{} within {} m", desc.subsample->threshold, desc.subsample->max_distance) : "off";
+  // The sequence: its manifest, mapping, frames (path, size, time) and positions.
+  uint64_t hsh = 1469598103934665603ull;
+  auto mix = [&](const std::string& s) {
+    for (unsigned char c : s) hsh = (hsh ^ c) * 1099511628211ull;
+  };
+  mix(bucket_cache_key(seq, BucketDesc{}, 0, 0));
+  for (const auto& pr : seq.probes) mix(fmt::format("{} {} {}", pr.position.x, pr.position.y, pr.position.z));
+  return {{"sequence", fmt::format("{} ({} probes, fingerprint {:016x})", seq.manifest, seq.probes.size(), hsh)},
+          {"grid", fmt::format("{},{},{}{}", desc.nx, desc.ny, desc.nz, desc.auto_grid ? " (auto)" : "")},
+          {"volume", volume},
+          {"bands", std::to_string(desc.bands)},
+          {"kernel", desc.auto_kernel ? "auto" : fmt::format("{}", p.kernel_cells)},
+          {"raster", fmt::format("{}", p.raster_cells)},
+          {"repair", repair_name(p.repair)},
+          {"directions", std::to_string(b.octahedral)},
+          {"block buckets", std::to_string(b.max_block_buckets)},
+          {"memory", std::to_string(b.memory_bytes)},
+          {"buckets", b.dir},
+          {"skip-bad", b.skip_bad ? "on" : "off"},
+          {"sanitize", b.sanitize ? "on" : "off"},
+          {"reuse", b.reuse ? "on" : "off"},
+          {"subsample", subsample},
+          {"cv-folds", std::to_string(desc.crossval.folds)},
+          {"auto buckets", std::to_string(desc.auto_max_buckets)},
+          {"parallax", desc.ball_parallax ? "on" : "off"}};
+}
+
+SHGrid build_shgrid(const Sequence& seq_in, const BuildDesc& desc, const ProgressFn& progress, BuildReport* report,
+                    Collective* team_in) {
+  Collective& team = team_in ? *team_in : serial_collective();
   auto t_all = Clock::now();
   BuildReport local;
   BuildReport& rep = report ? *report : local;
-  GridDesc grid = build_grid(seq_in, desc);
-  SHGrid out(grid, desc.bands);
+  rep = {};
+  const bool root = team.rank() == 0;
+  team.agree_on(describe_build(seq_in, desc));
+  GridDesc grid;
+  SHGrid out;
+  team.agree([&] {
+    grid = build_grid(seq_in, desc);
+    if (root) out = SHGrid(grid, desc.bands);
+  });
   ProjectDesc pd = desc.project;
   rep.probes_in = int(seq_in.probes.size());
-  Sequence seq = seq_in;
-  if (desc.subsample) {
-    auto t0 = Clock::now();
-    SubsampleDesc sd = *desc.subsample;
-    sd.skip_bad = sd.skip_bad || desc.buckets.skip_bad;
-    auto keep = subsample(seq_in, sd, progress);
-    seq.probes.clear();
-    for (int i : keep) seq.probes.push_back(seq_in.probes[i]);
-    rep.subsampled_out = int(seq_in.probes.size() - keep.size());
-    rep.t_subsample = since(t0);
-  }
-  // Sort.
+  Sequence seq = subsample_shared(seq_in, desc, progress, rep, team);
+  // Sort: each process writes its share of the blocks.
   auto t0 = Clock::now();
-  BucketDesc bd = resolve_directions(seq, desc);
+  BucketDesc bd;
+  team.agree([&] { bd = resolve_directions(seq, desc); });
   BucketReport br;
-  BucketStore store = BucketStore::sort(seq, bd, progress, &br);
+  BucketStore store = BucketStore::sort(seq, bd, progress, &br, &team);
   rep.t_sort = since(t0);
+  rep.t_read = br.read_seconds;
   rep.skipped = br.skipped;
   rep.skip_reasons = br.reasons;
   rep.buckets_reused = br.reused;
@@ -226,29 +298,46 @@ SHGrid build_shgrid(const Sequence& seq_in, const BuildDesc& desc, const Progres
   rep.probes_used = P - br.skipped;
   std::vector<Vec3> origins(static_cast<size_t>(P));
   for (int p = 0; p < P; ++p) origins[p] = seq.probes[p].position;
-  cross_validate_build(store, origins, desc, grid, pd, rep);
-  if (grid.nx != out.grid().nx || grid.ny != out.grid().ny || grid.nz != out.grid().nz) out = SHGrid(grid, desc.bands);
+  // The cross-validated choice and error: each process evaluates the sampled buckets of its blocks,
+  // the partial sums meet on every process, and every process makes the same choice.
+  CvShare share{store.block_begin(), store.block_end(), [&](const std::function<void()>& f) { team.agree(f); },
+                [&](double* x, size_t n) { team.sum(x, int64_t(n), true); }};
+  cross_validate_build(store, origins, desc, grid, pd, rep, share);
+  if (root && (grid.nx != out.grid().nx || grid.ny != out.grid().ny || grid.nz != out.grid().nz))
+    out = SHGrid(grid, desc.bands);
   rep.ball_radius = desc.ball_parallax && !t.start.empty() ? seq.ball.radius : 0.0;
-  // Resample, block by block.
+  // Resample this process's blocks, block by block, into partial SH sums.
   int K = desc.bands * desc.bands;
   int64_t G = grid.count(), rows = 3 * G;
-  std::vector<double> C(size_t(rows) * K, 0.0);
-  std::vector<float> R;
-  std::vector<uint16_t> buf;
-  BlockScratch scratch;
+  std::vector<double> C;
   double repair_s = 0, busy_s = 0;
-  for (int k = 0; k < t.blocks(); ++k) {
-    auto w = resample_block(store, k, grid, pd, origins, desc.bands, desc.ball_parallax, buf, R, scratch, C.data());
-    rep.samples += w.stats.rays;
-    rep.uncovered += w.stats.uncovered;
-    repair_s += w.stats.repair_seconds;
-    busy_s += w.stats.busy_seconds;
-    rep.t_project += w.project_seconds;
-    rep.gemm_flops += w.gemm_flops;
-    rep.t_accumulate += w.accumulate_seconds;
-    ibl::report(progress, "resample", double(k + 1) / t.blocks());
-  }
-  store_coefficients(C.data(), out);
+  int64_t counts[2] = {0, 0};  // rays, uncovered
+  team.agree([&] {
+    C.assign(size_t(rows) * K, 0.0);
+    std::vector<float> R;
+    std::vector<uint16_t> buf;
+    BlockScratch scratch;
+    const int k0 = store.block_begin(), k1 = store.block_end();
+    for (int k = k0; k < k1; ++k) {
+      auto w = resample_block(store, k, grid, pd, origins, desc.bands, desc.ball_parallax, buf, R, scratch, C.data());
+      counts[0] += w.stats.rays;
+      counts[1] += w.stats.uncovered;
+      repair_s += w.stats.repair_seconds;
+      busy_s += w.stats.busy_seconds;
+      rep.t_project += w.project_seconds;
+      rep.gemm_flops += w.gemm_flops;
+      rep.t_accumulate += w.accumulate_seconds;
+      if (root) ibl::report(progress, "resample", double(k - k0 + 1) / std::max(k1 - k0, 1));
+    }
+  });
+  // The partial sums meet on process 0, which stores the grid.
+  team.sum(C.data(), rows * K, false);
+  if (root) store_coefficients(C.data(), out);
+  std::vector<double>().swap(C);
+  team.sum(counts, 2);
+  team.sum_figures(&rep.gemm_flops, 1);
+  rep.samples = counts[0];
+  rep.uncovered = counts[1];
   rep.t_repair = busy_s > 0 ? rep.t_project * repair_s / busy_s : 0.0;
   rep.fraction_uncovered = double(rep.uncovered) / (double(G) * t.buckets());
   rep.t_total = since(t_all);

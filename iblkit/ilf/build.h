@@ -11,6 +11,7 @@
 
 #include "iblkit/core/progress.h"
 #include "iblkit/ilf/buckets.h"
+#include "iblkit/ilf/collective.h"
 #include "iblkit/ilf/crossval.h"
 #include "iblkit/ilf/project.h"
 #include "iblkit/ilf/shgrid.h"
@@ -51,6 +52,7 @@ struct BuildReport {
   int64_t uncovered = 0;          // (grid point, bucket) pairs filled by the repair
   double fraction_uncovered = 0;  // uncovered / (grid points · buckets)
   bool buckets_reused = false;    // an earlier run's bucket files were reused
+  double t_read = 0;              // decoding the frames (part of t_sort)
   double t_subsample = 0, t_sort = 0, t_project = 0, t_accumulate = 0, t_total = 0;  // seconds
   double t_repair = 0;                     // the repair's share of t_project (its share of the buckets' thread time)
   double gemm_flops = 0;                   // floating-point operations of the SH matrix products
@@ -72,10 +74,17 @@ double accumulate_block(const float* R, int64_t rows, int D, const float* B, int
 // Basis rows of buckets [b0, b1): B(j, k) = Σ_{q ∈ bucket b0+j} Ω_q·Y_k(ω_q), column-major (D × K).
 std::vector<float> bucket_basis(const DirectionTable& t, int b0, int b1, int bands);
 
+// The build. Split between the processes of a job by `team` (collective.h; none: this process
+// alone): every process calls it with the same arguments, process 0 returns the grid and the others
+// an empty one; `report`'s counts are the job's, its seconds this process's; give `progress` on
+// process 0 (it follows the whole job).
 SHGrid build_shgrid(const Sequence& seq, const BuildDesc& desc, const ProgressFn& progress = {},
-                    BuildReport* report = nullptr);
+                    BuildReport* report = nullptr, Collective* team = nullptr);
+// What the processes of a split build must agree on (Collective::agree_on): every setting of desc and
+// a fingerprint of the sequence (manifest, frames, positions), labelled.
+std::vector<DescribedValue> describe_build(const Sequence& seq, const BuildDesc& desc);
 
-// The phases of build_shgrid, for drivers that split the work between processes (ilf/mpi/):
+// The stages of build_shgrid:
 // checks desc (bands, kernel and the size of its raster) and returns the grid it builds over seq;
 GridDesc build_grid(const Sequence& seq, const BuildDesc& desc);
 // desc.buckets with `auto` directions resolved from the first readable frame header;

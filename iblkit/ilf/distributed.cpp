@@ -23,12 +23,12 @@ bool have_mpi() { return true; }
 bool have_mpi() { return false; }
 #endif
 
-void run_mpi_job(const std::function<void(MpiJob&)>& body) {
+void run_mpi_job(const MpiJobDesc& job, const std::function<void(MpiJob&)>& body) {
   if (!have_mpi())
     fail(ErrorKind::Unsupported,
          "this build has no MPI (install libopenmpi-dev and configure with IBLKIT_WITH_MPI=ON "
          "to build on a cluster; without mpirun the serial build runs)");
-  detail::mpi_driver.get().run(body);
+  detail::mpi_driver.get().run(job, body);
 }
 
 }  // namespace ibl::ilf

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "iblkit/core/error.h"
 #include "iblkit/core/plugin.h"
@@ -66,15 +67,26 @@ bool launched_by_mpi();
 // Whether this build has the distributed build (IBLKIT_WITH_MPI).
 bool have_mpi();
 
-// Initialises MPI (loading the "mpi" plugin), runs body on this rank and finalises MPI. The ranks'
-// thread pools share the node's cores (cores / ranks on the node each). An error any rank raises in
-// body reaches every rank: rank 0 throws it (an AgreedError), the others exit with status 1 without
-// a message, so the job prints it once and never hangs. Fails with Unsupported without MPI.
-void run_mpi_job(const std::function<void(MpiJob&)>& body);
+// What the ranks of a job must agree on before they work together, and how long they wait for each
+// other at that handshake.
+struct MpiJobDesc {
+  std::vector<DescribedValue> description;  // e.g. the command line's options and their values
+  double timeout_s = 60;                    // a rank that has not come by then ends the job (--mpi-timeout)
+};
+
+// Initialises MPI (loading the "mpi" plugin), runs body on this rank and finalises MPI. First the
+// ranks compare job.description (Collective::agree_on): where they differ, every rank ends with the
+// one line that names the first differing value; where a rank does not come within job.timeout_s
+// (it is not iblkit, or never started MPI), the job ends naming that rank (or, while MPI_Init itself
+// waits, saying so). The ranks' thread pools share the node's cores (cores / ranks on the node
+// each). An error any rank raises in body reaches every rank: rank 0 throws it (an AgreedError), the
+// others exit with status 1 without a message, so the job prints it once and never hangs. Fails
+// with Unsupported without MPI.
+void run_mpi_job(const MpiJobDesc& job, const std::function<void(MpiJob&)>& body);
 
 namespace detail {
 struct MpiDriver {
-  void (*run)(const std::function<void(MpiJob&)>& body);
+  void (*run)(const MpiJobDesc& job, const std::function<void(MpiJob&)>& body);
 };
 extern plugin::Provided<MpiDriver> mpi_driver;
 }  // namespace detail

@@ -11,6 +11,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "iblkit/core/json_file.h"
+
 #include "iblkit/core/error.h"
 
 namespace ibl::ilf {
@@ -42,18 +44,7 @@ inline const nlohmann::json& grid_header_field(const nlohmann::json& h, const st
 // "PATH: header field "f" = V is not an integer in [lo, hi]". Found by fuzz_shtree (fuzz/crashes/shtree/).
 inline int64_t grid_header_integer(const nlohmann::json& v, const std::string& path, const char* f, int64_t lo,
                                    int64_t hi) {
-  if (v.is_number_integer() && !v.is_number_unsigned()) {
-    const int64_t i = v.get<int64_t>();
-    if (i >= lo && i <= hi) return i;
-  } else if (v.is_number_unsigned()) {
-    const uint64_t u = v.get<uint64_t>();
-    if (hi >= 0 && u <= static_cast<uint64_t>(hi) && static_cast<int64_t>(u) >= lo) return static_cast<int64_t>(u);
-  } else if (v.is_number_float()) {
-    const double d = v.get<double>();
-    if (std::isfinite(d) && d == std::floor(d) && d >= static_cast<double>(lo) && d <= static_cast<double>(hi))
-      return static_cast<int64_t>(d);
-  }
-  fail(ErrorKind::Format, "{}: header field \"{}\" = {} is not an integer in [{}, {}]", path, f, v.dump(), lo, hi);
+  return json_integer(v, path + ": header", f, lo, hi);
 }
 inline std::vector<int64_t> grid_header_integers(const nlohmann::json& v, const std::string& path, const char* f,
                                                  int64_t lo, int64_t hi) {

@@ -185,26 +185,21 @@ void cross_validate(const CvBucket& cv, const BucketRays& rays, const GridDesc& 
 
 }  // namespace
 
-// Derivation (radiance projection of one bucket, [1] §3.2 done on a plane):
-//   A bucket holds rays R_pq(s) = x_p + s·ω_q (x_p + o_q + s·ω_q when the rays start on a mirror ball, o_q
-//   the reflection point of direction q relative to the ball's centre: everything below with x_p + o_q), q over the
-//   bucket's directions (one in pixel buckets), p over the probes. Let ω_b be the solid-angle-weighted mean of the ω_q
-//   and Π the plane through the volume centre c perpendicular to ω_b, with orthonormal axes (t, u). Ray pq meets Π at
-//     y_pq = x_p + λ·ω_q,  λ = (c − x_p)·ω_b / (ω_q·ω_b),
-//   and a grid point g projects (along ω_b) to (g − c)·(t, u). For parallel rays (ω_q = ω_b) the 2D
-//   distance between the two is exactly the distance from g to the ray, for either sign of s: the
-//   sample is projected through the whole volume in both directions. The estimate is the normalised
-//   Gaussian-weighted mean of the rays passing g within the kernel's support R = kernel·h/2:
-//   ┌─────────────────────────────────────────────────────────────────────────────┐
-//   │ L_b(g) = Σ_pq K(d_pq(g)) L_pq / Σ_pq K(d_pq(g)),  K(d) = exp(−d²/2σ²)·[d < R], σ = R/2 │
-//   └─────────────────────────────────────────────────────────────────────────────┘
-//   Numerator and denominator are splatted onto a raster of Π (pixel Δ = raster_cells·h) and read
-//   back bilinearly at the projected grid points: O(rays·(2R/Δ)² + grid points) per bucket instead of
-//   O(rays·grid points along the ray). For non-parallel rays of an octahedral bucket, the 2D distance
-//   differs from the 3D one by at most |(g − c)·ω_b|·sin∠(ω_q, ω_b).
-ProjectStats project_bucket(const GridDesc& grid, const BucketRays& rays, const ProjectDesc& desc, float* out,
-                            int64_t out_stride, ProjectScratch& sc, const CvBucket* cv) {
-  ProjectStats st;
+namespace {
+
+// The plane of one bucket's projection (derivation below): its frame, the raster over the projected
+// volume plus the kernel's support, and the bucket's mean direction, start offset and solid angle.
+struct BucketPlane {
+  double R = 0, sigma = 0, delta = 0;  // kernel support radius, its σ, the raster's pixel size
+  Vec3 wb, c, ob;                      // mean direction, volume centre, mean ray start offset
+  Frame fr;
+  double lo[2] = {0, 0};  // raster pixel (0, 0) is the plane point lo
+  int W = 0, H = 0;
+  size_t npx = 0;
+  double wsum = 0;  // the bucket's solid angle
+};
+
+BucketPlane bucket_plane(const GridDesc& grid, const BucketRays& rays, const ProjectDesc& desc) {
   Vec3 sp = grid.spacing();
   double h = std::max({sp.x, sp.y, sp.z});
   double R = std::max(desc.kernel_cells, 1e-3) * h / 2, sigma = R / 2, delta = std::max(desc.raster_cells, 0.05) * h;
@@ -231,12 +226,6 @@ ProjectStats project_bucket(const GridDesc& grid, const BucketRays& rays, const 
   hi[1] += R + delta;
   int W = int(std::ceil((hi[0] - lo[0]) / delta)) + 1, H = int(std::ceil((hi[1] - lo[1]) / delta)) + 1;
   size_t npx = size_t(W) * H;
-  sc.num.assign(npx * 3, 0.0f);
-  sc.den.assign(npx, 0.0f);
-  if (cv) {
-    sc.fnum.assign(npx * 3 * cv->n_folds, 0.0f);
-    sc.fden.assign(npx * cv->n_folds, 0.0f);
-  }
   Vec3 ob{0, 0, 0};  // the bucket's mean ray start offset (cross-validation reads there)
   double wsum = 0;
   for (int q = 0; q < rays.n_dirs; ++q) {
@@ -244,6 +233,21 @@ ProjectStats project_bucket(const GridDesc& grid, const BucketRays& rays, const 
     wsum += rays.weights[q];
   }
   if (wsum > 0) ob = ob / wsum;
+  BucketPlane pl{R, sigma, delta, wb, c, ob, fr, {lo[0], lo[1]}, W, H, npx, wsum};
+  return pl;
+}
+
+// Splats every valid probe's rays of the bucket into the plane rasters (num, den; with cv one pair
+// per fold, summed into num, den at the end) and sets cv's own means.
+void splat_rays(const BucketPlane& pl, const BucketRays& rays, const CvBucket* cv, ProjectScratch& sc,
+                ProjectStats& st) {
+  const double R = pl.R, sigma = pl.sigma, delta = pl.delta;
+  const Vec3 wb = pl.wb, c = pl.c, ob = pl.ob;
+  const Frame& fr = pl.fr;
+  const double* lo = pl.lo;
+  const int W = pl.W, H = pl.H;
+  const size_t npx = pl.npx;
+  const double wsum = pl.wsum;
   int rad_px = int(std::ceil(R / delta));
   double inv2s2 = 1.0 / (2 * sigma * sigma), R2 = R * R;
   std::vector<double> dx2(size_t(2 * rad_px + 2));
@@ -307,6 +311,44 @@ ProjectStats project_bucket(const GridDesc& grid, const BucketRays& rays, const 
       for (size_t i = 0; i < npx * 3; ++i) sc.num[i] += fn[i];
       for (size_t i = 0; i < npx; ++i) sc.den[i] += fd[i];
     }
+}
+
+}  // namespace
+
+// Derivation (radiance projection of one bucket, [1] §3.2 done on a plane):
+//   A bucket holds rays R_pq(s) = x_p + s·ω_q (x_p + o_q + s·ω_q when the rays start on a mirror ball, o_q
+//   the reflection point of direction q relative to the ball's centre: everything below with x_p + o_q), q over the
+//   bucket's directions (one in pixel buckets), p over the probes. Let ω_b be the solid-angle-weighted mean of the ω_q
+//   and Π the plane through the volume centre c perpendicular to ω_b, with orthonormal axes (t, u). Ray pq meets Π at
+//     y_pq = x_p + λ·ω_q,  λ = (c − x_p)·ω_b / (ω_q·ω_b),
+//   and a grid point g projects (along ω_b) to (g − c)·(t, u). For parallel rays (ω_q = ω_b) the 2D
+//   distance between the two is exactly the distance from g to the ray, for either sign of s: the
+//   sample is projected through the whole volume in both directions. The estimate is the normalised
+//   Gaussian-weighted mean of the rays passing g within the kernel's support R = kernel·h/2:
+//   ┌─────────────────────────────────────────────────────────────────────────────┐
+//   │ L_b(g) = Σ_pq K(d_pq(g)) L_pq / Σ_pq K(d_pq(g)),  K(d) = exp(−d²/2σ²)·[d < R], σ = R/2 │
+//   └─────────────────────────────────────────────────────────────────────────────┘
+//   Numerator and denominator are splatted onto a raster of Π (pixel Δ = raster_cells·h) and read
+//   back bilinearly at the projected grid points: O(rays·(2R/Δ)² + grid points) per bucket instead of
+//   O(rays·grid points along the ray). For non-parallel rays of an octahedral bucket, the 2D distance
+//   differs from the 3D one by at most |(g − c)·ω_b|·sin∠(ω_q, ω_b).
+ProjectStats project_bucket(const GridDesc& grid, const BucketRays& rays, const ProjectDesc& desc, float* out,
+                            int64_t out_stride, ProjectScratch& sc, const CvBucket* cv) {
+  ProjectStats st;
+  const BucketPlane pl = bucket_plane(grid, rays, desc);
+  const size_t npx = pl.npx;
+  const int W = pl.W, H = pl.H;
+  const Frame& fr = pl.fr;
+  const Vec3 c = pl.c, ob = pl.ob;
+  const double delta = pl.delta;
+  const double* lo = pl.lo;
+  sc.num.assign(npx * 3, 0.0f);
+  sc.den.assign(npx, 0.0f);
+  if (cv) {
+    sc.fnum.assign(npx * 3 * cv->n_folds, 0.0f);
+    sc.fden.assign(npx * cv->n_folds, 0.0f);
+  }
+  splat_rays(pl, rays, cv, sc, st);
   // Raster pixel (xx, yy) is the plane point lo + (xx, yy)·Δ (the splat above evaluates K there).
   bool plane_fill = desc.repair == Repair::PullPush && !cv;
   if (plane_fill) {

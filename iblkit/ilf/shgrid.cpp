@@ -1,4 +1,5 @@
 #include "iblkit/ilf/shgrid.h"
+#include "iblkit/core/input_file.h"
 
 #include <cmath>
 #include <cstring>
@@ -115,6 +116,7 @@ void write_shgrid(const std::string& path, const SHGrid& g) {
 }
 
 SHGrid read_shgrid(const std::string& path, bool any_content) {
+  require_input_file(path, "an SH grid");
   std::ifstream in(path, std::ios::binary);
   if (!in) fail(ErrorKind::Io, "{}: cannot open", path);
   size_t off = 0;
@@ -158,6 +160,10 @@ SHGrid read_shgrid(const std::string& path, bool any_content) {
       fail(ErrorKind::Format,
            "{}: truncated: the header declares {}x{}x{} points of {} bands ({:.0f} data bytes), the file holds {:.0f}",
            path, gd.nx, gd.ny, gd.nz, bands, want, std::max(0.0, file_bytes - double(off)));
+    if (!ec && want < file_bytes - double(off))
+      fail(ErrorKind::Format,
+           "{}: {:.0f} bytes after the data the header declares ({}x{}x{} points of {} bands): refused", path,
+           file_bytes - double(off) - want, gd.nx, gd.ny, gd.nz, bands);
   }
   SHGrid g(gd, bands);
   if (h.contains("content")) {

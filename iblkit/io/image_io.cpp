@@ -1,4 +1,5 @@
 #include "iblkit/io/image_io.h"
+#include "iblkit/core/input_file.h"
 
 #include <algorithm>
 #include <cctype>
@@ -111,9 +112,7 @@ Header read_header(const std::string& path) {
 }  // namespace detail
 
 Image read_image(const std::string& path, const ReadDesc& desc, ReadReport* report) {
-  std::error_code ec;
-  if (!fs::exists(path, ec)) fail(ErrorKind::Io, "{}: no such file", path);
-  if (fs::is_directory(path, ec)) fail(ErrorKind::Io, "{}: is a folder, not an image", path);
+  require_input_file(path, "an image");  // no FIFO, device or folder reaches a codec
   std::optional<detail::Decoded> d = detail::read_own(path);
   if (!d) d = detail::oiio_codec.get().read(path);
   Image& img = d->image;

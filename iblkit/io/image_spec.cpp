@@ -5,15 +5,14 @@
 #include <string>
 
 #include "iblkit/core/error.h"
+#include "iblkit/core/input_file.h"
 #include "iblkit/io/codecs.h"
 #include "iblkit/io/image_io.h"
 
 namespace ibl::io {
 
 ImageSpec read_image_spec(const std::string& path) {
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) fail(ErrorKind::Io, "{}: no such file", path);
-  if (std::filesystem::is_directory(path, ec)) fail(ErrorKind::Io, "{}: is a folder, not an image", path);
+  require_input_file(path, "an image");  // no FIFO, device or folder reaches a codec
   const detail::Header h = detail::read_header(path);
   if (h.width <= 0 || h.height <= 0 || h.channels <= 0)
     fail(ErrorKind::Format, "{}: image has no pixels ({}x{}x{})", path, h.width, h.height, h.channels);

@@ -104,7 +104,8 @@ Dataset read_dataset(const std::string& path) {
       !j["grid"][1].is_number_integer())
     fail(ErrorKind::Format, "{}: field \"grid\" must be [nx, ny] of whole numbers, got {}", path,
          j.contains("grid") ? j["grid"].dump() : "nothing");
-  const int64_t nx = j["grid"][0].get<int64_t>(), ny = j["grid"][1].get<int64_t>();
+  const int64_t nx = json_integer<int64_t>(j["grid"][0], path, "grid"),
+                ny = json_integer<int64_t>(j["grid"][1], path, "grid");
   if (nx < 1 || ny < 1 || nx > 256 || ny > 256)
     fail(ErrorKind::Value, "{}: field \"grid\": {}x{} out of range (1..256)", path, nx, ny);
   ds.nx = static_cast<int>(nx);

@@ -1,4 +1,5 @@
 #include "iblkit/nearfield/ies.h"
+#include "iblkit/core/input_file.h"
 
 #include <cmath>
 #include <fstream>
@@ -141,6 +142,7 @@ IesProfile parse_ies(const std::string& text, const std::string& what) {
 }
 
 IesProfile read_ies(const std::string& path) {
+  require_input_file(path, "an IES profile");
   std::ifstream in(path);
   if (!in) fail(ErrorKind::Io, "{}: no such file or not readable", path);
   std::stringstream ss;

@@ -61,7 +61,7 @@ Coeffs coeffs_from_json(const nlohmann::json& j, const std::string& what) {
     fail(ErrorKind::Format, "{}: \"format\" must be \"iblkit.sh/1\"", what);
   if (!j.contains("bands") || !j["bands"].is_number_integer())
     fail(ErrorKind::Format, "{}: \"bands\" must be an integer", what);
-  int bands = j["bands"].get<int>();
+  int bands = json_integer<int>(j["bands"], what, "bands");  // 2^32 + 3 is refused, not read as 3
   if (bands < 1 || bands > kMaxBands)
     fail(ErrorKind::Value, "{}: \"bands\" must be in 1..{} (got {})", what, kMaxBands, bands);
   if (!j.contains("coefficients") || !j["coefficients"].is_array())

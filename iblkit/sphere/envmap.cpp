@@ -1,6 +1,7 @@
 #include "iblkit/sphere/envmap.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 
 #include "iblkit/core/error.h"
@@ -202,8 +203,10 @@ Image resample(const EnvMap& src, const Mapping& dst, const ResampleDesc& desc) 
     std::vector<int> owner;
   };
   tbb::enumerable_thread_specific<RowBuffers> buffers;
+  std::atomic<int64_t> rows_done{0};
   parallel_for(0, dst.height(), [&](int64_t yy) {
     int y = static_cast<int>(yy);
+    report(desc.progress, "resample", double(rows_done++) / dst.height());
     // Pass 1: the row's sub-sample directions; pass 2: look them all up; pass 3: average.
     RowBuffers& rb = buffers.local();
     std::vector<float>&dx = rb.dx, &dy = rb.dy, &dz = rb.dz;

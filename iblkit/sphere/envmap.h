@@ -3,6 +3,7 @@
 #include <string>
 
 #include "iblkit/core/image.h"
+#include "iblkit/core/progress.h"
 #include "iblkit/core/vec.h"
 #include "iblkit/sphere/mapping.h"
 
@@ -33,6 +34,7 @@ struct ResampleDesc {
   int max_supersampling = 8;         // most sub-samples per axis for one output pixel
   Mat3 rotation = Mat3::identity();  // output direction d looks up the input at rotationᵀ·d
                                      // (i.e. the environment is rotated by `rotation`)
+  ProgressFn progress;               // "resample", by rows done
 };
 
 // Resamples src into mapping dst (any size). Each output pixel averages n×n bilinear sub-samples,
