@@ -30,6 +30,10 @@ namespace ibl::ilf::mpi {
 
 namespace {
 
+// Seconds a rank other than 0 waits after a failed job before it exits on its own (rank 0 reports, exits,
+// and mpirun ends it sooner): long enough for rank 0 to print under any load, short enough not to hang.
+constexpr int kWaitForRootReport = 20;
+
 int64_t peak_rss_bytes() {
   std::ifstream in("/proc/self/status");
   std::string line;
@@ -165,6 +169,10 @@ void run(const MpiJobDesc& desc, const std::function<void(MpiJob&)>& body) {
   MPI_Finalize();
   if (failed) {
     if (team.rank() == 0) throw AgreedError(kind, msg);
+    // Rank 0 reports the agreed error (main prints it) and exits non-zero, and mpirun then ends the
+    // others. A rank that exited non-zero first would make mpirun end the job before rank 0 has printed
+    // (seen under load: the job failed without a line), so the others wait for that, bounded.
+    std::this_thread::sleep_for(std::chrono::seconds(kWaitForRootReport));
     std::exit(1);
   }
 }
