@@ -10,7 +10,7 @@
 #include <fmt/format.h>
 
 #include "cli.h"
-#include "iblkit/augment/camera_io.h"
+#include "iblkit/geometry/camera_io.h"
 #include "iblkit/augment/object.h"
 #include "iblkit/core/atomic_file.h"
 #include "iblkit/core/error.h"
@@ -191,7 +191,7 @@ void run_photograph(const PhotoOpts& o) {
   ibl::lab::Scene scene = ibl::lab::load_scene(o.scene, false);
   ibl::geometry::Camera cam;
   if (!o.camera.empty()) {
-    cam = ibl::augment::read_camera(o.camera);
+    cam = ibl::geometry::read_camera(o.camera);
   } else {
     cam.eye = iblcli::parse_vec3(o.eye, "--eye");
     cam.target = iblcli::parse_vec3(o.target, "--target");
@@ -200,7 +200,7 @@ void run_photograph(const PhotoOpts& o) {
   }
   if (o.camera.empty() || cam.width == 0) cam.width = o.width;
   if (o.camera.empty() || cam.height == 0) cam.height = o.height;
-  ibl::augment::validate_camera(cam, o.camera.empty() ? "the camera" : o.camera);
+  ibl::geometry::validate_camera(cam, o.camera.empty() ? "the camera" : o.camera);
   int object = -1;
   if (!o.object.empty()) {
     const ibl::augment::ObjectDesc od = iblcli::inserted_object(o.object, o.object_size, o.triangles, o.at, o.albedo);
@@ -245,7 +245,7 @@ void run_photograph(const PhotoOpts& o) {
                       {"seconds", secs},
                       {"bounces", vd.render.bounces},
                       {"object_pixels", object_pixels},
-                      {"camera", ibl::augment::camera_to_json(cam)}};
+                      {"camera", ibl::geometry::camera_to_json(cam)}};
   if (!o.mask.empty()) j["mask"] = o.mask;
   iblcli::emit(j, [&] {
     fmt::print("photographed {} ({}x{}, {}x{} rays per pixel, {} bounce{}) in {:.2f} s: {}\n", scene.name, cam.width,

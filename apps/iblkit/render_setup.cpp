@@ -4,7 +4,7 @@
 #ifdef IBLKIT_HAVE_GEOMETRY
 #include <fmt/format.h>
 
-#include "iblkit/augment/camera_io.h"
+#include "iblkit/geometry/camera_io.h"
 #include "iblkit/core/error.h"
 #include "iblkit/io/image_io.h"
 #include "iblkit/render/objects.h"
@@ -81,7 +81,7 @@ ibl::geometry::Camera photo_camera(const PhotoSceneOptions& o, const ibl::Image&
   if (!o.camera.empty()) {
     if (!o.eye.empty() || !o.target.empty())
       ibl::fail(ibl::ErrorKind::Value, "give either --camera or --eye/--target, not both");
-    cam = ibl::augment::read_camera(o.camera);
+    cam = ibl::geometry::read_camera(o.camera);
     if ((cam.width != 0 && cam.width != photo.width()) || (cam.height != 0 && cam.height != photo.height()))
       ibl::fail(ibl::ErrorKind::Value, "{} is {}x{} but the photograph {} is {}x{}", o.camera, cam.width, cam.height,
                 photo_path, photo.width(), photo.height());
@@ -96,7 +96,7 @@ ibl::geometry::Camera photo_camera(const PhotoSceneOptions& o, const ibl::Image&
   }
   cam.width = photo.width();
   cam.height = photo.height();
-  ibl::augment::validate_camera(cam, o.camera.empty() ? "the camera" : o.camera);
+  ibl::geometry::validate_camera(cam, o.camera.empty() ? "the camera" : o.camera);
   return cam;
 }
 

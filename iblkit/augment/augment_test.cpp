@@ -8,7 +8,6 @@
 #include <random>
 #include <vector>
 
-#include "iblkit/augment/camera_io.h"
 #include "iblkit/augment/composite.h"
 #include "iblkit/augment/light.h"
 #include "iblkit/augment/measure.h"
@@ -344,31 +343,6 @@ TEST(AugmentComposite, BadInputFailsWithAClearMessage) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("is inside the proxy"), std::string::npos) << e.what();
   }
-}
-
-TEST(AugmentCamera, JsonRoundTripAndErrors) {
-  geometry::Camera c = top_camera();
-  geometry::Camera back = camera_from_json(camera_to_json(c), "test");
-  EXPECT_EQ(back.eye.y, 3);
-  EXPECT_EQ(back.up.z, -1);
-  EXPECT_EQ(back.fov_y_deg, 60);
-  EXPECT_EQ(back.width, kW);
-  EXPECT_EQ(back.height, kH);
-  auto path = (std::filesystem::temp_directory_path() / "augment_test_camera.json").string();
-  write_camera(path, c, false);
-  geometry::Camera r = read_camera(path);
-  EXPECT_EQ(r.width, 0);  // no size in the file: the photograph's
-  EXPECT_EQ(r.target.x, 0);
-  std::filesystem::remove(path);
-  nlohmann::json j = camera_to_json(c);
-  j["fov_y_deg"] = 190;
-  EXPECT_THROW(camera_from_json(j, "test"), Error);
-  j = camera_to_json(c);
-  j["format"] = "iblkit.sh/1";
-  EXPECT_THROW(camera_from_json(j, "test"), Error);
-  j = camera_to_json(c);
-  j["target"] = j["eye"];
-  EXPECT_THROW(camera_from_json(j, "test"), Error);
 }
 
 TEST(AugmentMeasure, PerfectCompositeHasNoErrorAndShadowErrorIsRelative) {

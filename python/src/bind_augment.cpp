@@ -4,7 +4,7 @@
 
 #include <fmt/format.h>
 
-#include "iblkit/augment/camera_io.h"
+#include "iblkit/geometry/camera_io.h"
 #include "iblkit/augment/composite.h"
 #include "iblkit/augment/light.h"
 #include "iblkit/augment/load.h"
@@ -101,7 +101,7 @@ void init_augment(py::module_& m) {
         ibl::Image ph = to_checked_image(photo, "composite: photo");
         camera.width = ph.width();
         camera.height = ph.height();
-        ag::validate_camera(camera, "composite: camera");
+        ibl::geometry::validate_camera(camera, "composite: camera");
         ibl::Vec3 a = to_vec3(albedo, "composite: albedo");
         ibl::Vec3 lo, hi;
         object.bounds(&lo, &hi);

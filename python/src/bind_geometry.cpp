@@ -5,7 +5,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
-#include "iblkit/augment/camera_io.h"
+#include "iblkit/geometry/camera_io.h"
 #include "iblkit/augment/object.h"
 #include "iblkit/core/check.h"
 #include "iblkit/core/error.h"
@@ -179,7 +179,7 @@ row 0 at the top.)doc")
              c.fov_y_deg = fov_y_deg;
              c.width = width;
              c.height = height;
-             ibl::augment::validate_camera(c, "Camera");
+             ibl::geometry::validate_camera(c, "Camera");
              return c;
            }),
            py::arg("eye") = py::make_tuple(0, 0.3, 1.2), py::arg("target") = py::make_tuple(0, 0, 0),
@@ -237,7 +237,7 @@ row 0 at the top.)doc")
           },
           "Eye → clip 4×4 matrix (GL perspective; row-major here).")
       .def(
-          "to_json", [](const Camera& c) { return ibl::augment::camera_to_json(c).dump(2); },
+          "to_json", [](const Camera& c) { return ibl::geometry::camera_to_json(c).dump(2); },
           "The iblkit.camera/1 text (with the size).")
       .def_static(
           "from_json",
@@ -248,13 +248,13 @@ row 0 at the top.)doc")
             } catch (const nlohmann::json::exception& e) {
               ibl::fail(ibl::ErrorKind::Format, "Camera.from_json: not JSON ({})", e.what());
             }
-            return ibl::augment::camera_from_json(j, "json");
+            return ibl::geometry::camera_from_json(j, "json");
           },
           py::arg("text"), "Parses iblkit.camera/1 text (width and height 0 when absent).")
       .def(
-          "save", [](const Camera& c, const std::string& p) { ibl::augment::write_camera(p, c); }, py::arg("path"),
+          "save", [](const Camera& c, const std::string& p) { ibl::geometry::write_camera(p, c); }, py::arg("path"),
           "Writes an iblkit.camera/1 file.")
-      .def_static("load", &ibl::augment::read_camera, py::arg("path"), "Reads an iblkit.camera/1 file.")
+      .def_static("load", &ibl::geometry::read_camera, py::arg("path"), "Reads an iblkit.camera/1 file.")
       .def("__repr__", [](const Camera& c) {
         return fmt::format("Camera(eye=({:g}, {:g}, {:g}), target=({:g}, {:g}, {:g}), fov_y_deg={:g}, {}x{})", c.eye.x,
                            c.eye.y, c.eye.z, c.target.x, c.target.y, c.target.z, c.fov_y_deg, c.width, c.height);

@@ -4,7 +4,7 @@
 
 #include <fmt/format.h>
 
-#include "iblkit/augment/camera_io.h"
+#include "iblkit/geometry/camera_io.h"
 #include "iblkit/core/check.h"
 #include "iblkit/core/error.h"
 #include "iblkit/geometry/camera.h"
@@ -182,7 +182,7 @@ and the proxy (for load_probe_set). Returns the manifest's path.)doc");
       "photograph",
       [](const Scene& scene, const ibl::geometry::Camera& camera, py::object object, py::handle albedo, int samples,
          int bounces, int area_samples, int env_samples, int seed, bool surface, py::object progress) -> py::object {
-        ibl::augment::validate_camera(camera, "photograph: camera");
+        ibl::geometry::validate_camera(camera, "photograph: camera");
         const Scene* use = &scene;
         Scene with_object;
         if (!object.is_none()) {  // the object goes into a fresh, unbuilt copy of the scene (as the CLI does)

@@ -4,7 +4,7 @@
 
 #include <fmt/format.h>
 
-#include "iblkit/augment/camera_io.h"
+#include "iblkit/geometry/camera_io.h"
 #include "iblkit/core/check.h"
 #include "iblkit/geometry/camera.h"
 #include "iblkit/geometry/mesh.h"
@@ -86,7 +86,7 @@ void init_render(py::module_& m) {
         } else {
           d.camera = camera.cast<ibl::geometry::Camera>();
         }
-        ibl::augment::validate_camera(d.camera, "render: camera");
+        ibl::geometry::validate_camera(d.camera, "render: camera");
         d.background = to_vec3(background, "render: background");
         ibl::geometry::TriMesh object, floor;
         {

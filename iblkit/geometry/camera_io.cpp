@@ -1,17 +1,16 @@
-#include "iblkit/augment/camera_io.h"
+#include "iblkit/geometry/camera_io.h"
 
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 
+#include "iblkit/core/check.h"
 #include "iblkit/core/error.h"
 #include "iblkit/core/json_file.h"
 
-namespace ibl::augment {
+namespace ibl::geometry {
 
 namespace {
-
-constexpr double kMaxCoordinate = 1e6;  // metres: anything larger is a unit mistake
 
 Vec3 vec3_field(const nlohmann::json& j, const char* key, const std::string& what) {
   if (!j.contains(key)) fail(ErrorKind::Format, "{}: \"{}\" is missing", what, key);
@@ -21,15 +20,11 @@ Vec3 vec3_field(const nlohmann::json& j, const char* key, const std::string& wha
   return {a[0].get<double>(), a[1].get<double>(), a[2].get<double>()};
 }
 
-bool finite_point(Vec3 p) {
-  for (int a = 0; a < 3; ++a)
-    if (!std::isfinite(p[a]) || std::abs(p[a]) > kMaxCoordinate) return false;
-  return true;
-}
+bool finite_point(Vec3 p) { return is_finite(p) && in_range(p); }
 
 }  // namespace
 
-void validate_camera(const geometry::Camera& c, const std::string& what) {
+void validate_camera(const Camera& c, const std::string& what) {
   if (!finite_point(c.eye))
     fail(ErrorKind::Value, "{}: eye ({}, {}, {}) is not a finite point within 1e6 m", what, c.eye.x, c.eye.y, c.eye.z);
   if (!finite_point(c.target))
@@ -47,7 +42,7 @@ void validate_camera(const geometry::Camera& c, const std::string& what) {
     fail(ErrorKind::Value, "{}: frame size {}x{} must lie in 1..16384", what, c.width, c.height);
 }
 
-nlohmann::json camera_to_json(const geometry::Camera& c, bool with_size) {
+nlohmann::json camera_to_json(const Camera& c, bool with_size) {
   auto v = [](Vec3 p) { return nlohmann::json::array({p.x, p.y, p.z}); };
   nlohmann::json j = {{"format", "iblkit.camera/1"},
                       {"eye", v(c.eye)},
@@ -61,9 +56,9 @@ nlohmann::json camera_to_json(const geometry::Camera& c, bool with_size) {
   return j;
 }
 
-geometry::Camera camera_from_json(const nlohmann::json& j, const std::string& what) {
+Camera camera_from_json(const nlohmann::json& j, const std::string& what) {
   require_format(j, what, "iblkit.camera/1");
-  geometry::Camera c;
+  Camera c;
   c.eye = vec3_field(j, "eye", what);
   c.target = vec3_field(j, "target", what);
   c.up = j.contains("up") ? vec3_field(j, "up", what) : Vec3{0, 1, 0};
@@ -74,19 +69,19 @@ geometry::Camera camera_from_json(const nlohmann::json& j, const std::string& wh
   for (const char* key : {"width", "height"})
     if (j.contains(key) && !j[key].is_number_integer())
       fail(ErrorKind::Format, "{}: \"{}\" must be an integer", what, key);
-  if (j.contains("width")) c.width = j["width"].get<int>();
-  if (j.contains("height")) c.height = j["height"].get<int>();
-  geometry::Camera check = c;
+  if (j.contains("width")) c.width = json_integer<int>(j["width"], what, "width");
+  if (j.contains("height")) c.height = json_integer<int>(j["height"], what, "height");
+  Camera check = c;
   if (check.width == 0) check.width = 1;
   if (check.height == 0) check.height = 1;
   validate_camera(check, what);
   return c;
 }
 
-geometry::Camera read_camera(const std::string& path) { return camera_from_json(read_json_file(path), path); }
+Camera read_camera(const std::string& path) { return camera_from_json(read_json_file(path), path); }
 
-void write_camera(const std::string& path, const geometry::Camera& cam, bool with_size) {
+void write_camera(const std::string& path, const Camera& cam, bool with_size) {
   write_json_file(path, camera_to_json(cam, with_size));
 }
 
-}  // namespace ibl::augment
+}  // namespace ibl::geometry

@@ -1,4 +1,4 @@
-// iblkit.camera/1: the one pinhole camera (geometry::Camera) as a JSON file (docs/formats.md):
+// iblkit.camera/1: the one pinhole camera (Camera) as a JSON file (docs/formats.md):
 //   {"format":"iblkit.camera/1","eye":[x,y,z],"target":[x,y,z],"up":[0,1,0],"fov_y_deg":40}
 // optionally with "width" and "height" (pixels); the frame's size is otherwise the photograph's.
 #pragma once
@@ -8,16 +8,16 @@
 
 #include "iblkit/geometry/camera.h"
 
-namespace ibl::augment {
+namespace ibl::geometry {
 
 // Checks eye, target and up (finite, |·| ≤ 1e6 m, eye ≠ target, up not parallel to the view),
 // fov_y_deg in (0, 179) and the frame size (1..16384); throws ibl::Error naming `what` and the field.
-void validate_camera(const geometry::Camera& cam, const std::string& what);
+void validate_camera(const Camera& cam, const std::string& what);
 
 // Reads a camera file. Width and height come from the file when it has them, else stay 0.
-geometry::Camera read_camera(const std::string& path);
-void write_camera(const std::string& path, const geometry::Camera& cam, bool with_size = true);
-nlohmann::json camera_to_json(const geometry::Camera& cam, bool with_size = true);
-geometry::Camera camera_from_json(const nlohmann::json& j, const std::string& what);
+Camera read_camera(const std::string& path);
+void write_camera(const std::string& path, const Camera& cam, bool with_size = true);
+nlohmann::json camera_to_json(const Camera& cam, bool with_size = true);
+Camera camera_from_json(const nlohmann::json& j, const std::string& what);
 
-}  // namespace ibl::augment
+}  // namespace ibl::geometry
