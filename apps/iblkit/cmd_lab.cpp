@@ -10,11 +10,11 @@
 #include <fmt/format.h>
 
 #include "cli.h"
-#include "iblkit/geometry/camera_io.h"
 #include "iblkit/augment/object.h"
 #include "iblkit/core/atomic_file.h"
 #include "iblkit/core/error.h"
 #include "iblkit/core/json_file.h"
+#include "iblkit/geometry/camera_io.h"
 #include "iblkit/io/image_io.h"
 #include "iblkit/io/tonemap.h"
 #include "iblkit/lab/capture.h"

@@ -4,8 +4,8 @@
 #ifdef IBLKIT_HAVE_GEOMETRY
 #include <fmt/format.h>
 
-#include "iblkit/geometry/camera_io.h"
 #include "iblkit/core/error.h"
+#include "iblkit/geometry/camera_io.h"
 #include "iblkit/io/image_io.h"
 #include "iblkit/render/objects.h"
 

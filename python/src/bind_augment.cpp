@@ -4,13 +4,13 @@
 
 #include <fmt/format.h>
 
-#include "iblkit/geometry/camera_io.h"
 #include "iblkit/augment/composite.h"
 #include "iblkit/augment/light.h"
 #include "iblkit/augment/load.h"
 #include "iblkit/augment/measure.h"
 #include "iblkit/core/check.h"
 #include "iblkit/fusion/probe_set.h"
+#include "iblkit/geometry/camera_io.h"
 #include "iblkit/geometry/mesh_io.h"
 #include "iblkit/ilf/shgrid.h"
 

@@ -5,11 +5,11 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
-#include "iblkit/geometry/camera_io.h"
 #include "iblkit/augment/object.h"
 #include "iblkit/core/check.h"
 #include "iblkit/core/error.h"
 #include "iblkit/geometry/camera.h"
+#include "iblkit/geometry/camera_io.h"
 #include "iblkit/geometry/mesh.h"
 #include "iblkit/geometry/mesh_io.h"
 

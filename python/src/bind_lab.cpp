@@ -4,10 +4,10 @@
 
 #include <fmt/format.h>
 
-#include "iblkit/geometry/camera_io.h"
 #include "iblkit/core/check.h"
 #include "iblkit/core/error.h"
 #include "iblkit/geometry/camera.h"
+#include "iblkit/geometry/camera_io.h"
 #include "iblkit/lab/capture.h"
 #include "iblkit/lab/scene_io.h"
 #include "iblkit/lab/sequence.h"

@@ -4,9 +4,9 @@
 
 #include <fmt/format.h>
 
-#include "iblkit/geometry/camera_io.h"
 #include "iblkit/core/check.h"
 #include "iblkit/geometry/camera.h"
+#include "iblkit/geometry/camera_io.h"
 #include "iblkit/geometry/mesh.h"
 #include "iblkit/ilf/shgrid.h"
 #include "iblkit/lights/light_set.h"
