@@ -17,6 +17,7 @@
 #include "iblkit/core/error.h"
 #include "iblkit/core/image.h"
 #include "iblkit/core/plugin.h"
+#include "iblkit/io/photo.h"
 
 namespace ibl::io::detail {
 
@@ -87,6 +88,9 @@ struct OiioCodec {
   void (*write)(const std::string& path, const Image& img, bool ldr, bool half);
   // Draws text as io/draw.h's draw_text documents, with the TrueType font at `font`.
   bool (*draw_text)(Image& img, int x, int y, const std::string& text, int size, const char* font, Vec3 rgb);
+  // A photograph's code values and Exif exposure data (io/photo.h), and the writer of one.
+  Photo (*read_photo)(const std::string& path);
+  void (*write_photo)(const std::string& path, const Image& codes, int bits, const PhotoMeta& meta, int quality);
 };
 extern plugin::Provided<OiioCodec> oiio_codec;
 
