@@ -11,7 +11,6 @@
 #include "iblkit/augment/composite.h"
 #include "iblkit/augment/light.h"
 #include "iblkit/augment/measure.h"
-#include "iblkit/augment/object.h"
 #include "iblkit/augment/testing.h"
 #include "iblkit/core/error.h"
 

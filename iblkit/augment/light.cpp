@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include "iblkit/augment/rays.h"
 #include "iblkit/core/error.h"
 #include "iblkit/core/parallel.h"
 #include "iblkit/fusion/fuse.h"
@@ -21,7 +22,6 @@ constexpr double kPowerShare = 0.8;     // sampling: this share by power, the re
                                         // from dim but near patches)
 // A patch's power is its mean RGB radiance × solid angle (not luminance: a red lamp is as much a light as a white one).
 double power_of(Vec3 L) { return (std::max(0.0, L.x) + std::max(0.0, L.y) + std::max(0.0, L.z)) / 3; }
-constexpr double kDepthInFront = 0.98;  // a depth this much shorter than the proxy's hit is a free emitter (a lamp)
 // Normal-conditioned tables (table_for): receivers within 10° of a table's normal use it; the proxy's flat parts
 // are its triangles' normals clustered within that angle, the largest by area first; this many tables at most
 // (both sides of each normal), and no more than kTableEntries entries in all (bounded memory for large maps).
@@ -285,8 +285,7 @@ double LightField::solid_angle_at(size_t i, Vec3 x) const {
 }
 
 long LightField::patch_along(Vec3 x, Vec3 w, const geometry::RayTracer& proxy_tracer) const {
-  constexpr double kRayStart = 1e-4;  // metres, as the composite's secondary rays
-  return patch_along(x, w, proxy_tracer.intersect(x, w, kRayStart));
+  return patch_along(x, w, proxy_tracer.intersect(x, w, kRayEpsilon));
 }
 
 long LightField::patch_along(Vec3 x, Vec3 w, const geometry::Hit& h) const {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "iblkit/augment/rays.h"
 #include "iblkit/core/error.h"
 #include "iblkit/core/parallel.h"
 #include "iblkit/geometry/raytracer.h"
@@ -11,7 +12,6 @@
 namespace ibl::augment {
 
 namespace {
-constexpr double kDepthInFront = 0.98;  // as light.cpp: a depth this much shorter than the proxy's hit is a lamp
 // E(n) = ∫ L max(0, n·ω) dω on a lat-long of 2·size × size normals, summed over the soft texels (`soft`) of the grid
 // gathered into at most 128 × 64 cells: each cell keeps the exact Σ L dω of its texels (a lamp's power stays whole)
 // at their solid-angle-weighted mean direction. No band limit: 3 SH bands misstate the side facing away from a

@@ -5,10 +5,10 @@
 #include <cmath>
 #include <vector>
 
-#include "iblkit/augment/object.h"
 #include "iblkit/augment/sphere_occlusion.h"
 #include "iblkit/augment/split_light.h"
 #include "iblkit/core/error.h"
+#include "iblkit/render/objects.h"
 #include "iblkit/sphere/mapping.h"
 
 namespace ibl::augment {
@@ -42,11 +42,7 @@ TEST(AugmentSphereOcclusion, CapCosineIntegralMatchesQuadratureAcrossTheHorizon)
 }
 
 TEST(AugmentSphereOcclusion, EquivalentSphereOfASphereAndOfAnOpenSquare) {
-  ObjectDesc d;
-  d.kind = "sphere";
-  d.size = 0.4;
-  d.at = {1, 2, 3};
-  OccluderSphere s = equivalent_sphere(make_object(d));
+  OccluderSphere s = equivalent_sphere(render::make_object({"sphere", 0.4, 0, {1, 2, 3}}));
   EXPECT_NEAR(s.radius, 0.2, 0.004);  // the tessellated sphere's volume is a little smaller
   EXPECT_NEAR(s.bound_radius, 0.2, 1e-3);
   EXPECT_NEAR(length(s.centre - Vec3{1, 2, 3}), 0, 1e-6);
@@ -59,10 +55,7 @@ TEST(AugmentSphereOcclusion, FacingIrradianceOfASphereIsTheCosineMeanOfItsHemisp
   // E_c(n) = 1 + n_y on a sphere: the side facing d, weighted by projected area (A max(0, n·d)), has the mean
   // normal (2/3) d, so its mean irradiance is 1 + (2/3) d_y. With the lower half's factor 0 (in a shadow),
   // the side facing straight down receives nothing and the side facing up all of it.
-  ObjectDesc d;
-  d.kind = "sphere";
-  d.size = 0.4;
-  const geometry::TriMesh sphere = make_object(d);
+  const geometry::TriMesh sphere = render::make_object({"sphere", 0.4, 0, {0, 0, 0}});
   Image irr(64, 32, 3);
   const sphere::Mapping ll(sphere::MappingKind::LatLong, 64, 32);
   for (int y = 0; y < 32; ++y)

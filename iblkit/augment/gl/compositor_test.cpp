@@ -10,10 +10,11 @@
 #include <memory>
 
 #include "iblkit/augment/gl/compositor.h"
-#include "iblkit/augment/object.h"
+#include "iblkit/augment/soft_visibility.h"
 #include "iblkit/augment/testing.h"
 #include "iblkit/core/error.h"
 #include "iblkit/render/gl/context.h"
+#include "iblkit/render/objects.h"
 
 namespace ibl::augment::gl {
 namespace {
@@ -83,7 +84,7 @@ TEST(AugmentGl, PixelsTheObjectDoesNotTouchAreThePhotographBitForBit) {
   EXPECT_GT(r.stats.object_pixels, 8);
 
   // No shadows (the pasted baseline): only the object's pixels change.
-  GlCompositeDesc none;
+  CompositeDesc none;
   none.shadows = false;
   auto p = augment::gl::composite(photo, cam, floor, sky({1, 1, 1}, {3000, 3000, 3000}, at), sphere_at(at, 0.3),
                                   {0.7, 0.7, 0.7}, none);
@@ -101,9 +102,7 @@ TEST(AugmentGl, SunUmbraFallsWhereTheCpuReferencePutsIt) {
   CompositeDesc cd;
   cd.bounce_samples = 0;
   auto cpu = augment::composite(photo, top_camera(), floor_mesh(), sun, object, {0.7, 0.7, 0.7}, cd);
-  GlCompositeDesc gd;
-  gd.bounce = false;
-  auto gl = augment::gl::composite(photo, top_camera(), floor_mesh(), sun, object, {0.7, 0.7, 0.7}, gd);
+  auto gl = augment::gl::composite(photo, top_camera(), floor_mesh(), sun, object, {0.7, 0.7, 0.7}, cd);
   // The CPU's umbra (≥ 90 % darker, off the object) against the GL's.
   int both = 0, either = 0;
   for (int y = 0; y < kH; ++y)
@@ -298,15 +297,11 @@ TEST(AugmentGl, SoftVisibilityDarkensTheUndersideAsTheCpuReferenceDoes) {
   const Vec3 at{0, 0.25, 0};
   Image photo = constant_photo(0.4);
   LocalLight light = sky({0.5, 0.5, 0.5}, {3000, 3000, 3000}, at);
-  ObjectDesc od;
-  od.size = 0.4;
-  od.triangles = 4000;
-  od.at = at;
-  geometry::TriMesh object = make_object(od);
+  geometry::TriMesh object = render::make_object({"blob", 0.4, 4000, at});
   const geometry::Camera cam = frame_camera({0, 0.45, 1.4}, at, 25);
   auto cpu = cpu_reference(photo, cam, light, object, render::Material{{0.7, 0.7, 0.7}, {0, 0, 0}});
-  GlCompositeDesc with, without;
-  without.visibility_samples = 0;
+  CompositeDesc with, without;
+  without.gl.visibility_samples = 0;
   auto gl = augment::gl::composite(photo, cam, floor_mesh(), light, object, {0.7, 0.7, 0.7}, with);
   auto gl0 = augment::gl::composite(photo, cam, floor_mesh(), light, object, {0.7, 0.7, 0.7}, without);
   const double py = kH / 2.0;  // the blob's centre is the camera's target: the frame's centre row
