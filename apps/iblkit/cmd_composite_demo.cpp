@@ -121,7 +121,7 @@ nlohmann::json real_case(iblcli::DemoContext& ctx, const fs::path& dir) {
   constexpr double kProbeHeight = 1.2;  // metres: the probe above its floor (the file does not say; a tripod's height)
   ibl::sphere::EnvMap env = ibl::io::read_envmap(ctx.probe);
   ibl::sphere::Mapping ll(ibl::sphere::MappingKind::LatLong, 256, 128);
-  ibl::augment::LocalLight light;
+  ibl::augment::LocalRadiance light;
   light.map = ibl::sphere::EnvMap(ibl::sphere::resample(env, ll), ll);
   light.centre = {0, kProbeHeight, 0};
   light.source = "probe " + fs::path(ctx.probe).filename().string();

@@ -9,7 +9,7 @@
 namespace ibl::augment {
 
 AlbedoEstimate estimate_albedo(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy,
-                               const LocalLight& light, int samples, uint64_t seed) {
+                               const LocalRadiance& light, int samples, uint64_t seed) {
   if (photo.channels() < 3)
     fail(ErrorKind::Value, "the photograph has {} channels; an RGB image is needed", photo.channels());
   if (photo.width() != cam.width || photo.height() != cam.height)

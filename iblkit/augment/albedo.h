@@ -22,6 +22,6 @@ struct AlbedoEstimate {
 
 // photo: RGB, cam's size. Throws ibl::Error on sizes that disagree or samples < 1.
 AlbedoEstimate estimate_albedo(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy,
-                               const LocalLight& light, int samples = 64, uint64_t seed = 1);
+                               const LocalRadiance& light, int samples = 64, uint64_t seed = 1);
 
 }  // namespace ibl::augment

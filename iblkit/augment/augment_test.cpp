@@ -41,8 +41,8 @@ std::pair<int, int> pixel_of(double x, double z) {
 
 geometry::TriMesh floor_mesh() { return geometry::make_quad({0, 0, 0}, {0, 1, 0}, {0, 0, -1}, 6, 6); }
 
-LocalLight constant_sky(Vec3 L, Vec3 centre) {
-  LocalLight l;
+LocalRadiance constant_sky(Vec3 L, Vec3 centre) {
+  LocalRadiance l;
   Image img(64, 32, 3);
   for (int y = 0; y < 32; ++y)
     for (int x = 0; x < 64; ++x) img.set_rgb(x, y, L);
@@ -105,7 +105,7 @@ TEST(AugmentLight, AFloorsTableLeavesOutWhatItCannotSeeAndStaysUnbiased) {
   // horizon, and its estimate of E must have the exact sum over the patches as its expectation, with less
   // spread than the plain table's (which spends a quarter of its samples on the floor). The guided search
   // must find the patch a search of the whole CDF finds.
-  LocalLight l;
+  LocalRadiance l;
   Image img(64, 32, 3);
   for (int y = 0; y < 32; ++y)
     for (int x = 0; x < 64; ++x) img.set_rgb(x, y, y < 16 ? Vec3{1, 1, 1} : Vec3{0.5, 0.5, 0.5});
@@ -175,7 +175,7 @@ TEST(AugmentLight, AFloorsTableLeavesOutWhatItCannotSeeAndStaysUnbiased) {
 }
 
 TEST(AugmentComposite, SunCastsAFullShadowAndLeavesTheSunlitFloorAlone) {
-  LocalLight sun;
+  LocalRadiance sun;
   Image img(64, 32, 3);
   img.set_rgb(20, 8, {5000, 5000, 5000});  // one texel ≈ 48° from the zenith
   sun.map = sphere::EnvMap(img, sphere::Mapping(sphere::MappingKind::LatLong, 64, 32));

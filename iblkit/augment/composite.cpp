@@ -165,7 +165,7 @@ void check_inputs(const Image& photo, const geometry::Camera& cam, const geometr
 }  // namespace
 
 CompositeResult composite(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy,
-                          const LocalLight& light, const geometry::TriMesh& object, const render::Material& material,
+                          const LocalRadiance& light, const geometry::TriMesh& object, const render::Material& material,
                           const CompositeDesc& desc) {
   auto t0 = std::chrono::steady_clock::now();
   check_inputs(photo, cam, proxy, object, material, desc);

@@ -99,11 +99,11 @@ struct CompositeResult {
 // of weight `specular` and exponent `exponent` (render::glossy_lobe) lit by the same patch samples. The
 // object's light on the proxy carries its diffuse part (the glossy part, seen from the proxy, is left out).
 CompositeResult composite(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy,
-                          const LocalLight& light, const geometry::TriMesh& object, const render::Material& material,
+                          const LocalRadiance& light, const geometry::TriMesh& object, const render::Material& material,
                           const CompositeDesc& desc = {});
 // A Lambertian object of albedo `albedo`.
 inline CompositeResult composite(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy,
-                                 const LocalLight& light, const geometry::TriMesh& object, Vec3 albedo,
+                                 const LocalRadiance& light, const geometry::TriMesh& object, Vec3 albedo,
                                  const CompositeDesc& desc = {}) {
   return composite(photo, cam, proxy, light, object, render::Material{albedo, {0, 0, 0}}, desc);
 }

@@ -32,9 +32,9 @@ constexpr double kConditionedShare = 0.7;  // a table's share for what its norma
 
 }  // namespace
 
-LocalLight light_from_grid(const ilf::SHGrid& grid, Vec3 at, int size) {
+LocalRadiance light_from_grid(const ilf::SHGrid& grid, Vec3 at, int size) {
   if (size < 4 || size > 4096) fail(ErrorKind::Value, "light map size {} must lie in 4..4096", size);
-  LocalLight l;
+  LocalRadiance l;
   l.map = sphere::EnvMap(Image(2 * size, size, 3), sphere::Mapping(sphere::MappingKind::LatLong, 2 * size, size));
   l.centre = at;
   // A radiance map from band-limited coefficients rings: a bright lamp's few bands swing negative around it.
@@ -68,24 +68,24 @@ LocalLight light_from_grid(const ilf::SHGrid& grid, Vec3 at, int size) {
   return l;
 }
 
-LocalLight light_from_probes(const fusion::ProbeSet& set, Vec3 at, int size) {
+LocalRadiance light_from_probes(const fusion::ProbeSet& set, Vec3 at, int size) {
   fusion::FuseDesc d;
   d.size = size;
   fusion::LocalMap m = fusion::fuse(set, at, d);
-  LocalLight l;
+  LocalRadiance l;
   l.map = std::move(m.radiance);
   l.centre = at;
   l.source = "fused probes";
   return l;
 }
 
-LocalLight as_median_cut(const LocalLight& light, int count) {
+LocalRadiance as_median_cut(const LocalRadiance& light, int count) {
   if (light.map.mapping.kind() != sphere::MappingKind::LatLong)
     fail(ErrorKind::Value, "median-cut baseline: the {} map is not lat-long", light.source);
   lights::CutDesc cd;
   cd.count = count;
   lights::LightSet set = lights::median_cut(light.map, cd);
-  LocalLight out = light;
+  LocalRadiance out = light;
   out.source = fmt::format("{} as {} median-cut lights", light.source, set.lights.size());
   const int W = light.map.image.width(), H = light.map.image.height();
   out.map.image = Image(W, H, 3);
@@ -101,7 +101,7 @@ LocalLight as_median_cut(const LocalLight& light, int count) {
   return out;
 }
 
-LightField::LightField(const LocalLight& light, const geometry::TriMesh& proxy,
+LightField::LightField(const LocalRadiance& light, const geometry::TriMesh& proxy,
                        const geometry::RayTracer& proxy_tracer) {
   const Image& img = light.map.image;
   const sphere::Mapping& mp = light.map.mapping;

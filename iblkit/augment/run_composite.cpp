@@ -41,8 +41,9 @@ bool gl_backend_available(std::string* why) {
   if (why) *why = "iblkit was built without OpenGL (IBLKIT_WITH_GL)";
   return false;
 }
-CompositeResult gl_backend_composite(const Image&, const geometry::Camera&, const geometry::TriMesh&, const LocalLight&,
-                                     const geometry::TriMesh&, const render::Material&, const CompositeDesc&) {
+CompositeResult gl_backend_composite(const Image&, const geometry::Camera&, const geometry::TriMesh&,
+                                     const LocalRadiance&, const geometry::TriMesh&, const render::Material&,
+                                     const CompositeDesc&) {
   fail(ErrorKind::Unsupported, "the GL backend: iblkit was built without OpenGL (IBLKIT_WITH_GL)");
 }
 #endif

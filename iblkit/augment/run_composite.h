@@ -48,13 +48,13 @@ CompositeScene prepare_composite(const CompositeJob& job);
 struct CompositeRun {
   CompositeResult result;          // its warnings begin with the light's
   Backend backend = Backend::Cpu;  // the one that ran (Auto resolved)
-  std::string light_source;        // LocalLight::source
+  std::string light_source;        // LocalRadiance::source
   std::vector<std::string> notes;  // what the caller may tell the user (the backend auto chose)
 };
 // `photo` (linear RGB) seen by `cam` (its size the photograph's). Throws ibl::Error on bad input, and
 // (ErrorKind::Unsupported) for Backend::Gl when iblkit has no OpenGL or no context can be made.
 CompositeRun run_composite(const Image& photo, const geometry::Camera& cam, const CompositeJob& job);
-// The same with the scene already in memory (Python's LocalLight and TriMesh); job.object, job.light and
+// The same with the scene already in memory (Python's LocalRadiance and TriMesh); job.object, job.light and
 // job.median_cut are not read.
 CompositeRun run_composite(const Image& photo, const geometry::Camera& cam, const CompositeJob& job,
                            const CompositeScene& scene);
@@ -63,7 +63,7 @@ CompositeRun run_composite(const Image& photo, const geometry::Camera& cam, cons
 // a context can be made (why not, when not), and its composite (gl::composite).
 bool gl_backend_available(std::string* why);
 CompositeResult gl_backend_composite(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy,
-                                     const LocalLight& light, const geometry::TriMesh& object,
+                                     const LocalRadiance& light, const geometry::TriMesh& object,
                                      const render::Material& material, const CompositeDesc& desc);
 
 }  // namespace ibl::augment

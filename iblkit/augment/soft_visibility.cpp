@@ -16,7 +16,7 @@ constexpr double kMaxSoftFactor = 16;  // the clamp of f (soft_visibility.h)
 constexpr int kMaxPoolRings = 3;
 }  // namespace
 
-std::vector<Vec3> soft_visibility(const LocalLight& light, const geometry::TriMesh& proxy,
+std::vector<Vec3> soft_visibility(const LocalRadiance& light, const geometry::TriMesh& proxy,
                                   const geometry::TriMesh& object, const SoftVisibilityDesc& desc) {
   if (desc.samples < 1 || desc.samples > 65536)
     fail(ErrorKind::Value, "soft visibility samples {} must lie in 1..65536", desc.samples);

@@ -35,7 +35,7 @@ struct SoftVisibilityDesc {
   int shadow_cone = 64;     // as CompositeDesc::bounce_samples
   uint64_t seed = 1;
 };
-std::vector<Vec3> soft_visibility(const LocalLight& light, const geometry::TriMesh& proxy,
+std::vector<Vec3> soft_visibility(const LocalRadiance& light, const geometry::TriMesh& proxy,
                                   const geometry::TriMesh& object, const SoftVisibilityDesc& desc = {});
 
 }  // namespace ibl::augment

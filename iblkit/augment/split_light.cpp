@@ -52,7 +52,7 @@ Vec3 HardLight::at(Vec3 centre, Vec3 x, Vec3 n) const {
   return irradiance * (dot(c, c) / r2 * std::max(0.0, dot(n, v) / std::sqrt(r2)));
 }
 
-SplitLight split_light(const LocalLight& light, const geometry::TriMesh& proxy, const SplitDesc& desc) {
+SplitLight split_light(const LocalRadiance& light, const geometry::TriMesh& proxy, const SplitDesc& desc) {
   if (desc.lights < 0 || desc.lights > 256) fail(ErrorKind::Value, "hard lights {} must lie in 0..256", desc.lights);
   if (!(desc.threshold >= 0) || !std::isfinite(desc.threshold))
     fail(ErrorKind::Value, "hard-light threshold {} must be ≥ 0", desc.threshold);

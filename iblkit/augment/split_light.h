@@ -45,6 +45,6 @@ struct SplitLight {
 
 // `proxy` places the lights (the map's own depth map, where it has one, places lamps in front of it).
 // Throws ibl::Error on a bad description or a map without light.
-SplitLight split_light(const LocalLight& light, const geometry::TriMesh& proxy, const SplitDesc& desc = {});
+SplitLight split_light(const LocalRadiance& light, const geometry::TriMesh& proxy, const SplitDesc& desc = {});
 
 }  // namespace ibl::augment

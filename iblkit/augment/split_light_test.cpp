@@ -81,13 +81,13 @@ TEST(AugmentSphereOcclusion, FacingIrradianceOfASphereIsTheCosineMeanOfItsHemisp
   EXPECT_THROW(facing_irradiance(sphere, &lit, Image(10, 10, 3)), Error);
 }
 
-LocalLight sky_and_sun(Vec3 centre) {
+LocalRadiance sky_and_sun(Vec3 centre) {
   Image img(64, 32, 3);
   for (int y = 0; y < 32; ++y)
     for (int x = 0; x < 64; ++x) img.set_rgb(x, y, y < 16 ? Vec3{0.5, 0.6, 1.0} : Vec3{0.2, 0.2, 0.2});
   img.set_rgb(20, 6, {3000, 2800, 2500});
   img.set_rgb(21, 6, {3000, 2800, 2500});
-  LocalLight l;
+  LocalRadiance l;
   l.map = sphere::EnvMap(img, sphere::Mapping(sphere::MappingKind::LatLong, 64, 32));
   l.centre = centre;
   l.source = "test sky";
@@ -95,7 +95,7 @@ LocalLight sky_and_sun(Vec3 centre) {
 }
 
 TEST(AugmentSplit, HardLightsAndSoftMapHoldAllOfTheMapsPowerAndSitWhereTheProxyIs) {
-  LocalLight l = sky_and_sun({0, 0.5, 0});
+  LocalRadiance l = sky_and_sun({0, 0.5, 0});
   std::vector<double> total = l.map.integral();
   geometry::TriMesh floor = geometry::make_quad({0, 0, 0}, {0, 1, 0}, {0, 0, -1}, 6, 6);
   SplitLight s = split_light(l, floor);
@@ -147,7 +147,7 @@ TEST(AugmentSplit, SoftIrradianceIsTheCosineSumOfTheSoftTexels) {
   // With nothing hard (threshold 0), E(n) on every normal of the irradiance map is Σ L dω max(0, n·ω) over the
   // map's texels, the sun's two included: against that sum done here texel by texel, within the cells' spread
   // (a 64 × 32 map is its own cells: exact but for float rounding).
-  LocalLight l = sky_and_sun({0, 0.5, 0});
+  LocalRadiance l = sky_and_sun({0, 0.5, 0});
   geometry::TriMesh floor = geometry::make_quad({0, 0, 0}, {0, 1, 0}, {0, 0, -1}, 6, 6);
   SplitDesc all_soft;
   all_soft.threshold = 0;

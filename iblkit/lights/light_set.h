@@ -2,7 +2,7 @@
 // the lat-long grid the methods work on, shadow-map ranking and minimum-separation merging.
 //
 // A directional light is (direction towards the light, irradiance it delivers at normal incidence);
-// its radiance is irradiance / solid angle (DESIGN.md).
+// its radiance is irradiance / solid angle (docs/conventions.md, "Directional lights").
 //
 // References
 //  [1] Debevec, "A median cut algorithm for light probe sampling", SIGGRAPH 2005 poster.

@@ -1,5 +1,5 @@
 // augment/: compositing a virtual object into a photograph (differential rendering), as
-// `iblkit composite`; the captured light (LocalLight) from files, an SH grid or fused probes.
+// `iblkit composite`; the captured light (LocalRadiance) from files, an SH grid or fused probes.
 #include "common.h"
 
 #include <fmt/format.h>
@@ -25,21 +25,21 @@ namespace ag = ibl::augment;
 }  // namespace
 
 void init_augment(py::module_& m) {
-  py::class_<ag::LocalLight>(
-      m, "LocalLight",
+  py::class_<ag::LocalRadiance>(
+      m, "LocalRadiance",
       "The captured light of a local scene as a composite uses it: a lat-long radiance map seen from `centre`.")
       .def(py::init([](py::handle map, py::handle centre, py::object depth) {
-             ag::LocalLight l;
-             ibl::Image img = to_checked_image(map, "LocalLight: map");
+             ag::LocalRadiance l;
+             ibl::Image img = to_checked_image(map, "LocalRadiance: map");
              ibl::sphere::Mapping mp = mapping_of("latlong", img.width(), img.height());
              l.map = ibl::sphere::EnvMap(std::move(img), mp);
-             l.centre = to_vec3(centre, "LocalLight: centre");
-             ibl::require_point("LocalLight: centre", l.centre);
+             l.centre = to_vec3(centre, "LocalRadiance: centre");
+             ibl::require_point("LocalRadiance: centre", l.centre);
              if (!depth.is_none()) {
-               l.depth = to_image(depth, "LocalLight: depth");
+               l.depth = to_image(depth, "LocalRadiance: depth");
                if (l.depth.width() != l.map.image.width() || l.depth.height() != l.map.image.height() ||
                    l.depth.channels() != 1)
-                 throw py::value_error("LocalLight: depth must be (H, W) of the map's size");
+                 throw py::value_error("LocalRadiance: depth must be (H, W) of the map's size");
              }
              l.source = "probe";
              return l;
@@ -63,9 +63,11 @@ void init_augment(py::module_& m) {
       .def("as_median_cut", &ag::as_median_cut, py::arg("count"),
            "The baseline of `count` median-cut lights, each in one texel.")
       .def_property_readonly(
-          "map", [](const ag::LocalLight& l) { return to_array(l.map.image); }, "(H, 2H, 3) lat-long radiance.")
-      .def_property_readonly("centre", [](const ag::LocalLight& l) { return vec3_tuple(l.centre); })
-      .def_readonly("source", &ag::LocalLight::source);
+          "map", [](const ag::LocalRadiance& l) { return to_array(l.map.image); }, "(H, 2H, 3) lat-long radiance.")
+      .def_property_readonly("centre", [](const ag::LocalRadiance& l) { return vec3_tuple(l.centre); })
+      .def_readonly("source", &ag::LocalRadiance::source);
+
+  m.attr("LocalLight") = m.attr("LocalRadiance");  // the name before 2026-12 (kept for old scripts)
 
   py::class_<ag::CompositeResult>(m, "CompositeResult", "The composite and its layers (float32 arrays) and statistics.")
       .def_property_readonly(
@@ -124,9 +126,10 @@ void init_augment(py::module_& m) {
         d.gl.visibility_samples = gl_visibility;
         ag::CompositeScene scene;
         scene.object = object;
-        if (!light.is_none() && py::isinstance<ag::LocalLight>(light)) {
-          scene.light.light = light.cast<ag::LocalLight>();
-          if (proxy.is_none()) throw py::value_error("composite: a LocalLight needs proxy= (a TriMesh or a mesh file)");
+        if (!light.is_none() && py::isinstance<ag::LocalRadiance>(light)) {
+          scene.light.light = light.cast<ag::LocalRadiance>();
+          if (proxy.is_none())
+            throw py::value_error("composite: a LocalRadiance needs proxy= (a TriMesh or a mesh file)");
           scene.light.proxy = py::isinstance<py::str>(proxy) ? ibl::geometry::read_mesh(proxy.cast<std::string>())
                                                              : proxy.cast<ibl::geometry::TriMesh>();
           if (median_cut > 0) scene.light.light = ag::as_median_cut(scene.light.light, median_cut);
@@ -168,7 +171,7 @@ void init_augment(py::module_& m) {
 with the composite, mask, difference, albedo and render layers.
 
 The captured light, as the CLI takes it: probes= an iblkit.probes/1 manifest; or light= an SH grid
-(.shgrid) or a probe image file (with at_probe=) and proxy= a mesh file; or light= a LocalLight with
+(.shgrid) or a probe image file (with at_probe=) and proxy= a mesh file; or light= a LocalRadiance with
 proxy= a TriMesh or mesh file. median_cut > 0: the N-light baseline. Sampling: light_samples,
 object_samples, bounce_samples (0: no bounce), triangle_samples, pixel_samples, seed; shadows=False
 pastes the object without its shadow. backend= "cpu" (the ray-traced reference), "gl" (OpenGL: shadow

@@ -18,7 +18,7 @@
 namespace ibl::augment::gl {
 
 CompositeResult composite(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy,
-                          const LocalLight& light, const geometry::TriMesh& object, const render::Material& material,
+                          const LocalRadiance& light, const geometry::TriMesh& object, const render::Material& material,
                           const CompositeDesc& desc, GlFrameTiming* timing) {
   auto t0 = std::chrono::steady_clock::now();
   if (desc.gl.visibility_samples < -1 || desc.gl.visibility_samples > 65536)
@@ -85,7 +85,7 @@ namespace ibl::augment {
 bool gl_backend_available(std::string* why) { return render::gl::available(why); }
 
 CompositeResult gl_backend_composite(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy,
-                                     const LocalLight& light, const geometry::TriMesh& object,
+                                     const LocalRadiance& light, const geometry::TriMesh& object,
                                      const render::Material& material, const CompositeDesc& desc) {
   return gl::composite(photo, cam, proxy, light, object, material, desc);
 }

@@ -85,11 +85,11 @@ class Compositor {
 // options; the sampling counts of the CPU path other than light_samples are not used. Throws ibl::Error (kind
 // Unsupported) when no GL context can be had, and as composite() does on bad input.
 CompositeResult composite(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy,
-                          const LocalLight& light, const geometry::TriMesh& object, const render::Material& material,
+                          const LocalRadiance& light, const geometry::TriMesh& object, const render::Material& material,
                           const CompositeDesc& desc = {}, GlFrameTiming* timing = nullptr);
 // A Lambertian object of albedo `albedo`.
 inline CompositeResult composite(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy,
-                                 const LocalLight& light, const geometry::TriMesh& object, Vec3 albedo,
+                                 const LocalRadiance& light, const geometry::TriMesh& object, Vec3 albedo,
                                  const CompositeDesc& desc = {}, GlFrameTiming* timing = nullptr) {
   return composite(photo, cam, proxy, light, object, render::Material{albedo, {0, 0, 0}}, desc, timing);
 }
