@@ -13,6 +13,7 @@
 #include "iblkit/augment/measure.h"
 #include "iblkit/augment/testing.h"
 #include "iblkit/core/error.h"
+#include "iblkit/render/objects.h"
 
 namespace ibl::augment {
 namespace {
@@ -342,6 +343,24 @@ TEST(AugmentComposite, BadInputFailsWithAClearMessage) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("is inside the proxy"), std::string::npos) << e.what();
   }
+}
+
+TEST(AugmentComposite, AnObjectRestingOnTheFloorIsAccepted) {
+  // The most common placement: a sphere whose lowest vertex lies on the floor, and a blob moved so that
+  // its lowest point does. Touching is not intersecting; sinking 1 cm into the floor is.
+  Image photo = constant_photo(kFloorAlbedo);
+  auto sky = constant_sky({1, 1, 1}, {0, 0.5, 0});
+  CompositeDesc d;
+  d.light_samples = d.object_samples = 4;
+  d.bounce_samples = 0;
+  EXPECT_NO_THROW(composite(photo, top_camera(), floor_mesh(), sky, sphere_at({0, 0.2, 0}, 0.4), {0.5, 0.5, 0.5}, d));
+  geometry::TriMesh blob = render::make_object({"blob", 0.3, 2000, {0, 0, 0}});
+  Vec3 lo, hi;
+  blob.bounds(&lo, &hi);
+  blob.transform(1.0, {0, -lo.y, 0});
+  EXPECT_NO_THROW(composite(photo, top_camera(), floor_mesh(), sky, blob, {0.5, 0.5, 0.5}, d));
+  blob.transform(1.0, {0, -0.01, 0});
+  EXPECT_THROW(composite(photo, top_camera(), floor_mesh(), sky, blob, {0.5, 0.5, 0.5}, d), Error);
 }
 
 TEST(AugmentMeasure, PerfectCompositeHasNoErrorAndShadowErrorIsRelative) {
