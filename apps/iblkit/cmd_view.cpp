@@ -422,7 +422,7 @@ void run_composite(const ViewOpts& o, const ibl::io::EnvReadDesc& rd) {
     bool software = renderer_name.find("llvmpipe") != std::string::npos;
     glfwSetWindowTitle(win, fmt::format("iblkit view — composite {} — {} {:.2f} ms/frame, {} hard lights",
                                         std::filesystem::path(o.photo).filename().string(), software ? "wall" : "GPU",
-                                        software ? ms : t.gpu_ms, split.hard.size())
+                                        software ? ms : t.gpu_ms, split.hard.lights.size())
                                 .c_str());
     glfwPollEvents();
   }
@@ -435,7 +435,7 @@ void run_composite(const ViewOpts& o, const ibl::io::EnvReadDesc& rd) {
                 {"gl_renderer", renderer_name},
                 {"screenshot", o.screenshot},
                 {"mode", "composite"},
-                {"hard_lights", split.hard.size()}},
+                {"hard_lights", split.hard.lights.size()}},
                [&] {
                  fmt::print(
                      "{} composite frames, {:.1f} ms per frame (shadow maps, differential render, display) on {}\n",

@@ -254,13 +254,15 @@ struct Compositor::Impl {
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
     for (int l = 0; l < lights; ++l) {
-      const HardLight& h = light.hard[static_cast<size_t>(l)];
+      const lights::Light& h = light.hard.lights[static_cast<size_t>(l)];
+      const bool distant = !h.position;
+      const Vec3 position = h.position.value_or(Vec3{});
       geometry::Camera lc;
       lc.width = lc.height = 1;
       Mat4f vp;
       float eye_w;
       Vec3 dir = h.direction;
-      if (h.distant) {
+      if (distant) {
         lc.eye = c + dir * reach;
         lc.target = c;
         lc.up = std::abs(dir.y) > 0.99 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
@@ -272,7 +274,7 @@ struct Compositor::Impl {
         vp = geometry::mul(p, lc.view());
         eye_w = static_cast<float>(2 * R / S);
       } else {
-        lc.eye = h.position + (light.centre - h.position) * 0.01;  // off the proxy surface the light sits on
+        lc.eye = position + (light.centre - position) * 0.01;  // off the proxy surface the light sits on
         double D = length(c - lc.eye);
         lc.target = c;
         Vec3 to = (c - lc.eye) / std::max(D, 1e-12);
@@ -291,11 +293,11 @@ struct Compositor::Impl {
       const std::string i = fmt::format("[{}]", l);
       for (GLuint prog : {prog_proxy, prog_object}) {
         glProgramUniform4f(prog, glGetUniformLocation(prog, ("u_light_dir" + i).c_str()), static_cast<float>(dir.x),
-                           static_cast<float>(dir.y), static_cast<float>(dir.z), h.distant ? 0.0f : 1.0f);
-        Vec3 off = h.position - light.centre;
+                           static_cast<float>(dir.y), static_cast<float>(dir.z), distant ? 0.0f : 1.0f);
+        Vec3 off = position - light.centre;
         glProgramUniform4f(prog, glGetUniformLocation(prog, ("u_light_pos" + i).c_str()),
-                           static_cast<float>(h.position.x), static_cast<float>(h.position.y),
-                           static_cast<float>(h.position.z), static_cast<float>(dot(off, off)));
+                           static_cast<float>(position.x), static_cast<float>(position.y),
+                           static_cast<float>(position.z), static_cast<float>(dot(off, off)));
         glProgramUniform4f(prog, glGetUniformLocation(prog, ("u_light_e" + i).c_str()),
                            static_cast<float>(h.irradiance.x), static_cast<float>(h.irradiance.y),
                            static_cast<float>(h.irradiance.z), 0.0f);
@@ -308,7 +310,7 @@ struct Compositor::Impl {
       set_mat(prog_depth, "u_view_projection", vp);
       set_vec3(prog_depth, "u_map_eye", lc.eye);
       set_vec3(prog_depth, "u_map_dir", dir);
-      set_int(prog_depth, "u_map_local", h.distant ? 0 : 1);
+      set_int(prog_depth, "u_map_local", distant ? 0 : 1);
       const float far[4] = {kFar, kFar, kFar, kFar};
       for (int pass = 0; pass < 2; ++pass) {
         glNamedFramebufferTextureLayer(fb_map, GL_COLOR_ATTACHMENT0, pass == 0 ? proxy_map : object_map, 0, l);
@@ -342,8 +344,8 @@ Compositor::Compositor(const Image& photo, const geometry::Camera& cam, const ge
   if (!(desc.soft_cutoff >= 0 && desc.soft_cutoff < 1))
     fail(ErrorKind::Value, "soft cut-off {} must lie in [0, 1)", desc.soft_cutoff);
   if (proxy.triangle_count() == 0) fail(ErrorKind::Value, "the proxy has no triangles");
-  if (light.hard.size() > static_cast<size_t>(kMaxLights))
-    fail(ErrorKind::Value, "{} hard lights: the GL compositor takes at most {}", light.hard.size(), kMaxLights);
+  if (light.hard.lights.size() > static_cast<size_t>(kMaxLights))
+    fail(ErrorKind::Value, "{} hard lights: the GL compositor takes at most {}", light.hard.lights.size(), kMaxLights);
   m.desc = desc;
   m.shadows = full_desc.shadows;
   m.bounce = full_desc.bounce_samples > 0;
@@ -351,7 +353,7 @@ Compositor::Compositor(const Image& photo, const geometry::Camera& cam, const ge
   m.light = light;
   m.W = cam.width;
   m.H = cam.height;
-  m.lights = static_cast<int>(light.hard.size());
+  m.lights = static_cast<int>(light.hard.lights.size());
   proxy.bounds(&m.proxy_lo, &m.proxy_hi);
   using render::gl::build_program;
   using render::gl::ShaderStage;
