@@ -51,7 +51,8 @@ void init_augment(py::module_& m) {
           [](const ibl::ilf::SHGrid& g, py::handle at, int size) {
             return ag::light_from_grid(g, to_vec3(at, "from_grid: at"), size);
           },
-          py::arg("grid"), py::arg("at"), py::arg("size") = 64, "An SH grid's radiance at `at` as a 2·size × size map.")
+          py::arg("grid"), py::arg("at"), py::arg("size") = ag::LightInput{}.grid_map_size,
+          "An SH grid's radiance at `at` as a 2·size × size map.")
       .def_static(
           "from_probes",
           [](const ibl::fusion::ProbeSet& s, py::handle at, int size) {
@@ -59,7 +60,8 @@ void init_augment(py::module_& m) {
             py::gil_scoped_release nogil;
             return ag::light_from_probes(s, x, size);
           },
-          py::arg("probe_set"), py::arg("at"), py::arg("size") = 128, "A probe set fused at `at`.")
+          py::arg("probe_set"), py::arg("at"), py::arg("size") = ag::LightInput{}.fused_map_size,
+          "A probe set fused at `at`.")
       .def("as_median_cut", &ag::as_median_cut, py::arg("count"),
            "The baseline of `count` median-cut lights, each in one texel.")
       .def_property_readonly(
