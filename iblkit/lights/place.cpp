@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "iblkit/core/error.h"
+#include "iblkit/sphere/mapping.h"
 
 namespace ibl::lights {
 
@@ -21,13 +22,15 @@ void place_by_depth(LightSet& set, const LatLongGrid& grid, Vec3 origin, const s
       if (label < 0) continue;
       const double e = luminance(grid.rgb[static_cast<size_t>(y) * grid.width + x]) * grid.row_solid_angle[y];
       if (!(e > 0)) continue;
-      e_all[static_cast<size_t>(label)] += e;
+      const size_t i = static_cast<size_t>(label);
+      e_all[i] += e;
       const double t = depth(x, y);
       if (t > 0 && std::isfinite(t)) {
-        e_hit[static_cast<size_t>(label)] += e;
-        depths[static_cast<size_t>(label)].push_back({t, e});
+        e_hit[i] += e;
+        depths[i].push_back({t, e});
       }
     }
+  const sphere::Mapping latlong(sphere::MappingKind::LatLong, grid.width, grid.height);
   for (size_t i = 0; i < n; ++i) {
     if (!(e_hit[i] > 0) || e_hit[i] < 0.5 * e_all[i]) continue;
     auto& d = depths[i];
@@ -38,7 +41,16 @@ void place_by_depth(LightSet& set, const LatLongGrid& grid, Vec3 origin, const s
         t = dist;
         break;
       }
-    set.lights[i].position = origin + set.lights[i].direction * t;
+    // Never beyond what the light's own direction sees.
+    const Vec3 dir = set.lights[i].direction;
+    double px, py;
+    if (latlong.to_pixel(dir, &px, &py)) {
+      const int x = std::clamp(static_cast<int>(px), 0, grid.width - 1),
+                y = std::clamp(static_cast<int>(py), 0, grid.height - 1);
+      const double along = depth(x, y);
+      if (along > 0 && std::isfinite(along)) t = std::min(t, along);
+    }
+    set.lights[i].position = origin + dir * t;
   }
   set.origin = origin;
 }

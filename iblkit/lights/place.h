@@ -4,6 +4,9 @@
 // t_j of R's pixels that see something at a finite distance (energy E_j = Y(L_j)·dω_j) — the median, not the
 // mean, because a rectangular region drags dim pixels at other depths along — when those pixels carry at
 // least half of R's energy; otherwise the light stays directional (light through a window or an open end).
+// t̃ is never more than the depth the pixel along d itself sees: a wide region's median depth along its mean
+// direction can land behind the surface (a window's light 12 cm above low-scene2's ceiling, whose shadow map
+// then saw only the ceiling: the GL object's error went from 4.2 % to 12.3 %).
 // A renderer treats a positioned light as a point light (light_set.h, irradiance_at).
 //
 //  [1] Pedersen, "Fusing environment maps for IBL in large scenes", MSc thesis, Aalborg 2008.
