@@ -259,19 +259,19 @@ int main(int argc, char** argv) {
       cam.height = height;
       augment::SplitLight L;
       L.centre = {0, 0.5, 0};
+      L.hard.origin = L.centre;
       L.soft = Image(128, 64, 3, 0.2f);
       L.soft_irradiance = Image(64, 32, 3, static_cast<float>(0.2 * kPi));
       for (int i = 0; i < 16; ++i) {
-        augment::HardLight h;
+        lights::Light h;
         h.irradiance = {0.3, 0.3, 0.3};
         if (i < 12) {
-          h.distant = false;
-          h.position = {-2.5 + (i % 4) * 5.0 / 3, 4.0, -3.0 + (i / 4) * 3.0};
-          h.direction = normalize(h.position - L.centre);
+          h.position = Vec3{-2.5 + (i % 4) * 5.0 / 3, 4.0, -3.0 + (i / 4) * 3.0};
+          h.direction = normalize(*h.position - L.centre);
         } else {
           h.direction = normalize(Vec3{std::cos(i * 1.3), 2.0, std::sin(i * 1.3)});
         }
-        L.hard.push_back(h);
+        L.hard.lights.push_back(h);
       }
       augment::gl::Compositor comp(Image(width, height, 3, 0.3f), cam, room, L, Image(width, height, 3, 0.5f));
       geometry::TriMesh object = blob;

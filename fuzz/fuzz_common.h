@@ -3,7 +3,7 @@
 // Policy: a reader may end in success or ibl::Error (the library's one exception type). A crash, a
 // sanitizer report, a leak, an allocation past libFuzzer's limit or any other exception escaping the
 // reader is a finding. nlohmann::json exceptions that escape a reader are the raw-message defect of
-// issue 19 ("Messages are one line that names the file…"), not a memory-safety fault: they count as
+// the error rule ("Messages are one line that names the file…"), not a memory-safety fault: they count as
 // clean unless IBLKIT_FUZZ_STRICT=1 is set, so that fuzzing goes on past them.
 #pragma once
 #include <unistd.h>

@@ -31,6 +31,8 @@ check camera-size fail "is 640x480 but the photograph" -- "$BIN" composite "$T/p
   --probes "$T/fus/probes.json" "${OBJ[@]}" --out "$T/c3.exr"
 
 # Bad input.
+check resting-on-floor ok "composited" -- "$BIN" composite "$T/photo.exr" "${CAM[@]}" --probes "$T/fus/probes.json" \
+  --object sphere --at 0,0.15,0 --object-size 0.3 --samples 4 --object-samples 4 --out "$T/c_rest.exr"
 check object-in-floor fail "the object intersects the proxy" -- "$BIN" composite "$T/photo.exr" "${CAM[@]}" --probes "$T/fus/probes.json" \
   --object blob --at 0,0.05,0 --object-size 0.3 --triangles 2000 --out "$T/c4.exr"
 check no-camera fail "give the photograph's camera" -- "$BIN" composite "$T/photo.exr" --probes "$T/fus/probes.json" --out "$T/c5.exr"

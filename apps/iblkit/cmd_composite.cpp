@@ -8,18 +8,13 @@
 
 #include "cli.h"
 #include "iblkit/augment/composite.h"
-#include "iblkit/core/atomic_file.h"
-#include "render_setup.h"
-#ifdef IBLKIT_HAVE_GL
-#include "iblkit/augment/gl/compositor.h"
-#include "iblkit/render/gl/context.h"
-#endif
-#include "iblkit/augment/load.h"
 #include "iblkit/augment/measure.h"
-#include "iblkit/augment/object.h"
+#include "iblkit/augment/run_composite.h"
+#include "iblkit/core/atomic_file.h"
 #include "iblkit/core/error.h"
 #include "iblkit/io/image_io.h"
 #include "iblkit/io/tonemap.h"
+#include "render_setup.h"
 
 namespace {
 
@@ -27,17 +22,17 @@ namespace fs = std::filesystem;
 using ibl::Vec3;
 
 struct Opts {
-  std::string photo, probe_depth, object = "blob", at = "0,0.15,0", albedo = "0.7,0.7,0.7", out = "composite.exr",
-                                  layers, backend = "cpu";
+  std::string photo, probe_depth, object, at, albedo = "0.7,0.7,0.7", out = "composite.exr", layers, backend = "cpu";
   iblcli::PhotoSceneOptions scene;
   std::vector<std::string> light, truth;
   std::string lobe = "phong", texture;
-  double object_size = 0.3, gloss = 0, exponent = 20;
-  int triangles = 20000, median_cut = 0;
-  ibl::augment::CompositeDesc desc;
-#ifdef IBLKIT_HAVE_GL
-  ibl::augment::gl::GlCompositeDesc gl;
-#endif
+  double gloss = 0, exponent = 20;
+  ibl::augment::CompositeJob job;  // its object's and sampling's defaults are the library's
+  Opts() {
+    const ibl::Vec3 p = job.object.at;
+    object = job.object.scene;
+    at = fmt::format("{},{},{}", p.x, p.y, p.z);
+  }
 };
 
 void write_layer(const fs::path& dir, const std::string& name, const ibl::Image& img) {
@@ -45,49 +40,24 @@ void write_layer(const fs::path& dir, const std::string& name, const ibl::Image&
 }
 
 void run(const Opts& o, const ibl::io::EnvReadDesc& read) {
-  if (o.backend != "cpu" && o.backend != "gl" && o.backend != "auto")
-    ibl::fail(ibl::ErrorKind::Value, "--backend {}: expected cpu, gl or auto", o.backend);
-  std::string backend = o.backend;
-#ifdef IBLKIT_HAVE_GL
-  if (backend == "auto") {
-    std::string why;
-    backend = ibl::render::gl::available(&why) ? "gl" : "cpu";
-    if (backend == "cpu") iblcli::info("--backend auto: no OpenGL context (" + why + "): the CPU reference composites");
-  }
-#else
-  if (backend == "gl")
-    ibl::fail(ibl::ErrorKind::Unsupported, "--backend gl: iblkit was built without OpenGL (IBLKIT_WITH_GL)");
-  if (backend == "auto") backend = "cpu";
-#endif
   if (o.light.size() > 1) ibl::fail(ibl::ErrorKind::Value, "--light: give one light file");
+  ibl::augment::CompositeJob job = o.job;
+  job.backend = ibl::augment::parse_backend(o.backend);
   ibl::Image photo = ibl::io::read_image(o.photo);
   const ibl::geometry::Camera cam = iblcli::photo_camera(o.scene, photo, o.photo, "");
-  const ibl::augment::ObjectDesc od = iblcli::inserted_object(o.object, o.object_size, o.triangles, o.at, o.albedo);
-  ibl::geometry::TriMesh object = ibl::augment::make_object(od);
-  Vec3 lo, hi;
-  object.bounds(&lo, &hi);
-  ibl::augment::LightInput li = iblcli::photo_light_input(o.scene, o.light);
-  li.probe_depth = o.probe_depth;
-  li.read = read;
-  ibl::augment::LoadedLight L = ibl::augment::load_light(li, lo, hi);
-  for (const auto& w : L.warnings) iblcli::info("warning: " + w);
-  if (o.median_cut > 0) L.light = ibl::augment::as_median_cut(L.light, o.median_cut);
-  ibl::augment::CompositeDesc d = o.desc;
-  d.progress = iblcli::progress_bar();
-  const ibl::render::Material material = iblcli::object_material(o.albedo, o.gloss, o.exponent, o.lobe, o.texture);
-  ibl::augment::CompositeResult r;
-#ifdef IBLKIT_HAVE_GL
-  if (backend == "gl") {
-    ibl::augment::gl::GlCompositeDesc g = o.gl;
-    g.albedo_samples = d.light_samples;
-    g.seed = d.seed;
-    g.shadows = d.shadows;
-    g.bounce = d.bounce_samples > 0;
-    r = ibl::augment::gl::composite(photo, cam, L.proxy, L.light, object, material, g);
-  }
-#endif
-  if (backend == "cpu") r = ibl::augment::composite(photo, cam, L.proxy, L.light, object, material, d);
+  const ibl::Vec3 at = iblcli::parse_vec3(o.at, "--at");
+  job.object.scene = o.object;
+  job.object.at = at;
+  job.light = iblcli::photo_light_input(o.scene, o.light);
+  job.light.probe_depth = o.probe_depth;
+  job.light.read = read;
+  job.material = iblcli::object_material(o.albedo, o.gloss, o.exponent, o.lobe, o.texture);
+  job.desc.progress = iblcli::progress_bar();
+  const ibl::augment::CompositeRun run = ibl::augment::run_composite(photo, cam, job);
   iblcli::progress_done();
+  for (const auto& n : run.notes) iblcli::info(n);
+  const ibl::augment::CompositeResult& r = run.result;
+  const std::string backend = ibl::augment::backend_name(run.backend);
   for (const auto& w : r.warnings) iblcli::info("warning: " + w);
   if (fs::path(o.out).extension() == ".png")
     ibl::io::write_image(o.out, ibl::io::tonemap(r.composite));
@@ -104,7 +74,7 @@ void run(const Opts& o, const ibl::io::EnvReadDesc& read) {
   }
   const auto& s = r.stats;
   nlohmann::json j = {{"out", o.out},
-                      {"light", L.light.source},
+                      {"light", run.light_source},
                       {"backend", backend},
                       {"seconds", s.seconds},
                       {"proxy_pixels", s.proxy_pixels},
@@ -138,7 +108,7 @@ void run(const Opts& o, const ibl::io::EnvReadDesc& read) {
   }
   iblcli::emit(j, [&] {
     fmt::print("composited the object into {} ({}x{}, light: {}, backend {}) in {:.2f} s: {}\n", o.photo, cam.width,
-               cam.height, L.light.source, backend, s.seconds, o.out);
+               cam.height, run.light_source, backend, s.seconds, o.out);
     fmt::print("  {} object pixels, {} proxy pixels changed by its shadow and light\n", s.object_pixels,
                s.changed_pixels);
     if (!o.layers.empty())
@@ -167,7 +137,8 @@ void setup(CLI::App& app) {
   auto& rd = iblcli::add_probe_read_options(app);
   app.add_option("--object", o->object, "blob, sphere, or a mesh file")->capture_default_str();
   app.add_option("--at", o->at, "where the object's centre goes")->capture_default_str();
-  app.add_option("--object-size", o->object_size, "largest extent, metres (0 keeps a mesh file's own size and place)")
+  app.add_option("--object-size", o->job.object.size,
+                 "largest extent, metres (0 keeps a mesh file's own size and place)")
       ->capture_default_str();
   app.add_option("--albedo", o->albedo, "the object's Lambertian albedo r,g,b")->capture_default_str();
   app.add_option("--gloss", o->gloss, "weight of the object's glossy lobe (0..1)")->check(CLI::Range(0.0, 1.0));
@@ -179,54 +150,54 @@ void setup(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--texture", o->texture,
                  "albedo texture of the object (sRGB PNG/JPG or linear EXR) at its UVs (the blob's and sphere's own)");
-  app.add_option("--triangles", o->triangles, "triangles of the blob")
+  app.add_option("--triangles", o->job.object.triangles, "triangles of the blob")
       ->check(CLI::Range(100, 5000000))
       ->capture_default_str();
-  app.add_option("--samples", o->desc.light_samples, "light samples per proxy pixel (albedo and shadows)")
+  app.add_option("--samples", o->job.desc.light_samples, "light samples per proxy pixel (albedo and shadows)")
       ->check(CLI::Range(1, 65536))
       ->capture_default_str();
-  app.add_option("--object-samples", o->desc.object_samples, "light samples per object pixel")
+  app.add_option("--object-samples", o->job.desc.object_samples, "light samples per object pixel")
       ->check(CLI::Range(1, 65536))
       ->capture_default_str();
-  app.add_option("--bounce-samples", o->desc.bounce_samples,
+  app.add_option("--bounce-samples", o->job.desc.bounce_samples,
                  "cone samples per proxy pixel towards the object: its light on the pixel and, with the light samples, "
                  "its shadow (a square number is stratified; 0: no interreflection)")
       ->check(CLI::Range(0, 65536))
       ->capture_default_str();
-  app.add_option("--pixel-samples", o->desc.pixel_samples, "n×n camera rays per pixel (object edges)")
+  app.add_option("--pixel-samples", o->job.desc.pixel_samples, "n×n camera rays per pixel (object edges)")
       ->check(CLI::Range(1, 8))
       ->capture_default_str();
-  app.add_option("--seed", o->desc.seed, "random seed")->capture_default_str();
-  app.add_option("--median-cut", o->median_cut,
+  app.add_option("--seed", o->job.desc.seed, "random seed")->capture_default_str();
+  app.add_option("--median-cut", o->job.median_cut,
                  "baseline: the light cut into N median-cut lights (shadows and shading from those only)")
       ->check(CLI::Range(1, 4096));
   app.add_flag(
-      "--no-shadows", [o](int64_t) { o->desc.shadows = false; },
+      "--no-shadows", [o](int64_t) { o->job.desc.shadows = false; },
       "baseline: the object pasted without its shadow and light on the scene");
   app.add_option("--backend", o->backend,
                  "cpu (the ray-traced reference), gl (OpenGL: shadow maps and a soft sphere term), auto (gl "
                  "when a GL context can be made)")
       ->capture_default_str();
 #ifdef IBLKIT_HAVE_GL
-  app.add_option("--gl-lights", o->gl.split.lights, "gl: most hard lights with shadow maps")
+  app.add_option("--gl-lights", o->job.desc.gl.split.lights, "gl: most hard lights with shadow maps")
       ->check(CLI::Range(0, 16))
       ->capture_default_str();
-  app.add_option("--gl-threshold", o->gl.split.threshold,
+  app.add_option("--gl-threshold", o->job.desc.gl.split.threshold,
                  "gl: a texel brighter than this x the mean radiance is a hard light's")
       ->check(CLI::Range(0.0, 1e6))
       ->capture_default_str();
-  app.add_option("--gl-visibility", o->gl.visibility_samples,
+  app.add_option("--gl-visibility", o->job.desc.gl.visibility_samples,
                  "gl: rays per object triangle for the soft light that reaches it (its own "
                  "occlusion, the floor its shadow darkens, the parallax from the probe; 0: none; default: 4194304 rays "
                  "over the "
                  "triangles, 16 to 1024 each)")
       ->check(CLI::Range(0, 65536));
-  app.add_option("--gl-cut", o->gl.cut,
+  app.add_option("--gl-soft-cutoff,--gl-cut", o->job.desc.gl.soft_cutoff,
                  "gl: the soft term is 0 where the object covers less than this cosine-weighted share of "
                  "the hemisphere (faded in up to twice it; the pixels left exactly as photographed)")
       ->check(CLI::Range(0.0, 0.5))
       ->capture_default_str();
-  app.add_option("--shadow-map-size", o->gl.shadow_map_size, "gl: texels per side of each light's shadow maps")
+  app.add_option("--shadow-map-size", o->job.desc.gl.shadow_map_size, "gl: texels per side of each light's shadow maps")
       ->check(CLI::Range(16, 8192))
       ->capture_default_str();
 #endif

@@ -13,7 +13,7 @@
 #include "iblkit/augment/composite.h"
 #include "iblkit/augment/load.h"
 #include "iblkit/augment/measure.h"
-#include "iblkit/augment/object.h"
+#include "iblkit/augment/run_composite.h"
 #include "iblkit/io/draw.h"
 #include "iblkit/io/envmap_io.h"
 #include "iblkit/io/image_io.h"
@@ -21,6 +21,7 @@
 #include "iblkit/lab/scene_io.h"
 #include "iblkit/lab/sequence.h"
 #include "iblkit/lab/view.h"
+#include "iblkit/render/objects.h"
 
 namespace {
 
@@ -76,12 +77,11 @@ ibl::lab::View photograph(const ibl::lab::Scene& scene, const ibl::geometry::Cam
 nlohmann::json lab_case(iblcli::DemoContext& ctx, const fs::path& dir, const ibl::geometry::Camera& cam,
                         const Image& photo, Vec3 at, const std::string& name) {
   auto t0 = std::chrono::steady_clock::now();
-  ibl::augment::ObjectDesc od;
-  od.at = at;
-  od.size = 0.3;
-  const ibl::geometry::TriMesh object = ibl::augment::make_object(od);
+  ibl::augment::CompositeJob job;
+  job.object.at = at;
+  const ibl::geometry::TriMesh object = ibl::render::make_object(job.object);
   ibl::lab::Scene with = ibl::lab::load_scene("low-scene2", false);
-  ibl::lab::add_object(with, "object", object, od.albedo);
+  ibl::lab::add_object(with, "object", object, job.material.albedo);
   with.build();
   const Image truth = photograph(with, cam, 2).radiance;  // the probes carry one bounce: the photograph reflects it
   const double truth_s = seconds_since(t0);
@@ -94,12 +94,8 @@ nlohmann::json lab_case(iblcli::DemoContext& ctx, const fs::path& dir, const ibl
   sd.capture.samples = 4;  // 4×4 rays per texel: a camera pixel integrates (one ray misses or doubles small lamps)
   sd.out_dir = (dir / (name + "_probe")).string();
   ibl::lab::write_probe_set(scene, {at}, sd);
-  Vec3 lo, hi;
-  object.bounds(&lo, &hi);
-  ibl::augment::LightInput li;
-  li.probes = (fs::path(sd.out_dir) / "probes.json").string();
-  ibl::augment::LoadedLight L = ibl::augment::load_light(li, lo, hi);
-  ibl::augment::CompositeResult r = ibl::augment::composite(photo, cam, L.proxy, L.light, object, od.albedo);
+  job.light.probes = (fs::path(sd.out_dir) / "probes.json").string();
+  const ibl::augment::CompositeResult r = ibl::augment::run_composite(photo, cam, job).result;
   ibl::augment::CompositeErrors e = ibl::augment::measure(photo, r.composite, truth, r.mask);
   std::string png = (dir / (name + ".png")).string();
   ibl::io::write_image(
@@ -125,7 +121,7 @@ nlohmann::json real_case(iblcli::DemoContext& ctx, const fs::path& dir) {
   constexpr double kProbeHeight = 1.2;  // metres: the probe above its floor (the file does not say; a tripod's height)
   ibl::sphere::EnvMap env = ibl::io::read_envmap(ctx.probe);
   ibl::sphere::Mapping ll(ibl::sphere::MappingKind::LatLong, 256, 128);
-  ibl::augment::LocalLight light;
+  ibl::augment::LocalRadiance light;
   light.map = ibl::sphere::EnvMap(ibl::sphere::resample(env, ll), ll);
   light.centre = {0, kProbeHeight, 0};
   light.source = "probe " + fs::path(ctx.probe).filename().string();
@@ -139,14 +135,15 @@ nlohmann::json real_case(iblcli::DemoContext& ctx, const fs::path& dir) {
   Image photo(kWidth, kHeight, 3);
   for (int y = 0; y < kHeight; ++y)
     for (int x = 0; x < kWidth; ++x) photo.set_rgb(x, y, light.map.sample_rgb(cam.ray_direction(x + 0.5, y + 0.5)));
-  ibl::augment::ObjectDesc od;
+  ibl::render::ObjectDesc od = ibl::augment::inserted_object_defaults();
   od.at = {0, 0.2, -1.5};
   od.size = 0.4;
-  ibl::geometry::TriMesh object = ibl::augment::make_object(od);
+  ibl::geometry::TriMesh object = ibl::render::make_object(od);
   Vec3 lo, hi;
   object.bounds(&lo, &hi);
   object.transform(1.0, {0, 0.002 - lo.y, 0});  // standing on the floor, 2 mm above it
-  ibl::augment::CompositeResult r = ibl::augment::composite(photo, cam, floor, light, object, od.albedo);
+  ibl::augment::CompositeResult r =
+      ibl::augment::composite(photo, cam, floor, light, object, ibl::augment::CompositeJob{}.material);
   std::string png = (dir / "real_probe.png").string();
   ibl::io::write_image(
       png, strip({{"probe seen from its centre", photo},

@@ -10,7 +10,6 @@
 #include <fmt/format.h>
 
 #include "cli.h"
-#include "iblkit/augment/object.h"
 #include "iblkit/core/atomic_file.h"
 #include "iblkit/core/error.h"
 #include "iblkit/core/json_file.h"
@@ -22,6 +21,7 @@
 #include "iblkit/lab/sequence.h"
 #include "iblkit/lab/truth.h"
 #include "iblkit/lab/view.h"
+#include "iblkit/render/objects.h"
 #include "iblkit/sh/coeffs.h"
 #include "render_setup.h"
 
@@ -203,8 +203,10 @@ void run_photograph(const PhotoOpts& o) {
   ibl::geometry::validate_camera(cam, o.camera.empty() ? "the camera" : o.camera);
   int object = -1;
   if (!o.object.empty()) {
-    const ibl::augment::ObjectDesc od = iblcli::inserted_object(o.object, o.object_size, o.triangles, o.at, o.albedo);
-    object = ibl::lab::add_object(scene, "object", ibl::augment::make_object(od), od.albedo);
+    const ibl::render::ObjectDesc od = iblcli::inserted_object(o.object, o.object_size, o.triangles, o.at);
+    const ibl::render::Material material = iblcli::object_material(o.albedo, 0, 20, "phong", "");
+    ibl::render::check_material(material, "--albedo");
+    object = ibl::lab::add_object(scene, "object", ibl::render::make_object(od), material.albedo);
   }
   scene.build();
   ibl::lab::ViewDesc vd;

@@ -21,7 +21,8 @@
 #include "iblkit/augment/composite.h"
 #include "iblkit/augment/gl/compositor.h"
 #include "iblkit/augment/load.h"
-#include "iblkit/augment/object.h"
+#include "iblkit/augment/run_composite.h"
+#include "iblkit/augment/soft_visibility.h"
 #include "iblkit/core/error.h"
 #include "iblkit/ilf/crossval.h"
 #include "iblkit/ilf/shgrid.h"
@@ -354,19 +355,19 @@ void show_frame(const ViewOpts& o, Inputs& in, State& st, Viewer& v, GLFWwindow*
 void run_composite(const ViewOpts& o, const ibl::io::EnvReadDesc& rd) {
   Image photo = io::read_image(o.photo);
   const geometry::Camera cam = iblcli::photo_camera(o.scene, photo, o.photo, "--composite: ");
-  const augment::ObjectDesc od =
-      iblcli::inserted_object(o.object.scene, o.object.size, o.object.triangles, o.at, o.albedo);
-  geometry::TriMesh object = augment::make_object(od);
-  Vec3 lo, hi;
-  object.bounds(&lo, &hi);
-  augment::LightInput li = iblcli::photo_light_input(o.scene, o.lights);
-  li.read = rd;
-  augment::LoadedLight L = augment::load_light(li, lo, hi);
+  augment::CompositeJob job;
+  job.object = iblcli::inserted_object(o.object.scene, o.object.size, o.object.triangles, o.at);
+  job.material = iblcli::object_material(o.albedo, 0, 20, "phong", "");  // Lambertian (composite takes --gloss)
+  job.light = iblcli::photo_light_input(o.scene, o.lights);
+  job.light.read = rd;
+  job.desc.gl.split.lights = o.gl_lights;
+  const augment::CompositeScene scene = augment::prepare_composite(job);
+  const augment::LoadedLight& L = scene.light;
+  const geometry::TriMesh& object = scene.object;
   for (const auto& w : L.warnings) iblcli::info("warning: " + w);
   iblcli::info("estimating the proxy's albedo (CPU, once)");
   augment::AlbedoEstimate est = augment::estimate_albedo(photo, cam, L.proxy, L.light);
-  augment::SplitDesc sd;
-  sd.lights = o.gl_lights;
+  const augment::SplitDesc& sd = job.desc.gl.split;
   augment::SplitLight split = augment::split_light(L.light, L.proxy, sd);
   if (!glfwInit()) fail(ErrorKind::Unsupported, "no display: GLFW could not initialise (is DISPLAY set? try xvfb-run)");
   struct Terminate {
@@ -376,16 +377,16 @@ void run_composite(const ViewOpts& o, const ibl::io::EnvReadDesc& rd) {
   glfwSetWindowAttrib(win, GLFW_RESIZABLE, GLFW_FALSE);  // the frame is the photograph's
   State st;
   st.exposure = o.exposure;
-  st.step = 0.1 * od.size;
+  st.step = 0.1 * job.object.size;
   install_controls(win, &st);
-  auto comp = std::make_unique<augment::gl::Compositor>(photo, cam, L.proxy, split, est.albedo);
+  auto comp = std::make_unique<augment::gl::Compositor>(photo, cam, L.proxy, split, est.albedo, job.desc);
   // The object's own occlusion of its soft light, which moves with it (composite, for one placement, also
   // traces the proxy's occlusion and the floor darkened by the object's shadow).
   augment::SoftVisibilityDesc vd;
   vd.proxy = false;
   vd.threshold = sd.lights > 0 ? sd.threshold : 0;
   const std::vector<Vec3> vis = augment::soft_visibility(L.light, L.proxy, object, vd);
-  comp->set_object(object, od.albedo, &vis);  // Lambertian (composite takes --gloss/--texture)
+  comp->set_object(object, job.material, &vis);
   auto present = std::make_unique<gl::Presenter>();
   const double meter = io::auto_exposure_scale(photo);
   const std::string renderer_name = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
@@ -402,7 +403,7 @@ void run_composite(const ViewOpts& o, const ibl::io::EnvReadDesc& rd) {
     Vec3 offset = st.offset;
     if (o.frames > 0) {
       double a = 2 * kPi * frame / o.frames;
-      offset += Vec3{std::cos(a), 0, std::sin(a)} * (0.5 * od.size);
+      offset += Vec3{std::cos(a), 0, std::sin(a)} * (0.5 * job.object.size);
     } else {
       offset += Vec3{-st.orbit.azimuth, 0, st.orbit.elevation - 0.35} * (10 * st.step);  // drag: over the floor
     }
@@ -421,7 +422,7 @@ void run_composite(const ViewOpts& o, const ibl::io::EnvReadDesc& rd) {
     bool software = renderer_name.find("llvmpipe") != std::string::npos;
     glfwSetWindowTitle(win, fmt::format("iblkit view — composite {} — {} {:.2f} ms/frame, {} hard lights",
                                         std::filesystem::path(o.photo).filename().string(), software ? "wall" : "GPU",
-                                        software ? ms : t.gpu_ms, split.hard.size())
+                                        software ? ms : t.gpu_ms, split.hard.lights.size())
                                 .c_str());
     glfwPollEvents();
   }
@@ -434,7 +435,7 @@ void run_composite(const ViewOpts& o, const ibl::io::EnvReadDesc& rd) {
                 {"gl_renderer", renderer_name},
                 {"screenshot", o.screenshot},
                 {"mode", "composite"},
-                {"hard_lights", split.hard.size()}},
+                {"hard_lights", split.hard.lights.size()}},
                [&] {
                  fmt::print(
                      "{} composite frames, {:.1f} ms per frame (shadow maps, differential render, display) on {}\n",

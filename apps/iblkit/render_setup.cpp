@@ -37,15 +37,8 @@ std::string grid_bounds_warning(const ibl::render::Lighting& L, const ibl::geome
       lo.x, lo.y, lo.z, hi.x, hi.y, hi.z, gmin.x, gmin.y, gmin.z, gmax.x, gmax.y, gmax.z);
 }
 
-ibl::augment::ObjectDesc inserted_object(const std::string& kind, double size, int triangles, const std::string& at,
-                                         const std::string& albedo) {
-  ibl::augment::ObjectDesc od;
-  od.kind = kind;
-  od.size = size;
-  od.triangles = triangles;
-  od.at = parse_vec3(at, "--at");
-  od.albedo = parse_vec3(albedo, "--albedo");
-  return od;
+ibl::render::ObjectDesc inserted_object(const std::string& kind, double size, int triangles, const std::string& at) {
+  return {kind, size, triangles, parse_vec3(at, "--at")};
 }
 
 ibl::render::Material object_material(const std::string& albedo, double gloss, double exponent, const std::string& lobe,

@@ -8,11 +8,11 @@
 #include <CLI/CLI.hpp>
 
 #include "iblkit/augment/load.h"
-#include "iblkit/augment/object.h"
 #include "iblkit/core/image.h"
 #include "iblkit/geometry/camera.h"
 #include "iblkit/geometry/mesh.h"
 #include "iblkit/render/frame.h"
+#include "iblkit/render/objects.h"
 #include "iblkit/render/shading.h"
 
 namespace iblcli {
@@ -36,10 +36,9 @@ void add_shadow_map_options(CLI::App& app, ShadowMapOptions* o);
 // faces), naming both boxes and the flags that move and shrink the object; else an empty string.
 std::string grid_bounds_warning(const ibl::render::Lighting& L, const ibl::geometry::TriMesh& object);
 
-// The inserted object of `composite` and `lab photograph` from their --object, --object-size,
-// --triangles, --at and --albedo values.
-ibl::augment::ObjectDesc inserted_object(const std::string& kind, double size, int triangles, const std::string& at,
-                                         const std::string& albedo);
+// The inserted object of `composite`, `view --composite` and `lab photograph` from their --object,
+// --object-size, --triangles and --at values (its surface is object_material's).
+ibl::render::ObjectDesc inserted_object(const std::string& kind, double size, int triangles, const std::string& at);
 
 // The object's surface from --albedo, --gloss, --exponent, --lobe (phong, blinn) and --texture (which then
 // replaces the albedo: white times the texture), as `render` and `composite` take them.

@@ -44,7 +44,7 @@ namespace {
 std::string stem(const std::string& path) { return fs::path(path).stem().string(); }
 
 // Files and folders inside the output folder are written as themselves: a link planted there (to a
-// file or a folder outside it) is replaced, never written through (issue 32).
+// file or a folder outside it) is replaced, never written through.
 void copy_into(const fs::path& from, const fs::path& to) { copy_file_atomically(from.string(), to.string()); }
 void real_folder(const fs::path& dir) {
   std::error_code ec;

@@ -1,7 +1,7 @@
-// The proxy's diffuse albedo per photograph pixel, estimated as the CPU composite does (composite.h,
-// method step 2): the camera ray through the pixel's centre meets the proxy at y, E₀(y) is the captured
-// light there (light.h's patches, `samples` stratified patch samples with the proxy's visibility) and
-// ρ = π · photo / E₀ per channel. Independent of the object: a real-time compositor (augment/gl/)
+// The proxy's diffuse albedo per photograph pixel, by the CPU composite's own estimator (proxy_light.h's
+// proxy_terms and proxy_albedo, composite.h's method): the camera ray through the pixel's centre meets the
+// proxy at y, E₀(y) is the captured light there (`samples` stratified patch samples with the proxy's
+// visibility) and ρ = π · photo / E₀ per channel. Independent of the object: a real-time compositor (augment/gl/)
 // computes it once per photograph and light, and then moves the object freely.
 #pragma once
 #include <cstdint>
@@ -22,6 +22,6 @@ struct AlbedoEstimate {
 
 // photo: RGB, cam's size. Throws ibl::Error on sizes that disagree or samples < 1.
 AlbedoEstimate estimate_albedo(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy,
-                               const LocalLight& light, int samples = 64, uint64_t seed = 1);
+                               const LocalRadiance& light, int samples = 64, uint64_t seed = 1);
 
 }  // namespace ibl::augment

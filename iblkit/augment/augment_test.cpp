@@ -11,9 +11,9 @@
 #include "iblkit/augment/composite.h"
 #include "iblkit/augment/light.h"
 #include "iblkit/augment/measure.h"
-#include "iblkit/augment/object.h"
 #include "iblkit/augment/testing.h"
 #include "iblkit/core/error.h"
+#include "iblkit/render/objects.h"
 
 namespace ibl::augment {
 namespace {
@@ -42,8 +42,8 @@ std::pair<int, int> pixel_of(double x, double z) {
 
 geometry::TriMesh floor_mesh() { return geometry::make_quad({0, 0, 0}, {0, 1, 0}, {0, 0, -1}, 6, 6); }
 
-LocalLight constant_sky(Vec3 L, Vec3 centre) {
-  LocalLight l;
+LocalRadiance constant_sky(Vec3 L, Vec3 centre) {
+  LocalRadiance l;
   Image img(64, 32, 3);
   for (int y = 0; y < 32; ++y)
     for (int x = 0; x < 64; ++x) img.set_rgb(x, y, L);
@@ -106,7 +106,7 @@ TEST(AugmentLight, AFloorsTableLeavesOutWhatItCannotSeeAndStaysUnbiased) {
   // horizon, and its estimate of E must have the exact sum over the patches as its expectation, with less
   // spread than the plain table's (which spends a quarter of its samples on the floor). The guided search
   // must find the patch a search of the whole CDF finds.
-  LocalLight l;
+  LocalRadiance l;
   Image img(64, 32, 3);
   for (int y = 0; y < 32; ++y)
     for (int x = 0; x < 64; ++x) img.set_rgb(x, y, y < 16 ? Vec3{1, 1, 1} : Vec3{0.5, 0.5, 0.5});
@@ -176,7 +176,7 @@ TEST(AugmentLight, AFloorsTableLeavesOutWhatItCannotSeeAndStaysUnbiased) {
 }
 
 TEST(AugmentComposite, SunCastsAFullShadowAndLeavesTheSunlitFloorAlone) {
-  LocalLight sun;
+  LocalRadiance sun;
   Image img(64, 32, 3);
   img.set_rgb(20, 8, {5000, 5000, 5000});  // one texel ≈ 48° from the zenith
   sun.map = sphere::EnvMap(img, sphere::Mapping(sphere::MappingKind::LatLong, 64, 32));
@@ -343,6 +343,24 @@ TEST(AugmentComposite, BadInputFailsWithAClearMessage) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("is inside the proxy"), std::string::npos) << e.what();
   }
+}
+
+TEST(AugmentComposite, AnObjectRestingOnTheFloorIsAccepted) {
+  // The most common placement: a sphere whose lowest vertex lies on the floor, and a blob moved so that
+  // its lowest point does. Touching is not intersecting; sinking 1 cm into the floor is.
+  Image photo = constant_photo(kFloorAlbedo);
+  auto sky = constant_sky({1, 1, 1}, {0, 0.5, 0});
+  CompositeDesc d;
+  d.light_samples = d.object_samples = 4;
+  d.bounce_samples = 0;
+  EXPECT_NO_THROW(composite(photo, top_camera(), floor_mesh(), sky, sphere_at({0, 0.2, 0}, 0.4), {0.5, 0.5, 0.5}, d));
+  geometry::TriMesh blob = render::make_object({"blob", 0.3, 2000, {0, 0, 0}});
+  Vec3 lo, hi;
+  blob.bounds(&lo, &hi);
+  blob.transform(1.0, {0, -lo.y, 0});
+  EXPECT_NO_THROW(composite(photo, top_camera(), floor_mesh(), sky, blob, {0.5, 0.5, 0.5}, d));
+  blob.transform(1.0, {0, -0.01, 0});
+  EXPECT_THROW(composite(photo, top_camera(), floor_mesh(), sky, blob, {0.5, 0.5, 0.5}, d), Error);
 }
 
 TEST(AugmentMeasure, PerfectCompositeHasNoErrorAndShadowErrorIsRelative) {

@@ -31,6 +31,7 @@
 #include <vector>
 
 #include "iblkit/augment/light.h"
+#include "iblkit/augment/split_light.h"
 #include "iblkit/core/image.h"
 #include "iblkit/core/progress.h"
 #include "iblkit/geometry/camera.h"
@@ -39,8 +40,24 @@
 
 namespace ibl::augment {
 
+// The real-time backend's own options (augment/gl/compositor.h). The options both backends share are
+// CompositeDesc's: its albedo estimate takes light_samples and seed, `shadows`, and the object's light on
+// the proxy is on when bounce_samples > 0.
+struct GlOptions {
+  SplitDesc split;              // hard lights (≤ 16) and their threshold
+  int shadow_map_size = 512;    // texels per side of each light's two maps (fitted to the object's bounding sphere)
+  int pcf = 1;                  // (2·pcf + 1)² taps per shadow lookup
+  int msaa = 4;                 // samples per pixel of the object pass (its coverage at edges)
+  double soft_cutoff = 4e-3;    // the soft term is 0 where the sphere's cosine-weighted share is below this, whole
+                                // above 2×
+  int visibility_samples = -1;  // patch samples per object triangle of its soft light's factor (soft_visibility.h);
+                                // 0: the object's soft light as the map's centre sees it; −1: kVisibilityRays over
+                                // the triangles, 16 to 1024 each
+  static constexpr int64_t kVisibilityRays = int64_t(1) << 22;  // 209 a triangle for the 20k-triangle blob
+};
+
 struct CompositeDesc {
-  int light_samples = 96;      // patch samples per proxy pixel (albedo and shadow; 64 until 2026-12-02)
+  int light_samples = 96;      // patch samples per proxy pixel (albedo and shadow)
   int object_samples = 1024;   // patch samples per object pixel (split over its camera rays)
   int bounce_samples = 64;     // cone samples per proxy pixel: the object's light on it (0: no bounce) and its shadow
                                // (MIS); a square is stratified
@@ -49,6 +66,7 @@ struct CompositeDesc {
   uint64_t seed = 1;           // random streams (same seed, same bytes)
   bool check_geometry = true;  // camera inside the proxy, object intersecting it: errors
   bool shadows = true;         // false: the object pasted without its shadow and light on the proxy (a baseline)
+  GlOptions gl;                // the real-time backend's own
   ProgressFn progress;         // stages "object", "composite" (by rows)
 };
 
@@ -81,42 +99,13 @@ struct CompositeResult {
 // of weight `specular` and exponent `exponent` (render::glossy_lobe) lit by the same patch samples. The
 // object's light on the proxy carries its diffuse part (the glossy part, seen from the proxy, is left out).
 CompositeResult composite(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy,
-                          const LocalLight& light, const geometry::TriMesh& object, const render::Material& material,
+                          const LocalRadiance& light, const geometry::TriMesh& object, const render::Material& material,
                           const CompositeDesc& desc = {});
 // A Lambertian object of albedo `albedo`.
 inline CompositeResult composite(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy,
-                                 const LocalLight& light, const geometry::TriMesh& object, Vec3 albedo,
+                                 const LocalRadiance& light, const geometry::TriMesh& object, Vec3 albedo,
                                  const CompositeDesc& desc = {}) {
   return composite(photo, cam, proxy, light, object, render::Material{albedo, {0, 0, 0}}, desc);
 }
-
-// For the real-time path (augment/gl/), which shades the object with the soft map's irradiance E_c(n) as seen
-// from the map's centre c: the factor that turns it into what each object triangle receives, as this reference
-// computes it. Per triangle (its centre z, its face normal n, the side the normal points to), per channel,
-//
-//   f = Σ_k c_k(z) V(z, q_k) s_k / Σ_k c_k(c)      over patch samples k of the light (light.h) that are soft,
-//
-// c_k(x) patch k's contribution at x with normal n, V the visibility past the proxy and the object itself, s_k the
-// patch's shadow factor (the object's shadow on the proxy it sees, from all of the light: the floor under an
-// object does not light its underside). The denominator estimates E_c(n) from the same samples, so f carries the
-// parallax between c and z as well as what is hidden (a triangle near a lit floor sees more of it than c does; one
-// facing down 15 cm below c does not see the walls between the two heights): f may exceed 1, and is clamped to
-// [0, 16]. Without the parallax (c_k(z) below too) the GL blob in low-scene2 was 4.4–5.2 % brighter than this
-// reference; with it, within 0.2 % (docs/augment.md). "Soft": the texels split_light leaves in the soft map (mean
-// RGB radiance at most `threshold` × the map's mean; 0: every texel). Where every sampled patch is distant and
-// nothing is hidden, f is exactly 1. proxy = false: the object's own occlusion alone (V past the object, s = 1,
-// both sums at z), which stays right while the object moves (iblkit view).
-struct SoftVisibilityDesc {
-  int samples = 64;         // patch samples per triangle
-  int pool_rays = 1536;     // each triangle's f pools the sums of the triangles around it (up to 3 rings of
-                            // shared vertices) until they hold this many rays (≤ samples: none pooled)
-  double threshold = 8;     // as SplitDesc::threshold
-  bool proxy = true;        // the proxy occludes and carries the object's shadow (as composite())
-  int shadow_samples = 64;  // as CompositeDesc::light_samples, for the shadow on the proxy's patches
-  int shadow_cone = 64;     // as CompositeDesc::bounce_samples
-  uint64_t seed = 1;
-};
-std::vector<Vec3> soft_visibility(const LocalLight& light, const geometry::TriMesh& proxy,
-                                  const geometry::TriMesh& object, const SoftVisibilityDesc& desc = {});
 
 }  // namespace ibl::augment

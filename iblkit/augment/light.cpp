@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include "iblkit/augment/rays.h"
 #include "iblkit/core/error.h"
 #include "iblkit/core/parallel.h"
 #include "iblkit/fusion/fuse.h"
@@ -21,7 +22,6 @@ constexpr double kPowerShare = 0.8;     // sampling: this share by power, the re
                                         // from dim but near patches)
 // A patch's power is its mean RGB radiance × solid angle (not luminance: a red lamp is as much a light as a white one).
 double power_of(Vec3 L) { return (std::max(0.0, L.x) + std::max(0.0, L.y) + std::max(0.0, L.z)) / 3; }
-constexpr double kDepthInFront = 0.98;  // a depth this much shorter than the proxy's hit is a free emitter (a lamp)
 // Normal-conditioned tables (table_for): receivers within 10° of a table's normal use it; the proxy's flat parts
 // are its triangles' normals clustered within that angle, the largest by area first; this many tables at most
 // (both sides of each normal), and no more than kTableEntries entries in all (bounded memory for large maps).
@@ -32,9 +32,9 @@ constexpr double kConditionedShare = 0.7;  // a table's share for what its norma
 
 }  // namespace
 
-LocalLight light_from_grid(const ilf::SHGrid& grid, Vec3 at, int size) {
+LocalRadiance light_from_grid(const ilf::SHGrid& grid, Vec3 at, int size) {
   if (size < 4 || size > 4096) fail(ErrorKind::Value, "light map size {} must lie in 4..4096", size);
-  LocalLight l;
+  LocalRadiance l;
   l.map = sphere::EnvMap(Image(2 * size, size, 3), sphere::Mapping(sphere::MappingKind::LatLong, 2 * size, size));
   l.centre = at;
   // A radiance map from band-limited coefficients rings: a bright lamp's few bands swing negative around it.
@@ -68,24 +68,24 @@ LocalLight light_from_grid(const ilf::SHGrid& grid, Vec3 at, int size) {
   return l;
 }
 
-LocalLight light_from_probes(const fusion::ProbeSet& set, Vec3 at, int size) {
+LocalRadiance light_from_probes(const fusion::ProbeSet& set, Vec3 at, int size) {
   fusion::FuseDesc d;
   d.size = size;
   fusion::LocalMap m = fusion::fuse(set, at, d);
-  LocalLight l;
+  LocalRadiance l;
   l.map = std::move(m.radiance);
   l.centre = at;
   l.source = "fused probes";
   return l;
 }
 
-LocalLight as_median_cut(const LocalLight& light, int count) {
+LocalRadiance as_median_cut(const LocalRadiance& light, int count) {
   if (light.map.mapping.kind() != sphere::MappingKind::LatLong)
     fail(ErrorKind::Value, "median-cut baseline: the {} map is not lat-long", light.source);
   lights::CutDesc cd;
   cd.count = count;
   lights::LightSet set = lights::median_cut(light.map, cd);
-  LocalLight out = light;
+  LocalRadiance out = light;
   out.source = fmt::format("{} as {} median-cut lights", light.source, set.lights.size());
   const int W = light.map.image.width(), H = light.map.image.height();
   out.map.image = Image(W, H, 3);
@@ -101,7 +101,7 @@ LocalLight as_median_cut(const LocalLight& light, int count) {
   return out;
 }
 
-LightField::LightField(const LocalLight& light, const geometry::TriMesh& proxy,
+LightField::LightField(const LocalRadiance& light, const geometry::TriMesh& proxy,
                        const geometry::RayTracer& proxy_tracer) {
   const Image& img = light.map.image;
   const sphere::Mapping& mp = light.map.mapping;
@@ -285,8 +285,7 @@ double LightField::solid_angle_at(size_t i, Vec3 x) const {
 }
 
 long LightField::patch_along(Vec3 x, Vec3 w, const geometry::RayTracer& proxy_tracer) const {
-  constexpr double kRayStart = 1e-4;  // metres, as the composite's secondary rays
-  return patch_along(x, w, proxy_tracer.intersect(x, w, kRayStart));
+  return patch_along(x, w, proxy_tracer.intersect(x, w, kRayEpsilon));
 }
 
 long LightField::patch_along(Vec3 x, Vec3 w, const geometry::Hit& h) const {

@@ -24,7 +24,10 @@
 
 namespace ibl::augment {
 
-struct LocalLight {
+// The radiance arriving at one point of the local scene (`centre`), as a lat-long map, with the optional
+// depth of what each texel sees: the captured light a composite uses (from a probe, an SH grid or fused
+// probes). A map, not a light: LightField below turns it into the patches that light the proxy.
+struct LocalRadiance {
   sphere::EnvMap map{Image(2, 1, 3),
                      sphere::Mapping(sphere::MappingKind::LatLong, 2, 1)};  // radiance arriving at centre
   Vec3 centre;                                                              // where the map was taken, world metres
@@ -34,20 +37,20 @@ struct LocalLight {
 
 // The grid's radiance at `at` as a lat-long map of 2·size × size: Hanning-windowed, negative ringing clamped to
 // 0, then scaled per channel to the grid's own power there (clamping alone adds light).
-LocalLight light_from_grid(const ilf::SHGrid& grid, Vec3 at, int size = 64);
+LocalRadiance light_from_grid(const ilf::SHGrid& grid, Vec3 at, int size = 64);
 // The probe set fused at `at` (fusion::fuse, footprint blend) as a lat-long map of 2·size × size.
-LocalLight light_from_probes(const fusion::ProbeSet& set, Vec3 at, int size = 128);
+LocalRadiance light_from_probes(const fusion::ProbeSet& set, Vec3 at, int size = 128);
 
 // A baseline: the light cut into `count` median-cut lights (lights::median_cut, Debevec 2005), each put into
 // the one texel of its direction with all of its region's power (and that texel's depth): what a renderer
 // with N shadow-casting lights sees. The map must be lat-long.
-LocalLight as_median_cut(const LocalLight& light, int count);
+LocalRadiance as_median_cut(const LocalRadiance& light, int count);
 
 // The light's patches on the proxy, and their sampling.
 class LightField {
  public:
   // `proxy_tracer` holds `proxy` as its mesh 0 (and nothing else).
-  LightField(const LocalLight& light, const geometry::TriMesh& proxy, const geometry::RayTracer& proxy_tracer);
+  LightField(const LocalRadiance& light, const geometry::TriMesh& proxy, const geometry::RayTracer& proxy_tracer);
   size_t size() const { return patches_.size(); }
   // The sampling table for a receiver with unit normal n: one conditioned on one of the proxy's main normals
   // (within 10°, either side; kept for the proxy's largest flat parts by area), or −1, the table for any normal.

@@ -26,7 +26,7 @@ struct LightInput {
 };
 
 struct LoadedLight {
-  LocalLight light;
+  LocalRadiance light;
   geometry::TriMesh proxy;
   std::vector<std::string> warnings;  // a probe outside the proxy, an object reaching outside a grid
 };

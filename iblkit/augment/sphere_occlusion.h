@@ -25,7 +25,7 @@ OccluderSphere equivalent_sphere(const geometry::TriMesh& object);
 
 // ∫ over the cap of half-angle α (sin²α = sin2_alpha) around an axis at angle β (cos β = cos_beta) from
 // the normal of max(0, cos θ) dω, in sr: π sin²α cos β when the cap is wholly above the horizon, 0 when
-// wholly below. The GLSL twin is in render/gl/shaders/augment_common.glsl.
+// wholly below. The GLSL twin is in augment/gl/shaders/augment_common.glsl.
 double cap_cosine_integral(double cos_beta, double sin2_alpha);
 
 // The soft irradiance of the object's side that faces each way, for the light the sphere sends back: for a

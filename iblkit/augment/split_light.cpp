@@ -3,15 +3,16 @@
 #include <algorithm>
 #include <cmath>
 
+#include "iblkit/augment/rays.h"
 #include "iblkit/core/error.h"
 #include "iblkit/core/parallel.h"
 #include "iblkit/geometry/raytracer.h"
 #include "iblkit/lights/cut.h"
+#include "iblkit/lights/place.h"
 
 namespace ibl::augment {
 
 namespace {
-constexpr double kDepthInFront = 0.98;  // as light.cpp: a depth this much shorter than the proxy's hit is a lamp
 // E(n) = ∫ L max(0, n·ω) dω on a lat-long of 2·size × size normals, summed over the soft texels (`soft`) of the grid
 // gathered into at most 128 × 64 cells: each cell keeps the exact Σ L dω of its texels (a lamp's power stays whole)
 // at their solid-angle-weighted mean direction. No band limit: 3 SH bands misstate the side facing away from a
@@ -43,16 +44,7 @@ Image cosine_convolution(int W, int H, const lights::LatLongGrid& grid, const st
 
 }  // namespace
 
-Vec3 HardLight::at(Vec3 centre, Vec3 x, Vec3 n) const {
-  if (distant) return irradiance * std::max(0.0, dot(n, direction));
-  Vec3 v = position - x;
-  double r2 = dot(v, v);
-  if (!(r2 > 0)) return {};
-  Vec3 c = position - centre;
-  return irradiance * (dot(c, c) / r2 * std::max(0.0, dot(n, v) / std::sqrt(r2)));
-}
-
-SplitLight split_light(const LocalLight& light, const geometry::TriMesh& proxy, const SplitDesc& desc) {
+SplitLight split_light(const LocalRadiance& light, const geometry::TriMesh& proxy, const SplitDesc& desc) {
   if (desc.lights < 0 || desc.lights > 256) fail(ErrorKind::Value, "hard lights {} must lie in 0..256", desc.lights);
   if (!(desc.threshold >= 0) || !std::isfinite(desc.threshold))
     fail(ErrorKind::Value, "hard-light threshold {} must be ≥ 0", desc.threshold);
@@ -90,31 +82,26 @@ SplitLight split_light(const LocalLight& light, const geometry::TriMesh& proxy, 
   if (hard_texels > 0) {
     lights::CutDesc cd;
     cd.count = std::min(desc.lights, hard_texels);
-    lights::LightSet set = lights::median_cut(hard, cd);
+    s.hard = lights::median_cut(hard, cd);
+    for (auto& l : s.hard.lights) l.direction = normalize(l.direction);
     geometry::RayTracer rt;
     rt.add(proxy);
     rt.commit();
-    for (const auto& l : set.lights) {
-      HardLight h;
-      h.direction = normalize(l.direction);
-      h.irradiance = l.irradiance;
-      h.solid_angle = l.solid_angle;
-      geometry::Hit hit = rt.intersect(light.centre, h.direction, 1e-6);
+    // A texel's depth: where the probe's depth map says a lamp hangs in front of the proxy, else where the
+    // texel's ray from the centre meets the proxy (∞: it leaves the proxy).
+    const bool have_depth = !light.depth.empty() && light.depth.width() == W && light.depth.height() == H;
+    lights::place_by_depth(s.hard, hard, light.centre, [&](int x, int y) {
+      const Vec3 d = grid.direction(x + 0.5, y + 0.5);
+      const geometry::Hit hit = rt.intersect(light.centre, d, 1e-6);
       double dist = hit.hit ? hit.t : std::numeric_limits<double>::infinity();
-      if (!light.depth.empty()) {
-        double px, py;
-        if (light.map.mapping.to_pixel(h.direction, &px, &py)) {
-          int ix = std::clamp(static_cast<int>(px), 0, light.depth.width() - 1),
-              iy = std::clamp(static_cast<int>(py), 0, light.depth.height() - 1);
-          double d = light.depth.at(ix, iy, 0);
-          if (d > 0 && std::isfinite(d) && d < kDepthInFront * dist) dist = d;
-        }
+      if (have_depth) {
+        const double t = light.depth.at(x, y, 0);
+        if (t > 0 && std::isfinite(t) && t < kDepthInFront * dist) dist = t;
       }
-      h.distant = !std::isfinite(dist);
-      if (!h.distant) h.position = light.centre + h.direction * dist;
-      s.hard.push_back(h);
-    }
+      return dist;
+    });
   }
+  s.hard.origin = light.centre;
   s.soft_irradiance = cosine_convolution(grid.width, grid.height, grid, soft_texel, desc.irradiance_size);
   return s;
 }

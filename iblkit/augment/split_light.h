@@ -1,10 +1,12 @@
 // The captured light split for a real-time compositor (augment/gl/): its concentrated part — the texels
 // brighter than `threshold` × the map's mean radiance (the sun, lamps, bright windows) — becomes a few
-// localised lights (median cut of that part, Debevec 2005; each light put where its ray from the map's
-// centre meets the proxy, or the probe's depth map says a lamp hangs, or at infinity where the ray leaves
-// the proxy), which cast shadow maps; the rest of the map (sky, walls, floor) stays a smooth environment,
-// whose shadow is the soft term (sphere_occlusion.h) and whose irradiance shades the object (its cosine convolution).
-// The lights and the soft map together hold all of the map's power (test AugmentSplit.*).
+// localised lights (median cut of that part, Debevec 2005; each light placed by lights/place.h's rule, the
+// one fusion's lights follow: its texels' energy-weighted median depth, a texel's depth where the probe's
+// depth map says a lamp hangs in front of the proxy, else where its ray from the map's centre meets the
+// proxy; directional where most of its light comes from beyond the proxy), which cast shadow maps; the rest of the map
+// (sky, walls, floor) stays a smooth environment, whose shadow is the soft term (sphere_occlusion.h) and whose
+// irradiance shades the object (its cosine convolution). The lights and the soft map together hold all of the map's
+// power (test AugmentSplit.*).
 #pragma once
 #include <algorithm>
 #include <vector>
@@ -12,18 +14,9 @@
 #include "iblkit/augment/light.h"
 #include "iblkit/core/image.h"
 #include "iblkit/geometry/mesh.h"
+#include "iblkit/lights/light_set.h"
 
 namespace ibl::augment {
-
-struct HardLight {
-  Vec3 direction;          // unit, from the map's centre towards the light
-  Vec3 irradiance;         // RGB W/m² at the centre, normal incidence (Σ L dω of its region)
-  double solid_angle = 0;  // sr of its region, seen from the centre
-  bool distant = true;     // false: a point light at `position`
-  Vec3 position;           // world metres (local lights); intensity irradiance · |position − centre|² W/sr
-  // Irradiance on a surface at x with unit normal n (no visibility): inverse square from a local light.
-  Vec3 at(Vec3 centre, Vec3 x, Vec3 n) const;
-};
 
 // What the threshold is compared with: a texel's mean RGB radiance, negative channels as 0.
 inline double split_measure(Vec3 L) { return (std::max(0.0, L.x) + std::max(0.0, L.y) + std::max(0.0, L.z)) / 3; }
@@ -35,9 +28,11 @@ struct SplitDesc {
 };
 
 struct SplitLight {
-  Vec3 centre;                  // the map's centre, world metres
-  std::vector<HardLight> hard;  // the concentrated light
-  Image soft;                   // lat-long radiance (RGB, 2H × H): the map less the hard texels
+  Vec3 centre;            // the map's centre, world metres
+  lights::LightSet hard;  // the concentrated light: lights::Light's (direction from the centre, irradiance there,
+                          // solid angle; a position when placed on the proxy or by the depth map: a point light),
+                          // origin = centre; lights::irradiance_at evaluates them
+  Image soft;             // lat-long radiance (RGB, 2H × H): the map less the hard texels
   Image soft_irradiance;  // lat-long (RGB, 2·irradiance_size × irradiance_size): E_soft(n) = ∫ L_soft max(0, n·ω) dω,
                           // summed over the soft map (render::prefilter_phong, exponent 1, times π)
   double hard_share = 0;  // share of the map's ∫ mean(RGB) dω in the hard lights
@@ -45,6 +40,6 @@ struct SplitLight {
 
 // `proxy` places the lights (the map's own depth map, where it has one, places lamps in front of it).
 // Throws ibl::Error on a bad description or a map without light.
-SplitLight split_light(const LocalLight& light, const geometry::TriMesh& proxy, const SplitDesc& desc = {});
+SplitLight split_light(const LocalRadiance& light, const geometry::TriMesh& proxy, const SplitDesc& desc = {});
 
 }  // namespace ibl::augment

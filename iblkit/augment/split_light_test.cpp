@@ -5,10 +5,10 @@
 #include <cmath>
 #include <vector>
 
-#include "iblkit/augment/object.h"
 #include "iblkit/augment/sphere_occlusion.h"
 #include "iblkit/augment/split_light.h"
 #include "iblkit/core/error.h"
+#include "iblkit/render/objects.h"
 #include "iblkit/sphere/mapping.h"
 
 namespace ibl::augment {
@@ -42,11 +42,7 @@ TEST(AugmentSphereOcclusion, CapCosineIntegralMatchesQuadratureAcrossTheHorizon)
 }
 
 TEST(AugmentSphereOcclusion, EquivalentSphereOfASphereAndOfAnOpenSquare) {
-  ObjectDesc d;
-  d.kind = "sphere";
-  d.size = 0.4;
-  d.at = {1, 2, 3};
-  OccluderSphere s = equivalent_sphere(make_object(d));
+  OccluderSphere s = equivalent_sphere(render::make_object({"sphere", 0.4, 0, {1, 2, 3}}));
   EXPECT_NEAR(s.radius, 0.2, 0.004);  // the tessellated sphere's volume is a little smaller
   EXPECT_NEAR(s.bound_radius, 0.2, 1e-3);
   EXPECT_NEAR(length(s.centre - Vec3{1, 2, 3}), 0, 1e-6);
@@ -59,10 +55,7 @@ TEST(AugmentSphereOcclusion, FacingIrradianceOfASphereIsTheCosineMeanOfItsHemisp
   // E_c(n) = 1 + n_y on a sphere: the side facing d, weighted by projected area (A max(0, n·d)), has the mean
   // normal (2/3) d, so its mean irradiance is 1 + (2/3) d_y. With the lower half's factor 0 (in a shadow),
   // the side facing straight down receives nothing and the side facing up all of it.
-  ObjectDesc d;
-  d.kind = "sphere";
-  d.size = 0.4;
-  const geometry::TriMesh sphere = make_object(d);
+  const geometry::TriMesh sphere = render::make_object({"sphere", 0.4, 0, {0, 0, 0}});
   Image irr(64, 32, 3);
   const sphere::Mapping ll(sphere::MappingKind::LatLong, 64, 32);
   for (int y = 0; y < 32; ++y)
@@ -88,13 +81,13 @@ TEST(AugmentSphereOcclusion, FacingIrradianceOfASphereIsTheCosineMeanOfItsHemisp
   EXPECT_THROW(facing_irradiance(sphere, &lit, Image(10, 10, 3)), Error);
 }
 
-LocalLight sky_and_sun(Vec3 centre) {
+LocalRadiance sky_and_sun(Vec3 centre) {
   Image img(64, 32, 3);
   for (int y = 0; y < 32; ++y)
     for (int x = 0; x < 64; ++x) img.set_rgb(x, y, y < 16 ? Vec3{0.5, 0.6, 1.0} : Vec3{0.2, 0.2, 0.2});
   img.set_rgb(20, 6, {3000, 2800, 2500});
   img.set_rgb(21, 6, {3000, 2800, 2500});
-  LocalLight l;
+  LocalRadiance l;
   l.map = sphere::EnvMap(img, sphere::Mapping(sphere::MappingKind::LatLong, 64, 32));
   l.centre = centre;
   l.source = "test sky";
@@ -102,16 +95,18 @@ LocalLight sky_and_sun(Vec3 centre) {
 }
 
 TEST(AugmentSplit, HardLightsAndSoftMapHoldAllOfTheMapsPowerAndSitWhereTheProxyIs) {
-  LocalLight l = sky_and_sun({0, 0.5, 0});
+  LocalRadiance l = sky_and_sun({0, 0.5, 0});
   std::vector<double> total = l.map.integral();
   geometry::TriMesh floor = geometry::make_quad({0, 0, 0}, {0, 1, 0}, {0, 0, -1}, 6, 6);
   SplitLight s = split_light(l, floor);
-  ASSERT_EQ(s.hard.size(), 2u);  // the two sun texels, nothing else is 8× the mean
+  ASSERT_EQ(s.hard.lights.size(), 2u);  // the two sun texels, nothing else is 8× the mean
   Vec3 hard;
-  for (const auto& h : s.hard) {
+  for (const auto& h : s.hard.lights) {
     hard += h.irradiance;
-    EXPECT_TRUE(h.distant);  // above an open floor
+    EXPECT_FALSE(h.position);  // above an open floor: directional
   }
+  ASSERT_TRUE(s.hard.origin);
+  EXPECT_EQ(length(*s.hard.origin - l.centre), 0.0);
   sphere::EnvMap soft(s.soft, sphere::Mapping(sphere::MappingKind::LatLong, 64, 32));
   std::vector<double> rest = soft.integral();
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(hard[c] + rest[c], total[c], 1e-6 * total[c]);
@@ -133,19 +128,22 @@ TEST(AugmentSplit, HardLightsAndSoftMapHoldAllOfTheMapsPowerAndSitWhereTheProxyI
   EXPECT_NEAR(irr.rgb(irr.width() / 2, 0).z, kPi * (1.0 * (1 + c) / 2 + 0.2 * (1 - c) / 2) - sun_sky, 2e-3);
   EXPECT_NEAR(irr.rgb(irr.width() / 2, irr.height() - 1).z, kPi * (0.2 * (1 + c) / 2 + 1.0 * (1 - c) / 2), 2e-3);
 
-  // Under a ceiling the sun's light comes from a point on it (intensity E·d² W/sr).
+  // Under a ceiling the sun's light comes from a point on it (intensity E·d² W/sr), placed by the rule of
+  // fusion's lights (lights/place.h): the light's direction times its texels' median depth, never beyond what
+  // the direction itself sees (the ceiling).
   geometry::TriMesh room = floor;
   room.append(geometry::make_quad({0, 2, 0}, {0, -1, 0}, {0, 0, 1}, 6, 6));
   SplitLight r = split_light(l, room);
-  ASSERT_FALSE(r.hard.empty());
-  EXPECT_FALSE(r.hard[0].distant);
-  EXPECT_NEAR(r.hard[0].position.y, 2.0, 1e-6);
-  Vec3 e = r.hard[0].at(l.centre, l.centre, r.hard[0].direction);
-  EXPECT_NEAR(e.x, r.hard[0].irradiance.x, 1e-9 * e.x);
+  ASSERT_FALSE(r.hard.lights.empty());
+  const lights::Light& lamp = r.hard.lights[0];
+  ASSERT_TRUE(lamp.position);
+  EXPECT_NEAR(lamp.position->y, 2.0, 1e-6);
+  Vec3 e = lights::irradiance_at(r.hard, lamp, l.centre, lamp.direction);  // gives back E at the centre
+  EXPECT_NEAR(e.x, lamp.irradiance.x, 1e-9 * e.x);
 
   SplitDesc none;
   none.threshold = 0;
-  EXPECT_TRUE(split_light(l, floor, none).hard.empty());
+  EXPECT_TRUE(split_light(l, floor, none).hard.lights.empty());
   none.lights = -1;
   EXPECT_THROW(split_light(l, floor, none), Error);
 }
@@ -154,7 +152,7 @@ TEST(AugmentSplit, SoftIrradianceIsTheCosineSumOfTheSoftTexels) {
   // With nothing hard (threshold 0), E(n) on every normal of the irradiance map is Σ L dω max(0, n·ω) over the
   // map's texels, the sun's two included: against that sum done here texel by texel, within the cells' spread
   // (a 64 × 32 map is its own cells: exact but for float rounding).
-  LocalLight l = sky_and_sun({0, 0.5, 0});
+  LocalRadiance l = sky_and_sun({0, 0.5, 0});
   geometry::TriMesh floor = geometry::make_quad({0, 0, 0}, {0, 1, 0}, {0, 0, -1}, 6, 6);
   SplitDesc all_soft;
   all_soft.threshold = 0;

@@ -1,9 +1,9 @@
 // Fixtures the augment/ tests share (CPU and GL compositor tests): a constant photograph and a
 // sphere object at a point.
 #pragma once
-#include "iblkit/augment/object.h"
 #include "iblkit/core/image.h"
 #include "iblkit/geometry/mesh.h"
+#include "iblkit/render/objects.h"
 
 namespace ibl::augment::testing {
 
@@ -14,12 +14,6 @@ inline Image constant_photo(int w, int h, double v) {
   return p;
 }
 
-inline geometry::TriMesh sphere_at(Vec3 c, double size) {
-  ObjectDesc d;
-  d.kind = "sphere";
-  d.size = size;
-  d.at = c;
-  return make_object(d);
-}
+inline geometry::TriMesh sphere_at(Vec3 c, double size) { return render::make_object({"sphere", size, 0, c}); }
 
 }  // namespace ibl::augment::testing

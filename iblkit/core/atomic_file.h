@@ -1,8 +1,8 @@
-// Output files written whole or not at all (DESIGN.md, "Errors"): every writer puts its bytes into a
-// temporary file beside the output and renames it into place once it is complete and closed, so a
-// failed or killed command never leaves a half-written file at its output path, and the file that
-// was there before stays intact until the new one replaces it in one step. (Protection against
-// crashes of the process, not of the machine: nothing is fsync'ed.)
+// Output files written whole or not at all (docs/formats.md, "How every output is written"): every writer puts its
+// bytes into a temporary file beside the output and renames it into place once it is complete and closed, so a failed
+// or killed command never leaves a half-written file at its output path, and the file that was there before stays
+// intact until the new one replaces it in one step. (Protection against crashes of the process, not of the machine:
+// nothing is fsync'ed.)
 //
 //   AtomicFile f(path);                     // nothing created yet
 //   write_somehow(f.temp_path());           // e.g. "out/probe.tmp-4711-3.exr"; throws on failure
@@ -59,7 +59,7 @@ void remove_live_temp_files() noexcept;
 // as without the handler. A signal the process ignores (nohup, a shell's background job) stays ignored.
 void remove_temp_files_on_signals();
 
-// A command's outputs as one (issue 19: "a command that fails after writing one of several outputs
+// A command's outputs as one ("a command that fails after writing one of several outputs
 // removes what it wrote"). While a transaction is open, AtomicFile::commit() still renames each file
 // into place at once (so the command can read back what it wrote: a capture's frames, cached depth
 // maps), but first keeps the file it replaces as a hard link beside it ("<stem>.bak-<pid>-<n><ext>"),

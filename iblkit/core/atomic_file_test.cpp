@@ -114,7 +114,7 @@ TEST(AtomicFile, LinksAndDevices) {
   write_file_atomically((d / "real.txt").string(), "old");
   fs::create_symlink("real.txt", d / "link.txt");
   write_file_atomically((d / "link.txt").string(), "new");
-  // The link is replaced, never written through (issue 32: a link planted in an output folder).
+  // The link is replaced, never written through (a link planted in an output folder).
   EXPECT_FALSE(fs::is_symlink(d / "link.txt"));
   EXPECT_EQ(slurp(d / "link.txt"), "new");
   EXPECT_EQ(slurp(d / "real.txt"), "old");

@@ -1,4 +1,4 @@
-// core/check.h: the checks every point, direction, box and size entering the library passes (issue 19).
+// core/check.h: the checks every point, direction, box and size entering the library passes.
 #include <gtest/gtest.h>
 
 #include <cmath>

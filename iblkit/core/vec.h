@@ -60,7 +60,7 @@ inline Vec3 normalize(Vec3 a) {
 }
 inline double max_component(Vec3 a) { return std::max({a.x, a.y, a.z}); }
 
-// Luminance of linear Rec.709 RGB (DESIGN.md).
+// Luminance of linear Rec.709 RGB (docs/conventions.md).
 inline constexpr double kLumR = 0.2125, kLumG = 0.7154, kLumB = 0.0721;
 constexpr double luminance(double r, double g, double b) { return kLumR * r + kLumG * g + kLumB * b; }
 constexpr double luminance(Vec3 rgb) { return luminance(rgb.x, rgb.y, rgb.z); }

@@ -1,4 +1,4 @@
-// Fusion (issue 6): depth tracing, back-projection and blending against closed forms on "painted"
+// Fusion: depth tracing, back-projection and blending against closed forms on "painted"
 // proxies (every proxy point has a known view-independent radiance, so the exact local map anywhere is
 // known), the visibility test, bad input, localised lights and the path tracker.
 #include <gtest/gtest.h>

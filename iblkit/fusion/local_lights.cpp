@@ -11,6 +11,7 @@
 #include "iblkit/core/json_file.h"
 #include "iblkit/lights/cut.h"
 #include "iblkit/lights/evaluate.h"
+#include "iblkit/lights/place.h"
 #include "iblkit/sphere/pointset.h"
 
 namespace ibl::fusion {
@@ -24,35 +25,7 @@ lights::LightSet localize_lights(const LocalMap& map, const LocalLightsDesc& des
   cd.count = desc.count;
   cd.min_separation_deg = desc.min_separation_deg;
   lights::LightSet set = lights::median_cut(grid, cd);
-  size_t n = set.lights.size();
-  std::vector<double> e_all(n, 0), e_hit(n, 0);
-  std::vector<std::vector<std::pair<double, double>>> depths(n);  // (depth, energy) of the pixels that hit
-  for (int y = 0; y < grid.height; ++y)
-    for (int x = 0; x < grid.width; ++x) {
-      int lab = set.regions.at(x, y);
-      if (lab < 0) continue;
-      double e = luminance(grid.rgb[static_cast<size_t>(y) * grid.width + x]) * grid.row_solid_angle[y];
-      e_all[lab] += e;
-      double t = map.depth.at(x, y, 0);
-      if (t > 0 && e > 0) {
-        e_hit[lab] += e;
-        depths[lab].push_back({t, e});
-      }
-    }
-  for (size_t i = 0; i < n; ++i) {
-    if (!(e_hit[i] > 0) || e_hit[i] < 0.5 * e_all[i]) continue;
-    // Energy-weighted median depth: robust to the dim pixels a rectangular region drags along.
-    auto& d = depths[i];
-    std::sort(d.begin(), d.end());
-    double acc = 0, t = d.back().first;
-    for (const auto& [depth, e] : d)
-      if ((acc += e) >= 0.5 * e_hit[i]) {
-        t = depth;
-        break;
-      }
-    set.lights[i].position = map.point + set.lights[i].direction * t;
-  }
-  set.origin = map.point;
+  lights::place_by_depth(set, grid, map.point, [&](int x, int y) { return double(map.depth.at(x, y, 0)); });
   set.method = "fusion-" + set.method;
   return set;
 }

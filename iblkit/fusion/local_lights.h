@@ -2,13 +2,10 @@
 // "Shadow handling"), and their tracking along a path of a moving object: identities kept from frame
 // to frame and positions/powers low-pass filtered, the thesis's open problem (§7, §8.1).
 //
-// Localisation: median cut (lights/) on the lat-long fused map; a light of direction d and region R
-// sits at P = x + t̃·d, t̃ the energy-weighted median of the depths t_j of R's pixels whose ray hit the
-// proxy (energy E_j = Y(L_j)·dω_j) — the median, not the mean, because a rectangular region drags dim
-// pixels at other depths along — when those pixels carry at least half of R's energy; otherwise the
-// light stays directional (no position: light through a window or an open end). The set's origin is x; a
-// renderer treats a positioned light as a point light of intensity I = E·|P − x|² (W/sr), which gives
-// back the cut's irradiance E at x.
+// Localisation: median cut (lights/) on the lat-long fused map, each light placed by its region's depths
+// (lights/place.h: the one placement rule, the energy-weighted median depth); the set's origin is the
+// map's point x, and a positioned light is a point light of intensity E·|P − x|² (W/sr), which gives back
+// the cut's irradiance E at x.
 //
 // Tracking: frame k's lights are matched to the tracks of frame k−1 by a minimum-cost assignment
 // (Hungarian method) on c = 1 − d_a·d_b + ½·|ln(Y_a/Y_b)| (direction and power), then each track is

@@ -1,4 +1,4 @@
-// Fusion probe sets (iblkit.probes/1, DESIGN.md / docs/formats.md): a proxy mesh and several HDR
+// Fusion probe sets (iblkit.probes/1, docs/formats.md): a proxy mesh and several HDR
 // probes, each with a position, an optional rotation and a depth map. Depth maps that the manifest
 // does not name are traced on the proxy with Embree and cached beside the probe.
 //

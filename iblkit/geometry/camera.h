@@ -1,4 +1,4 @@
-// The pinhole camera every renderer and evaluation uses (DESIGN.md, "Camera"): an eye looking at a
+// The pinhole camera every renderer and evaluation uses (docs/conventions.md, "Camera"): an eye looking at a
 // target, a vertical field of view and a frame of width × height pixels. Pixel (i, j) — row i, column j —
 // has its centre at the continuous position (j + ½, i + ½), row 0 at the top, in the CPU and GL
 // renderers, the near-field renderer, the lab's photographs and the fusion views alike.

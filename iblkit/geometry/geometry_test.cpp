@@ -123,7 +123,7 @@ TEST(GeometryMesh, RenderObjectsCarryTheirNormals) {
   EXPECT_TRUE(floor.has_uvs());
 }
 
-// Issue 19: Embree aborts on a ray that is not finite or beyond 1.8e18; the ray tracer refuses it first.
+// Hostile input: Embree aborts on a ray that is not finite or beyond 1.8e18; the ray tracer refuses it first.
 TEST(GeometryRayTracer, NonFiniteOrHugeRaysAreErrorsNotAborts) {
   RayTracer rt;
   rt.add(make_box({-1, -1, -1}, {1, 1, 1}, true));

@@ -1,4 +1,4 @@
-// An adaptive SH grid (issue 15 §4; Löw et al. 2009 §5.3, §6): the coefficients of a dense fine grid
+// An adaptive SH grid (docs/ilf.md "Adaptive storage"; Löw et al. 2009 §5.3, §6): the coefficients of a dense fine grid
 // (SHGrid) kept at full resolution only where a coarser level's trilinear interpolation misses them.
 // Level 0 is the fine grid, level l+1 halves level l's resolution (every 2^l-th fine point per axis,
 // the last fine point always included), up to the top level of 2 points per axis. Each level's points

@@ -6,20 +6,26 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
-#include <random>
 
 #include "iblkit/core/error.h"
 #include "iblkit/core/parallel.h"
+#include "iblkit/core/rng.h"
 #include "iblkit/ilf/build.h"
 
 namespace ibl::ilf {
+
+namespace {
+// Streams of iblkit's RNG (core/rng.h), so that the folds are the same on every standard library.
+constexpr uint64_t kFoldStream = 0x666f6c64;       // "fold": the probes' fold assignment
+constexpr uint64_t kEvaluatedStream = 0x6576616c;  // "eval": the probes the error is evaluated at
+}  // namespace
 
 std::vector<uint8_t> assign_folds(int n, int folds, uint64_t seed) {
   if (folds < 2 || folds > 255) fail(ErrorKind::Value, "cross-validation: {} folds outside [2, 255]", folds);
   std::vector<int> perm(size_t(std::max(n, 0)));
   for (int i = 0; i < n; ++i) perm[i] = i;
-  std::mt19937_64 rng(seed);
-  std::shuffle(perm.begin(), perm.end(), rng);
+  Rng rng(stream_key(seed, kFoldStream));
+  shuffle(perm.begin(), perm.end(), rng);
   std::vector<uint8_t> fold(perm.size());
   for (int i = 0; i < n; ++i) fold[perm[i]] = uint8_t(i % folds);
   return fold;
@@ -34,8 +40,8 @@ CrossValidator::CrossValidator(const GridDesc& grid, const std::vector<Vec3>& or
   for (int p = 0; p < P; ++p)
     if (valid.empty() || valid[p]) ids.push_back(p);
   if (int(ids.size()) > desc.max_evaluated) {
-    std::mt19937_64 rng(desc.seed + 1);
-    std::shuffle(ids.begin(), ids.end(), rng);
+    Rng rng(stream_key(desc.seed, kEvaluatedStream));
+    shuffle(ids.begin(), ids.end(), rng);
     ids.resize(size_t(std::max(desc.max_evaluated, 1)));
     std::sort(ids.begin(), ids.end());
   }

@@ -1,4 +1,4 @@
-// The ILF build on a cluster (issue 18, docs/ilf.md "On a cluster"): `mpirun -np N iblkit ilf build …`
+// The ILF build on a cluster (docs/ilf.md "On a cluster"): `mpirun -np N iblkit ilf build …`
 // runs build_shgrid's phases split between the N processes of an MPI job and gives the serial build's
 // grid (to float rounding). Ranks own contiguous ranges of direction blocks; each reads a disjoint
 // slice of the probe frames, sends every block's samples to its owner (MPI_Alltoallv), cross-validates

@@ -1,4 +1,4 @@
-// The regular grid of an SH grid (DESIGN.md, .shgrid): point (i,j,k) sits at
+// The regular grid of an SH grid (docs/formats.md, .shgrid): point (i,j,k) sits at
 // min + (max − min)·(i/(nx−1), j/(ny−1), k/(nz−1)); linear index (k·ny + j)·nx + i.
 #pragma once
 #include <cstdint>

@@ -1,4 +1,4 @@
-// Probe sequences (iblkit.sequence/1, DESIGN.md): a manifest of probe images and the positions they
+// Probe sequences (iblkit.sequence/1, docs/formats.md): a manifest of probe images and the positions they
 // were captured at, as Löw et al. 2009 [1] capture them with a mirror ball on a translation stage.
 //
 // [1] J. Löw, A. Ynnerman, P. Larsson, J. Unger. HDR light probe sequence resampling for realtime

@@ -1,6 +1,6 @@
 // An SH grid ([1] §3–4): SH coefficients of the incident radiance at the points of a regular grid,
 // with trilinear lookup and the diffuse and Phong-glossy responses of [1] §4. File format .shgrid
-// (DESIGN.md, docs/formats.md): line 1 "IBLKIT-SHGRID 1", line 2 a JSON header padded with spaces so
+// (docs/formats.md): line 1 "IBLKIT-SHGRID 1", line 2 a JSON header padded with spaces so
 // that the data starts at a multiple of 64 bytes, then little-endian float32 values at index
 // (((z·ny + y)·nx + x)·K + k)·3 + c.
 #pragma once

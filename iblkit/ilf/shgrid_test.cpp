@@ -166,7 +166,7 @@ TEST(IlfAccumulate, BlockProductMatchesNaiveSum) {
     }
 }
 
-// Issue 19: the lookup is defined for any input, and a header cannot make the reader allocate what
+// Hostile input: the lookup is defined for any input, and a header cannot make the reader allocate what
 // the file does not hold or accept a volume beyond the supported range.
 TEST(SHGrid, LookupOfANonFinitePointIsAnErrorAndFarPointsClamp) {
   SHGrid g(small_grid(), 2);

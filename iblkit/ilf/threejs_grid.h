@@ -14,7 +14,7 @@
 //    copy of its first and last data slice, so that the trilinear filter never blends two
 //    sub-volumes. Texel (x, y, z) at ((z·ny + y)·nx + x)·4.
 //  - the coefficients are radiance in the orthonormal real basis of SphericalHarmonics3 (iblkit's own,
-//    DESIGN.md), 3 bands; the shader turns them into irradiance E(n) = Σ Â_l c_lm Y_lm(n) (π, 2π/3, π/4),
+//    docs/conventions.md), 3 bands; the shader turns them into irradiance E(n) = Σ Â_l c_lm Y_lm(n) (π, 2π/3, π/4),
 //    the same as iblkit's `ilf query`. Grids of more bands are truncated to 3 (the bands above carry
 //    no or little irradiance: Â_3 = 0, Â_4 = π/24).
 #pragma once

@@ -1,4 +1,4 @@
-// The lab's exact answers: checks listed in issue 4.
+// The lab's exact answers (docs/lab.md).
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -79,7 +79,7 @@ Scene disc_light(double R, double h, Vec3 L) {
   return s;
 }
 
-// Issue 19: positions entering the lab are checked before any ray reaches Embree.
+// Hostile input: positions entering the lab are checked before any ray reaches Embree.
 TEST(LabCapture, NonFiniteOrFarPositionsAreErrors) {
   Scene s = uniform_sky({1, 1, 1});
   CaptureDesc d;

@@ -13,8 +13,8 @@
 #pragma once
 #include <cstdint>
 
+#include "iblkit/core/rng.h"
 #include "iblkit/core/vec.h"
-#include "iblkit/lab/rng.h"
 #include "iblkit/lab/scene.h"
 
 namespace ibl::lab {

@@ -14,12 +14,12 @@
 #include "iblkit/core/check.h"
 #include "iblkit/core/error.h"
 #include "iblkit/core/json_file.h"
+#include "iblkit/core/rng.h"
 #include "iblkit/geometry/mesh_io.h"
 #include "iblkit/ilf/sequence.h"
 #include "iblkit/io/draw.h"
 #include "iblkit/io/image_io.h"
 #include "iblkit/io/tonemap.h"
-#include "iblkit/lab/rng.h"
 
 namespace ibl::lab {
 

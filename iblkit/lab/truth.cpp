@@ -6,9 +6,9 @@
 #include "iblkit/core/check.h"
 #include "iblkit/core/error.h"
 #include "iblkit/core/parallel.h"
+#include "iblkit/core/rng.h"
 #include "iblkit/lab/capture.h"
 #include "iblkit/lab/radiance.h"
-#include "iblkit/lab/rng.h"
 #include "iblkit/sh/project.h"
 
 namespace ibl::lab {

@@ -4,8 +4,8 @@
 
 #include "iblkit/core/error.h"
 #include "iblkit/core/parallel.h"
+#include "iblkit/core/rng.h"
 #include "iblkit/lab/radiance.h"
-#include "iblkit/lab/rng.h"
 
 namespace ibl::lab {
 

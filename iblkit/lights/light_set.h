@@ -2,7 +2,7 @@
 // the lat-long grid the methods work on, shadow-map ranking and minimum-separation merging.
 //
 // A directional light is (direction towards the light, irradiance it delivers at normal incidence);
-// its radiance is irradiance / solid angle (DESIGN.md).
+// its radiance is irradiance / solid angle (docs/conventions.md, "Directional lights").
 //
 // References
 //  [1] Debevec, "A median cut algorithm for light probe sampling", SIGGRAPH 2005 poster.
@@ -10,6 +10,8 @@
 //      real-time augmented reality", GRAPP 2007 (../shared/papers/001_…).
 //  [3] Pedersen, "Fusing environment maps for IBL in large scenes", 2008, §5.3.1 (../shared/papers/003_…).
 #pragma once
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -47,6 +49,19 @@ struct LightSet {
   // A light with a position is then a point light of intensity irradiance·|position − origin|² (W/sr).
   std::optional<Vec3> origin;
 };
+
+// The irradiance light `l` of `set` delivers on a surface at x with unit normal n (no visibility): a
+// directional light E·max(0, n·d); a positioned light (its position and the set's origin known) the point
+// light of intensity E·|position − origin|², which gives back E at the origin (docs/conventions.md,
+// "Directional lights"). The one rule for fusion's localised lights and the GL compositor's hard lights.
+inline Vec3 irradiance_at(const LightSet& set, const Light& l, Vec3 x, Vec3 n) {
+  if (!l.position || !set.origin) return l.irradiance * std::max(0.0, dot(n, l.direction));
+  const Vec3 v = *l.position - x;
+  const double r2 = dot(v, v);
+  if (!(r2 > 0)) return {};
+  const Vec3 c = *l.position - *set.origin;
+  return l.irradiance * (dot(c, c) / r2 * std::max(0.0, dot(n, v) / std::sqrt(r2)));
+}
 
 // Sum of the lights' irradiance (RGB) — equals ∫ L dω of the probe for every cut.
 Vec3 total_irradiance(const LightSet& set);

@@ -1,5 +1,7 @@
 #include "iblkit/render/frame.h"
 
+#include <fmt/format.h>
+
 #include "iblkit/core/error.h"
 
 namespace ibl::render {
@@ -9,9 +11,7 @@ void check_objects(const FrameDesc& d) {
   for (size_t i = 0; i < d.objects.size(); ++i) {
     const geometry::TriMesh* m = d.objects[i].mesh;
     if (!m) fail(ErrorKind::Value, "object {} has no mesh", i);
-    const Vec3 a = d.objects[i].material.albedo;
-    if (!is_finite(a) || a.x < 0 || a.y < 0 || a.z < 0 || a.x > 1 || a.y > 1 || a.z > 1)
-      fail(ErrorKind::Value, "object {}: albedo ({}, {}, {}) must lie in [0, 1] per channel", i, a.x, a.y, a.z);
+    check_material(d.objects[i].material, fmt::format("object {}", i));
     if (!m->has_normals() && m->vertex_count() > 0)
       fail(ErrorKind::Value,
            "object {}: its mesh has {} normals for {} vertices (geometry::with_normals gives a mesh its shading "

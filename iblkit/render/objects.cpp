@@ -15,6 +15,8 @@ geometry::TriMesh make_object(const ObjectDesc& desc) {
     fail(ErrorKind::Value, "object size {} must be > 0 for the {}", size, scene);
   require_point("object position", desc.at);
   require_number("object size", size, 0, kMaxCoordinate);
+  if (scene == "blob" && (desc.triangles < 100 || desc.triangles > 5000000))
+    fail(ErrorKind::Value, "blob triangles {} must lie in 100..5000000", desc.triangles);
   geometry::TriMesh object;
   if (scene == "blob") {
     object = geometry::make_blob(desc.triangles, size);
@@ -32,6 +34,7 @@ geometry::TriMesh make_object(const ObjectDesc& desc) {
     object.transform(size / extent, {0, 0, 0});
   }
   object.transform(1.0, desc.at);
+  if (object.triangle_count() == 0) fail(ErrorKind::Value, "{}: the mesh has no triangles", scene);
   return object;
 }
 

@@ -17,8 +17,11 @@ struct ObjectDesc {
   Vec3 at;                     // where the object's centre goes (not used for a file kept as it is)
 };
 
-// The object with its shading normals: a mesh file's break at creases over 40° (geometry::with_normals),
+// The one object maker: the blob, sphere or mesh file that `iblkit render` shows, `composite` inserts
+// and the lab photographs as its truth (their defaults differ: augment/run_composite.h). With its shading
+// normals: a mesh file's break at creases over 40° (geometry::with_normals),
 // centred on the origin and scaled to `size` before it moves to `at`.
+// Throws ibl::Error on a bad size, position, triangle count, file or an empty mesh.
 geometry::TriMesh make_object(const ObjectDesc& desc);
 
 // True when the object reaches outside the volume of L's SH grid (lookups there clamp to the grid's

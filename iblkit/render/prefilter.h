@@ -25,7 +25,7 @@ namespace ibl::render {
 
 struct GlossyMap {
   double exponent = 20;  // Phong exponent s of the lobe the map is convolved with
-  Image latlong;         // RGB, 2H × H, G_s(r) for r through each pixel centre (DESIGN.md lat-long)
+  Image latlong;         // RGB, 2H × H, G_s(r) for r through each pixel centre (docs/conventions.md lat-long)
 };
 
 // Rows of the map for exponent s (the rule above).

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "iblkit/core/check.h"
+#include "iblkit/core/error.h"
 #include "iblkit/sh/basis.h"
 #include "iblkit/sh/convolve.h"
 
@@ -77,6 +79,18 @@ Vec3 shade(const Lighting& lighting, const Material& m, Vec3 p, Vec3 n, Vec3 v, 
   Vec3 out = m.albedo * E * (1.0 / kPi) + m.specular * G;
   // SH ringing can make a few values negative; light is never negative.
   return {std::max(0.0, out.x), std::max(0.0, out.y), std::max(0.0, out.z)};
+}
+
+void check_material(const Material& m, const std::string& who) {
+  const Vec3 a = m.albedo, k = m.specular;
+  for (int c = 0; c < 3; ++c)
+    if (!(a[c] >= 0 && a[c] <= 1 && k[c] >= 0 && k[c] <= 1))
+      fail(ErrorKind::Value, "{}: albedo ({}, {}, {}) and gloss ({}, {}, {}) must lie in [0, 1] per channel", who, a.x,
+           a.y, a.z, k.x, k.y, k.z);
+  if (!(m.exponent >= 1 && m.exponent <= 1e4))
+    fail(ErrorKind::Value, "{}: glossy exponent {} must lie in 1..10000", who, m.exponent);
+  if (m.texture && (m.texture->empty() || m.texture->channels() < 3))
+    fail(ErrorKind::Value, "{}: the texture must be an RGB image", who);
 }
 
 Vec3 texture_albedo(const Image& texture, Vec2 uv) {

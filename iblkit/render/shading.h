@@ -18,6 +18,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "iblkit/core/image.h"
@@ -46,6 +47,11 @@ struct Material {
   // Exponent of the Phong lobe that filters SH and prefiltered maps for this material.
   double environment_exponent() const { return lobe == Lobe::BlinnPhong ? exponent / 4 : exponent; }
 };
+
+// The one check of a material, for every renderer and compositor: albedo and glossy weight finite and in
+// [0, 1] per channel, the lobe's exponent in [1, 10000], a texture (when given) a non-empty RGB image.
+// `who` starts the message ("object", "object 2"). Throws ibl::Error (ErrorKind::Value).
+void check_material(const Material& m, const std::string& who = "object");
 
 // The albedo texture's value at uv (the lookup both renderers make).
 Vec3 texture_albedo(const Image& texture, Vec2 uv);

@@ -1,6 +1,6 @@
 // Real spherical harmonics: basis evaluation, Gauss–Legendre nodes, exact quadrature on the sphere.
 //
-// Convention (DESIGN.md, docs/conventions.md "Spherical harmonics"): real, orthonormal
+// Convention (docs/conventions.md, "Spherical harmonics"): real, orthonormal
 // (∫ Y_lm² dω = 1), no Condon–Shortley phase, index k = l(l+1)+m, z the polar axis of the
 // formulas, evaluated on world directions as they are: Y_1,−1 = c₁ y, Y_10 = c₁ z, Y_11 = c₁ x with
 // c₁ = √(3/4π) — the basis of [1], [2], three.js and (up to the sign of odd m) Filament.

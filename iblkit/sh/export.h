@@ -1,5 +1,5 @@
 // Export of 3-band SH radiance coefficients into other engines' layouts (docs/formats.md). Each is
-// a conversion of iblkit's coefficients (DESIGN.md: real, orthonormal, no Condon–Shortley phase,
+// a conversion of iblkit's coefficients (docs/conventions.md: real, orthonormal, no Condon–Shortley phase,
 // world axes +Y up, right-handed — the same axes as three.js, Filament and glTF; but Filament's cmgen
 // puts a lat-long probe into its world turned by 90° about +Y relative to iblkit and three.js, see
 // filament_from_iblkit):

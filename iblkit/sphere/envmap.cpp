@@ -182,6 +182,37 @@ std::vector<const float*> prefilter_poles(const Image& src, std::vector<float>* 
   return rows;
 }
 
+// Pass 3 of resample(): each output pixel of row y is the mean of its sub-samples (`owner`, ascending).
+void average_by_owner(const float* vals, const int* owner, int count, int nc, Image* out, int y) {
+  if (nc == 3) {
+    for (int k = 0; k < count;) {
+      int x = owner[k], m = 0;
+      float a0 = 0, a1 = 0, a2 = 0;
+      for (; k < count && owner[k] == x; ++k, ++m) {
+        const float* v = vals + static_cast<size_t>(k) * 3;
+        a0 += v[0];
+        a1 += v[1];
+        a2 += v[2];
+      }
+      float* o = out->pixel(x, y);
+      float inv_m = 1.0f / m;
+      o[0] = a0 * inv_m;
+      o[1] = a1 * inv_m;
+      o[2] = a2 * inv_m;
+    }
+    return;
+  }
+  std::vector<float> acc(static_cast<size_t>(nc));
+  for (int k = 0; k < count;) {
+    int x = owner[k], m = 0;
+    std::fill(acc.begin(), acc.end(), 0.0f);
+    for (; k < count && owner[k] == x; ++k, ++m)
+      for (int c = 0; c < nc; ++c) acc[static_cast<size_t>(c)] += vals[static_cast<size_t>(k) * nc + c];
+    float* o = out->pixel(x, y);
+    for (int c = 0; c < nc; ++c) o[c] = acc[static_cast<size_t>(c)] / m;
+  }
+}
+
 }  // namespace
 
 Image resample(const EnvMap& src, const Mapping& dst, const ResampleDesc& desc) {
@@ -309,33 +340,7 @@ Image resample(const EnvMap& src, const Mapping& dst, const ResampleDesc& desc) 
     } else {
       for (int k = 0; k < count; ++k) src.sample({dx[k], dy[k], dz[k]}, vals.data() + static_cast<size_t>(k) * nc);
     }
-    if (nc == 3) {
-      for (int k = 0; k < count;) {
-        int x = owner[k], m = 0;
-        float a0 = 0, a1 = 0, a2 = 0;
-        for (; k < count && owner[k] == x; ++k, ++m) {
-          const float* v = vals.data() + static_cast<size_t>(k) * 3;
-          a0 += v[0];
-          a1 += v[1];
-          a2 += v[2];
-        }
-        float* o = out.pixel(x, y);
-        float inv_m = 1.0f / m;
-        o[0] = a0 * inv_m;
-        o[1] = a1 * inv_m;
-        o[2] = a2 * inv_m;
-      }
-      return;
-    }
-    std::vector<float> acc(nc);
-    for (int k = 0; k < count;) {
-      int x = owner[k], m = 0;
-      std::fill(acc.begin(), acc.end(), 0.0f);
-      for (; k < count && owner[k] == x; ++k, ++m)
-        for (int c = 0; c < nc; ++c) acc[c] += vals[static_cast<size_t>(k) * nc + c];
-      float* o = out.pixel(x, y);
-      for (int c = 0; c < nc; ++c) o[c] = acc[c] / m;
-    }
+    average_by_owner(vals.data(), owner.data(), count, nc, &out, y);
   });
   return out;
 }

@@ -1,5 +1,5 @@
 // Direction <-> pixel mappings of the sphere, with exact per-pixel solid angles.
-// Conventions (docs/conventions.md, DESIGN.md):
+// Conventions (docs/conventions.md):
 //  - lat-long: θ = π v from +Y, u = atan2(d.z, d.x)/(2π) + 0.5, d = (−sinθ cos2πu, cosθ, −sinθ sin2πu).
 //  - mirror ball: orthographic view of a chrome ball from +Z (camera looks along −Z); the disc fills the
 //    image; the centre reflects +Z, the rim −Z; every pixel in the disc covers 4π/(π r²) sr per unit
@@ -30,7 +30,7 @@ std::optional<MappingKind> find_mapping(std::string_view name);  // nullopt for 
 // Throws ibl::Error "[what: ]unknown mapping 'x' (use latlong, …)" for an unknown name.
 MappingKind parse_mapping(std::string_view name, std::string_view what = {});
 
-// Cube faces in the DESIGN.md order.
+// Cube faces in docs/conventions.md's order.
 enum class CubeFace { PX = 0, NX, PY, NY, PZ, NZ };
 // Direction through face texel (s,t) ∈ [−1,1]² (not normalised: the point on the unit cube).
 Vec3 cube_face_point(int face, double s, double t);

@@ -26,7 +26,7 @@ std::vector<Mapping> all_mappings() {
 
 TEST(Mapping, LatLongMatchesDesignFormula) {
   Mapping m(MappingKind::LatLong, 360, 180);
-  // u = atan2(d.z, d.x)/(2π) + 0.5 and θ = π v from +Y (DESIGN.md).
+  // u = atan2(d.z, d.x)/(2π) + 0.5 and θ = π v from +Y (docs/conventions.md).
   Vec3 d;
   ASSERT_TRUE(m.to_direction(0.25 * 360, 0.5 * 180, &d));  // u = 0.25: φ = π/2 → d = (0, 0, −1)
   EXPECT_NEAR(d.x, 0, 1e-12);
@@ -78,7 +78,7 @@ TEST(Mapping, RoundTripEveryMapping) {
     }
 }
 
-// Issue 19: odd-sized mirror balls, whose middle column touches the disc at its top and bottom
+// Hostile input: odd-sized mirror balls, whose middle column touches the disc at its top and bottom
 // edge, once summed to more than 4π (a 1×1 ball to 16 sr).
 TEST(Mapping, OddMirrorBallsSumToFourPi) {
   for (int n : {1, 3, 5, 9}) {
@@ -142,7 +142,7 @@ TEST(Mapping, SolidAngleMatchesBruteForce) {
   }
 }
 
-// The mirror ball's equal-weight property (DESIGN.md): every pixel fully inside the disc covers
+// The mirror ball's equal-weight property (docs/conventions.md): every pixel fully inside the disc covers
 // 4π/(π r²) steradians per unit image area.
 TEST(Mapping, MirrorBallEqualSolidAngle) {
   Mapping m(MappingKind::MirrorBall, 250, 250);

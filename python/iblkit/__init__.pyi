@@ -178,16 +178,18 @@ def render(light: object, mesh: Optional[TriMesh] = None, camera: Optional[Camer
            mapping: str = "latlong", coverage: bool = False,
            progress: Progress = None) -> Union[np.ndarray, Tuple[np.ndarray, np.ndarray]]: ...
 
-class LocalLight:
+class LocalRadiance:
     map: np.ndarray
     centre: Vec3
     source: str
     def __init__(self, map: ArrayLike, centre: ArrayLike, depth: Optional[ArrayLike] = None) -> None: ...
     @staticmethod
-    def from_grid(grid: ilf.SHGrid, at: ArrayLike, size: int = 64) -> LocalLight: ...
+    def from_grid(grid: ilf.SHGrid, at: ArrayLike, size: int = 64) -> LocalRadiance: ...
     @staticmethod
-    def from_probes(probe_set: ProbeSet, at: ArrayLike, size: int = 128) -> LocalLight: ...
-    def as_median_cut(self, count: int) -> LocalLight: ...
+    def from_probes(probe_set: ProbeSet, at: ArrayLike, size: int = 128) -> LocalRadiance: ...
+    def as_median_cut(self, count: int) -> LocalRadiance: ...
+
+LocalLight = LocalRadiance  # the earlier name
 
 class CompositeResult:
     composite: np.ndarray
@@ -200,10 +202,11 @@ class CompositeResult:
     warnings: list
 
 def composite(photo: ArrayLike, camera: Camera, object: TriMesh, probes: Optional[str] = None,
-              light: Union[None, str, LocalLight] = None, proxy: Union[None, str, TriMesh] = None,
+              light: Union[None, str, LocalRadiance] = None, proxy: Union[None, str, TriMesh] = None,
               at_probe: Optional[ArrayLike] = None, probe_depth: str = "", albedo: ArrayLike = (0.7, 0.7, 0.7),
               median_cut: int = 0, light_samples: int = 96, object_samples: int = 1024, bounce_samples: int = 64,
               triangle_samples: int = 64, pixel_samples: int = 2, seed: int = 1, shadows: bool = True,
+              backend: str = "cpu", gl_lights: int = 16, gl_threshold: float = 8.0, gl_visibility: int = -1,
               progress: Progress = None) -> CompositeResult: ...
 def measure_composite(photo: ArrayLike, composite: ArrayLike, truth: ArrayLike, mask: ArrayLike, threshold: float = 0.02) -> dict: ...
 

@@ -1,5 +1,5 @@
 // augment/: compositing a virtual object into a photograph (differential rendering), as
-// `iblkit composite`; the captured light (LocalLight) from files, an SH grid or fused probes.
+// `iblkit composite`; the captured light (LocalRadiance) from files, an SH grid or fused probes.
 #include "common.h"
 
 #include <fmt/format.h>
@@ -8,11 +8,13 @@
 #include "iblkit/augment/light.h"
 #include "iblkit/augment/load.h"
 #include "iblkit/augment/measure.h"
+#include "iblkit/augment/run_composite.h"
 #include "iblkit/core/check.h"
 #include "iblkit/fusion/probe_set.h"
 #include "iblkit/geometry/camera_io.h"
 #include "iblkit/geometry/mesh_io.h"
 #include "iblkit/ilf/shgrid.h"
+#include "iblkit/render/shading.h"
 
 namespace iblpy {
 
@@ -23,21 +25,21 @@ namespace ag = ibl::augment;
 }  // namespace
 
 void init_augment(py::module_& m) {
-  py::class_<ag::LocalLight>(
-      m, "LocalLight",
+  py::class_<ag::LocalRadiance>(
+      m, "LocalRadiance",
       "The captured light of a local scene as a composite uses it: a lat-long radiance map seen from `centre`.")
       .def(py::init([](py::handle map, py::handle centre, py::object depth) {
-             ag::LocalLight l;
-             ibl::Image img = to_checked_image(map, "LocalLight: map");
+             ag::LocalRadiance l;
+             ibl::Image img = to_checked_image(map, "LocalRadiance: map");
              ibl::sphere::Mapping mp = mapping_of("latlong", img.width(), img.height());
              l.map = ibl::sphere::EnvMap(std::move(img), mp);
-             l.centre = to_vec3(centre, "LocalLight: centre");
-             ibl::require_point("LocalLight: centre", l.centre);
+             l.centre = to_vec3(centre, "LocalRadiance: centre");
+             ibl::require_point("LocalRadiance: centre", l.centre);
              if (!depth.is_none()) {
-               l.depth = to_image(depth, "LocalLight: depth");
+               l.depth = to_image(depth, "LocalRadiance: depth");
                if (l.depth.width() != l.map.image.width() || l.depth.height() != l.map.image.height() ||
                    l.depth.channels() != 1)
-                 throw py::value_error("LocalLight: depth must be (H, W) of the map's size");
+                 throw py::value_error("LocalRadiance: depth must be (H, W) of the map's size");
              }
              l.source = "probe";
              return l;
@@ -49,7 +51,8 @@ void init_augment(py::module_& m) {
           [](const ibl::ilf::SHGrid& g, py::handle at, int size) {
             return ag::light_from_grid(g, to_vec3(at, "from_grid: at"), size);
           },
-          py::arg("grid"), py::arg("at"), py::arg("size") = 64, "An SH grid's radiance at `at` as a 2·size × size map.")
+          py::arg("grid"), py::arg("at"), py::arg("size") = ag::LightInput{}.grid_map_size,
+          "An SH grid's radiance at `at` as a 2·size × size map.")
       .def_static(
           "from_probes",
           [](const ibl::fusion::ProbeSet& s, py::handle at, int size) {
@@ -57,13 +60,16 @@ void init_augment(py::module_& m) {
             py::gil_scoped_release nogil;
             return ag::light_from_probes(s, x, size);
           },
-          py::arg("probe_set"), py::arg("at"), py::arg("size") = 128, "A probe set fused at `at`.")
+          py::arg("probe_set"), py::arg("at"), py::arg("size") = ag::LightInput{}.fused_map_size,
+          "A probe set fused at `at`.")
       .def("as_median_cut", &ag::as_median_cut, py::arg("count"),
            "The baseline of `count` median-cut lights, each in one texel.")
       .def_property_readonly(
-          "map", [](const ag::LocalLight& l) { return to_array(l.map.image); }, "(H, 2H, 3) lat-long radiance.")
-      .def_property_readonly("centre", [](const ag::LocalLight& l) { return vec3_tuple(l.centre); })
-      .def_readonly("source", &ag::LocalLight::source);
+          "map", [](const ag::LocalRadiance& l) { return to_array(l.map.image); }, "(H, 2H, 3) lat-long radiance.")
+      .def_property_readonly("centre", [](const ag::LocalRadiance& l) { return vec3_tuple(l.centre); })
+      .def_readonly("source", &ag::LocalRadiance::source);
+
+  m.attr("LocalLight") = m.attr("LocalRadiance");  // the name before 2026-12 (kept for old scripts)
 
   py::class_<ag::CompositeResult>(m, "CompositeResult", "The composite and its layers (float32 arrays) and statistics.")
       .def_property_readonly(
@@ -91,77 +97,89 @@ void init_augment(py::module_& m) {
                              })
       .def_readonly("warnings", &ag::CompositeResult::warnings);
 
-  static const ag::CompositeDesc kDefaults;  // the sample counts default to the library's (and the CLI's)
+  static const ag::CompositeJob kJob;  // every default is the library's (and so the CLI's)
+  static const ag::CompositeDesc& kDefaults = kJob.desc;
   m.def(
       "composite",
       [](py::handle photo, ibl::geometry::Camera camera, const ibl::geometry::TriMesh& object, py::object probes,
          py::object light, py::object proxy, py::object at_probe, const std::string& probe_depth, py::handle albedo,
          int median_cut, int light_samples, int object_samples, int bounce_samples, int triangle_samples,
-         int pixel_samples, int seed, bool shadows, py::object progress) {
+         int pixel_samples, uint64_t seed, bool shadows, const std::string& backend, int gl_lights, double gl_threshold,
+         int gl_visibility, py::object progress) {
         ibl::Image ph = to_checked_image(photo, "composite: photo");
         camera.width = ph.width();
         camera.height = ph.height();
         ibl::geometry::validate_camera(camera, "composite: camera");
-        ibl::Vec3 a = to_vec3(albedo, "composite: albedo");
-        ibl::Vec3 lo, hi;
-        object.bounds(&lo, &hi);
-        ag::LocalLight L;
-        ibl::geometry::TriMesh prox;
-        std::vector<std::string> warnings;
-        if (!light.is_none() && py::isinstance<ag::LocalLight>(light)) {
-          L = light.cast<ag::LocalLight>();
-          if (proxy.is_none()) throw py::value_error("composite: a LocalLight needs proxy= (a TriMesh or a mesh file)");
-          prox = py::isinstance<py::str>(proxy) ? ibl::geometry::read_mesh(proxy.cast<std::string>())
-                                                : proxy.cast<ibl::geometry::TriMesh>();
-        } else {  // files, as the CLI takes them
-          ag::LightInput li;
-          if (!probes.is_none()) li.probes = py::str(probes);
-          if (!light.is_none()) li.light = py::str(light);
-          if (!proxy.is_none()) li.proxy = py::str(proxy);
-          if (!at_probe.is_none()) li.at_probe = to_vec3(at_probe, "composite: at_probe");
-          li.probe_depth = probe_depth;
-          py::gil_scoped_release nogil;
-          ag::LoadedLight ll = ag::load_light(li, lo, hi);
-          L = std::move(ll.light);
-          prox = std::move(ll.proxy);
-          warnings = std::move(ll.warnings);
-        }
-        if (median_cut > 0) L = ag::as_median_cut(L, median_cut);
-        ag::CompositeDesc d;
+        ag::CompositeJob job;
+        job.material = ibl::render::Material{to_vec3(albedo, "composite: albedo"), {0, 0, 0}};
+        ibl::render::check_material(job.material, "composite: albedo");
+        job.backend = ag::parse_backend(backend);
+        job.median_cut = median_cut;
+        ag::CompositeDesc& d = job.desc;
         d.light_samples = light_samples;
         d.object_samples = object_samples;
         d.bounce_samples = bounce_samples;
         d.triangle_samples = triangle_samples;
         d.pixel_samples = pixel_samples;
-        d.seed = static_cast<uint64_t>(seed);
+        d.seed = seed;
         d.shadows = shadows;
+        d.gl.split.lights = gl_lights;
+        d.gl.split.threshold = gl_threshold;
+        d.gl.visibility_samples = gl_visibility;
+        ag::CompositeScene scene;
+        scene.object = object;
+        if (!light.is_none() && py::isinstance<ag::LocalRadiance>(light)) {
+          scene.light.light = light.cast<ag::LocalRadiance>();
+          if (proxy.is_none())
+            throw py::value_error("composite: a LocalRadiance needs proxy= (a TriMesh or a mesh file)");
+          scene.light.proxy = py::isinstance<py::str>(proxy) ? ibl::geometry::read_mesh(proxy.cast<std::string>())
+                                                             : proxy.cast<ibl::geometry::TriMesh>();
+          if (median_cut > 0) scene.light.light = ag::as_median_cut(scene.light.light, median_cut);
+        } else {  // files, as the CLI takes them
+          if (!probes.is_none()) job.light.probes = py::str(probes);
+          if (!light.is_none()) job.light.light = py::str(light);
+          if (!proxy.is_none()) job.light.proxy = py::str(proxy);
+          if (!at_probe.is_none()) job.light.at_probe = to_vec3(at_probe, "composite: at_probe");
+          job.light.probe_depth = probe_depth;
+          ibl::Vec3 lo, hi;
+          object.bounds(&lo, &hi);
+          py::gil_scoped_release nogil;
+          scene.light = ag::load_light(job.light, lo, hi);
+          if (median_cut > 0) scene.light.light = ag::as_median_cut(scene.light.light, median_cut);
+        }
         Progress pr(progress);
         d.progress = pr.fn();
-        ag::CompositeResult r;
+        ag::CompositeRun run;
         {
           py::gil_scoped_release nogil;
-          r = ag::composite(ph, camera, prox, L, object, a, d);
+          run = ag::run_composite(ph, camera, job, scene);
         }
         pr.rethrow();
-        r.warnings.insert(r.warnings.begin(), warnings.begin(), warnings.end());
-        return r;
+        run.result.warnings.insert(run.result.warnings.end(), run.notes.begin(), run.notes.end());
+        return run.result;
       },
       py::arg("photo"), py::arg("camera"), py::arg("object"), py::arg("probes") = py::none(),
       py::arg("light") = py::none(), py::arg("proxy") = py::none(), py::arg("at_probe") = py::none(),
-      py::arg("probe_depth") = "", py::arg("albedo") = py::make_tuple(0.7, 0.7, 0.7), py::arg("median_cut") = 0,
-      py::arg("light_samples") = kDefaults.light_samples, py::arg("object_samples") = kDefaults.object_samples,
-      py::arg("bounce_samples") = kDefaults.bounce_samples, py::arg("triangle_samples") = kDefaults.triangle_samples,
-      py::arg("pixel_samples") = kDefaults.pixel_samples, py::arg("seed") = 1, py::arg("shadows") = true,
-      py::arg("progress") = py::none(),
+      py::arg("probe_depth") = kJob.light.probe_depth, py::arg("albedo") = vec3_tuple(kJob.material.albedo),
+      py::arg("median_cut") = kJob.median_cut, py::arg("light_samples") = kDefaults.light_samples,
+      py::arg("object_samples") = kDefaults.object_samples, py::arg("bounce_samples") = kDefaults.bounce_samples,
+      py::arg("triangle_samples") = kDefaults.triangle_samples, py::arg("pixel_samples") = kDefaults.pixel_samples,
+      py::arg("seed") = kDefaults.seed, py::arg("shadows") = kDefaults.shadows,
+      py::arg("backend") = std::string(ag::backend_name(kJob.backend)),
+      py::arg("gl_lights") = kDefaults.gl.split.lights, py::arg("gl_threshold") = kDefaults.gl.split.threshold,
+      py::arg("gl_visibility") = kDefaults.gl.visibility_samples, py::arg("progress") = py::none(),
       R"doc(Composites `object` (a TriMesh, e.g. TriMesh.object(at=…)) into the photograph (H, W, 3) seen by
 `camera` (its size becomes the photograph's), as `iblkit composite` (Debevec 1998): a CompositeResult
 with the composite, mask, difference, albedo and render layers.
 
 The captured light, as the CLI takes it: probes= an iblkit.probes/1 manifest; or light= an SH grid
-(.shgrid) or a probe image file (with at_probe=) and proxy= a mesh file; or light= a LocalLight with
+(.shgrid) or a probe image file (with at_probe=) and proxy= a mesh file; or light= a LocalRadiance with
 proxy= a TriMesh or mesh file. median_cut > 0: the N-light baseline. Sampling: light_samples,
 object_samples, bounce_samples (0: no bounce), triangle_samples, pixel_samples, seed; shadows=False
-pastes the object without its shadow. Releases the GIL; progress(stage, fraction).)doc");
+pastes the object without its shadow. backend= "cpu" (the ray-traced reference), "gl" (OpenGL: shadow
+maps and the soft sphere term; gl_lights, gl_threshold, gl_visibility as --gl-lights, --gl-threshold,
+--gl-visibility) or "auto". Every default is the library's (augment::CompositeJob). Releases the GIL;
+progress(stage, fraction).)doc");
 
   m.def(
       "measure_composite",

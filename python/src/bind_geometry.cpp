@@ -5,13 +5,14 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
-#include "iblkit/augment/object.h"
+#include "iblkit/augment/run_composite.h"
 #include "iblkit/core/check.h"
 #include "iblkit/core/error.h"
 #include "iblkit/geometry/camera.h"
 #include "iblkit/geometry/camera_io.h"
 #include "iblkit/geometry/mesh.h"
 #include "iblkit/geometry/mesh_io.h"
+#include "iblkit/render/objects.h"
 
 namespace iblpy {
 
@@ -154,15 +155,13 @@ UVs (V, 2). The array properties are copies.)doc")
       .def_static(
           "object",
           [](const std::string& kind, double size, int triangles, py::handle at) {
-            ibl::augment::ObjectDesc d;
-            d.kind = kind;
-            d.size = size;
-            d.triangles = triangles;
-            d.at = to_vec3(at, "object: at");
+            const ibl::render::ObjectDesc d{kind, size, triangles, to_vec3(at, "object: at")};
             py::gil_scoped_release nogil;
-            return ibl::augment::make_object(d);
+            return ibl::render::make_object(d);
           },
-          py::arg("kind") = "blob", py::arg("size") = 0.3, py::arg("triangles") = 20000,
+          py::arg("kind") = ibl::augment::inserted_object_defaults().scene,
+          py::arg("size") = ibl::augment::inserted_object_defaults().size,
+          py::arg("triangles") = ibl::augment::inserted_object_defaults().triangles,
           py::arg("at") = py::make_tuple(0, 0, 0),
           R"doc(The object `iblkit composite` and `iblkit lab photograph --object` insert: "blob" (a bunny-sized
 procedural object), "sphere", or a mesh file, its largest extent `size` metres, centred at `at`.)doc");

@@ -437,12 +437,13 @@ coefficients kept at full resolution only where coarser levels miss them by more
         for (auto& r : srep.reasons) rep.skip_reasons.insert(rep.skip_reasons.begin(), r);
         return py::make_tuple(std::move(g), report_dict(rep));
       },
-      py::arg("source"), py::arg("positions") = py::none(), py::arg("grid") = 16, py::arg("bands") = 5,
-      py::arg("volume") = py::none(), py::arg("mapping") = "auto", py::arg("dead_angle") = 0.0,
-      py::arg("rotation") = py::none(), py::arg("repair") = "mip", py::arg("kernel_cells") = 3.0,
-      py::arg("raster_cells") = 0.5, py::arg("directions") = "auto", py::arg("memory") = "2G",
-      py::arg("skip_bad") = false, py::arg("sanitize") = false, py::arg("subsample") = py::none(),
-      py::arg("work_dir") = "", py::arg("progress") = py::none(),
+      py::arg("source"), py::arg("positions") = py::none(), py::arg("grid") = ibl::ilf::BuildDesc{}.nx,
+      py::arg("bands") = ibl::ilf::BuildDesc{}.bands, py::arg("volume") = py::none(), py::arg("mapping") = "auto",
+      py::arg("dead_angle") = 0.0, py::arg("rotation") = py::none(), py::arg("repair") = "mip",
+      py::arg("kernel_cells") = ibl::ilf::ProjectDesc{}.kernel_cells,
+      py::arg("raster_cells") = ibl::ilf::ProjectDesc{}.raster_cells, py::arg("directions") = "auto",
+      py::arg("memory") = "2G", py::arg("skip_bad") = false, py::arg("sanitize") = false,
+      py::arg("subsample") = py::none(), py::arg("work_dir") = "", py::arg("progress") = py::none(),
       R"doc(Builds an SH grid from a probe sequence, as `iblkit ilf build`; returns (SHGrid, report dict).
 
 source: an iblkit.sequence/1 manifest path (its buckets go to work_dir, default PATH.buckets, and are

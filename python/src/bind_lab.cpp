@@ -173,9 +173,10 @@ and the proxy (for load_probe_set). Returns the manifest's path.)doc");
         pr.rethrow();
         return t;
       },
-      py::arg("scene"), py::arg("position"), py::arg("size") = 128, py::arg("samples") = 4,
-      py::arg("area_samples") = 64, py::arg("bands") = 3, py::arg("normals") = py::none(), py::arg("seed") = 1,
-      py::arg("progress") = py::none(),
+      py::arg("scene"), py::arg("position"), py::arg("size") = ibl::lab::TruthDesc{}.size,
+      py::arg("samples") = ibl::lab::TruthDesc{}.samples, py::arg("area_samples") = ibl::lab::TruthDesc{}.area_samples,
+      py::arg("bands") = ibl::lab::TruthDesc{}.bands, py::arg("normals") = py::none(),
+      py::arg("seed") = static_cast<int>(ibl::lab::TruthDesc{}.seed), py::arg("progress") = py::none(),
       "The exact answers at a point, as `iblkit lab truth` (default normals: ±X, ±Y, ±Z): a Truth.");
 
   m.def(

@@ -128,12 +128,13 @@ void init_render(py::module_& m) {
         return to_array(std::move(r.color));
       },
       py::arg("light"), py::arg("mesh") = py::none(), py::arg("camera") = py::none(), py::arg("object") = "blob",
-      py::arg("at") = py::make_tuple(0, 0, 0), py::arg("size") = 0.8, py::arg("triangles") = 100000,
-      py::arg("albedo") = py::make_tuple(0.75, 0.75, 0.75), py::arg("gloss") = 0.0, py::arg("exponent") = 20.0,
-      py::arg("lobe") = "phong", py::arg("floor_size") = 6.0, py::arg("shadows") = 4, py::arg("bands") = 5,
-      py::arg("width") = 1024, py::arg("height") = 768, py::arg("fov") = 40.0,
-      py::arg("background") = py::make_tuple(0, 0, 0), py::arg("mapping") = "latlong", py::arg("coverage") = false,
-      py::arg("progress") = py::none(),
+      py::arg("at") = py::make_tuple(0, 0, 0), py::arg("size") = rd::ObjectDesc{}.size,
+      py::arg("triangles") = rd::ObjectDesc{}.triangles, py::arg("albedo") = py::make_tuple(0.75, 0.75, 0.75),
+      py::arg("gloss") = 0.0, py::arg("exponent") = rd::Material{}.exponent, py::arg("lobe") = "phong",
+      py::arg("floor_size") = 6.0, py::arg("shadows") = rd::LightingReadDesc{}.shadows,
+      py::arg("bands") = rd::LightingReadDesc{}.bands, py::arg("width") = 1024, py::arg("height") = 768,
+      py::arg("fov") = 40.0, py::arg("background") = py::make_tuple(0, 0, 0), py::arg("mapping") = "latlong",
+      py::arg("coverage") = false, py::arg("progress") = py::none(),
       R"doc(Renders an object under a lighting with the CPU reference renderer, as `iblkit render --backend cpu`:
 an (H, W, 3) float32 radiance array (with coverage=True also the (H, W) coverage).
 

@@ -141,15 +141,28 @@ def test_photograph_and_composite_match_cli(tmp_path, probe_set, scene):
     assert np.array_equal(r.composite, iblkit.read_image(str(tmp_path / "c.exr"))[..., :3])
     assert r.mask.shape == (16, 24) and r.stats["object_pixels"] > 0 and r.difference.shape == (16, 24, 3)
     assert r.albedo.shape == r.render_with.shape == r.render_without.shape == (16, 24, 3)
-    # in-memory light: the fused map at the object as a LocalLight, on the probe set's proxy
+    # in-memory light: the fused map at the object as a LocalRadiance, on the probe set's proxy
     s = iblkit.ProbeSet.load(str(probe_set))
-    L = iblkit.LocalLight.from_probes(s, (0, 0.3, 0), size=16)
+    L = iblkit.LocalRadiance.from_probes(s, (0, 0.3, 0), size=16)
     assert L.map.shape == (16, 32, 3) and L.source
     r2 = iblkit.composite(photo, cam, obj, light=L, proxy=s.proxy, **args)
     assert r2.composite.shape == (16, 24, 3)
     err = iblkit.measure_composite(photo, r.composite, with_obj, r.mask)
     assert 0 <= err["object"] < 1
-    assert iblkit.LocalLight(L.map, L.centre).centre == L.centre
+    assert iblkit.LocalRadiance(L.map, L.centre).centre == L.centre
     assert L.as_median_cut(4).map.shape == L.map.shape
     g = iblkit.ilf.SHGrid(np.zeros((2, 2, 2, 9, 3), np.float32) + 0.5, (-1, 0, -1), (1, 2, 1))
-    assert iblkit.LocalLight.from_grid(g, (0, 0.3, 0), size=8).map.shape == (8, 16, 3)
+    assert iblkit.LocalRadiance.from_grid(g, (0, 0.3, 0), size=8).map.shape == (8, 16, 3)
+    assert iblkit.LocalLight is iblkit.LocalRadiance  # the earlier name still works
+    # the GL backend through the same entry point as the CLI's --backend gl: the same bytes
+    gl_args = dict(light_samples=8, bounce_samples=2, gl_visibility=16)
+    try:
+        g1 = iblkit.composite(photo, cam, obj, probes=str(probe_set), backend="gl", **gl_args)
+    except iblkit.Unsupported as e:  # no OpenGL in this build, or no context on this machine
+        pytest.skip(f"no OpenGL context: {e}")
+    run_cli("composite", tmp_path / "photo.exr", "--eye", "0,1.2,2.4", "--target", "0,0.6,0", "--probes", probe_set, "--object", "sphere",
+            "--at", "0,0.3,0", "--samples", 8, "--bounce-samples", 2, "--backend", "gl", "--gl-visibility", 16,
+            "--out", tmp_path / "g.exr")
+    assert np.array_equal(g1.composite, iblkit.read_image(str(tmp_path / "g.exr"))[..., :3])
+    with pytest.raises(iblkit.Error, match="expected cpu, gl or auto"):
+        iblkit.composite(photo, cam, obj, probes=str(probe_set), backend="vulkan")

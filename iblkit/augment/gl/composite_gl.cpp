@@ -1,4 +1,5 @@
 #include "iblkit/augment/gl/compositor.h"
+#include "iblkit/augment/soft_visibility.h"
 
 #include <algorithm>
 #include <chrono>
@@ -6,6 +7,8 @@
 #include <fmt/format.h>
 
 #include "iblkit/augment/albedo.h"
+#include "iblkit/augment/proxy_light.h"
+#include "iblkit/augment/run_composite.h"
 #include "iblkit/core/error.h"
 #include "iblkit/render/gl/context.h"
 
@@ -15,14 +18,14 @@
 namespace ibl::augment::gl {
 
 CompositeResult composite(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy,
-                          const LocalLight& light, const geometry::TriMesh& object, const render::Material& material,
-                          const GlCompositeDesc& desc, GlFrameTiming* timing) {
+                          const LocalRadiance& light, const geometry::TriMesh& object, const render::Material& material,
+                          const CompositeDesc& desc, GlFrameTiming* timing) {
   auto t0 = std::chrono::steady_clock::now();
-  if (desc.visibility_samples < -1 || desc.visibility_samples > 65536)
-    fail(ErrorKind::Value, "visibility samples {} must lie in 0..65536 (or -1: automatic)", desc.visibility_samples);
+  if (desc.gl.visibility_samples < -1 || desc.gl.visibility_samples > 65536)
+    fail(ErrorKind::Value, "visibility samples {} must lie in 0..65536 (or -1: automatic)", desc.gl.visibility_samples);
   render::gl::Context context;
-  AlbedoEstimate est = estimate_albedo(photo, cam, proxy, light, desc.albedo_samples, desc.seed);
-  SplitDesc sd = desc.split;
+  AlbedoEstimate est = estimate_albedo(photo, cam, proxy, light, desc.light_samples, desc.seed);
+  SplitDesc sd = desc.gl.split;
   sd.lights = std::min(sd.lights, Compositor::kMaxLights);
   SplitLight split = split_light(light, proxy, sd);
   CompositeResult r;
@@ -31,10 +34,10 @@ CompositeResult composite(const Image& photo, const geometry::Camera& cam, const
     std::vector<Vec3> vis;
     // The noise a pixel shows depends on the rays per unit of the object's area: a fixed budget over the triangles.
     const int samples =
-        desc.visibility_samples >= 0
-            ? desc.visibility_samples
+        desc.gl.visibility_samples >= 0
+            ? desc.gl.visibility_samples
             : static_cast<int>(std::clamp<int64_t>(
-                  GlCompositeDesc::kVisibilityRays / std::max<int64_t>(object.triangle_count(), 1), 16, 1024));
+                  GlOptions::kVisibilityRays / std::max<int64_t>(object.triangle_count(), 1), 16, 1024));
     if (samples > 0) {
       SoftVisibilityDesc vd;
       vd.samples = samples;
@@ -69,17 +72,22 @@ CompositeResult composite(const Image& photo, const geometry::Camera& cam, const
   r.stats.albedo_over_one = est.over_one;
   r.stats.unlit = est.unlit;
   r.stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  if (est.over_one > 0)
-    r.warnings.push_back(
-        fmt::format("{} proxy pixels ({:.1f} %) have an estimated albedo > 1: the captured light is weaker there than "
-                    "the photograph says; their change is limited to what a white surface would show",
-                    est.over_one, 100.0 * est.over_one / std::max<int64_t>(1, est.proxy_pixels)));
-  if (est.unlit > 0)
-    r.warnings.push_back(fmt::format(
-        "{} proxy pixels receive no captured light in some channel: they keep the photograph's value", est.unlit));
+  r.warnings = albedo_warnings(est.proxy_pixels, est.over_one, est.unlit);
   if (r.stats.object_pixels == 0)
     r.warnings.push_back("no pixel of the photograph sees the object: check at, the eye and the target");
   return r;
 }
 
 }  // namespace ibl::augment::gl
+
+namespace ibl::augment {
+
+bool gl_backend_available(std::string* why) { return render::gl::available(why); }
+
+CompositeResult gl_backend_composite(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy,
+                                     const LocalRadiance& light, const geometry::TriMesh& object,
+                                     const render::Material& material, const CompositeDesc& desc) {
+  return gl::composite(photo, cam, proxy, light, object, material, desc);
+}
+
+}  // namespace ibl::augment

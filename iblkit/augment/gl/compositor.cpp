@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <string>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -20,6 +22,28 @@ namespace {
 using geometry::Mat4f;
 constexpr int kMaxLights = Compositor::kMaxLights;
 constexpr float kFar = 1e30f;  // a shadow-map texel nothing covers
+
+// The texture units the constructor names in the programs' samplers and draw() binds: one list for both.
+// The proxy and object passes share 0–10; the final pass binds its own three from 0.
+enum Unit : GLuint {
+  kUnitPhoto = 0,
+  kUnitAlbedo = 1,
+  kUnitGPosition = 2,
+  kUnitGNormal = 3,
+  kUnitSoft = 4,
+  kUnitSoftIrradiance = 5,
+  kUnitObjectMap = 6,
+  kUnitProxyMap = 7,
+  kUnitObjectTexture = 8,
+  kUnitObjectGlossy = 9,
+  kUnitFacingIrradiance = 10,
+  kUnitFinalProxyComposite = 0,
+  kUnitFinalObject = 1,
+  kUnitFinalPhoto = 2,
+};
+
+// The prelude of the programs that include augment_common.glsl: its array bound is the compositor's.
+std::string lights_prelude() { return fmt::format("#define MAX_LIGHTS {}\n", kMaxLights); }
 
 // Flat-shaded triangles: position, face normal, UV (0 for a mesh without UVs) and the soft light's factor
 // (composite.h's soft_visibility, smoothed over each vertex; 1 where none is given) per corner, 11 floats, so that both
@@ -172,7 +196,8 @@ Image read_texture(GLuint tex, int w, int h, int channels) {
 }  // namespace
 
 struct Compositor::Impl {
-  GlCompositeDesc desc;
+  GlOptions desc;
+  bool shadows = true, bounce = true;
   geometry::Camera cam;
   SplitLight light;
   Vec3 proxy_lo, proxy_hi;
@@ -189,6 +214,13 @@ struct Compositor::Impl {
   GLuint object_map = 0, proxy_map = 0, map_depth = 0, depth_rb = 0, ms_color = 0, ms_depth = 0;
   GLuint fb_gbuffer = 0, fb_proxy = 0, fb_object_ms = 0, fb_object = 0, fb_final = 0, fb_map = 0, query = 0;
 
+  // Every GL object it holds is released when it goes, also when the constructor throws half-way (the
+  // unique_ptr that owns it is a member, destroyed as the constructor unwinds).
+  Impl() = default;
+  Impl(const Impl&) = delete;
+  Impl& operator=(const Impl&) = delete;
+  ~Impl() { release(); }
+
   void release() {
     for (GLuint p : {prog_gbuffer, prog_depth, prog_proxy, prog_object, prog_final})
       if (p) glDeleteProgram(p);
@@ -204,6 +236,11 @@ struct Compositor::Impl {
     if (query) glDeleteQueries(1, &query);
     proxy.release();
     object.release();
+    prog_gbuffer = prog_depth = prog_proxy = prog_object = prog_final = empty_vao = query = 0;
+    photo_tex = albedo_tex = soft_tex = irr_tex = gpos = gnormal = proxy_comp = object_tex = color = diff = 0;
+    object_map = proxy_map = object_texture = object_glossy = facing_tex = 0;
+    map_depth = depth_rb = ms_color = ms_depth = 0;
+    fb_gbuffer = fb_proxy = fb_object_ms = fb_object = fb_final = fb_map = 0;
   }
 
   // The light uniforms and both shadow maps of every hard light, fitted to the object's bounding sphere at c.
@@ -217,13 +254,15 @@ struct Compositor::Impl {
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
     for (int l = 0; l < lights; ++l) {
-      const HardLight& h = light.hard[static_cast<size_t>(l)];
+      const lights::Light& h = light.hard.lights[static_cast<size_t>(l)];
+      const bool distant = !h.position;
+      const Vec3 position = h.position.value_or(Vec3{});
       geometry::Camera lc;
       lc.width = lc.height = 1;
       Mat4f vp;
       float eye_w;
       Vec3 dir = h.direction;
-      if (h.distant) {
+      if (distant) {
         lc.eye = c + dir * reach;
         lc.target = c;
         lc.up = std::abs(dir.y) > 0.99 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
@@ -235,7 +274,7 @@ struct Compositor::Impl {
         vp = geometry::mul(p, lc.view());
         eye_w = static_cast<float>(2 * R / S);
       } else {
-        lc.eye = h.position + (light.centre - h.position) * 0.01;  // off the proxy surface the light sits on
+        lc.eye = position + (light.centre - position) * 0.01;  // off the proxy surface the light sits on
         double D = length(c - lc.eye);
         lc.target = c;
         Vec3 to = (c - lc.eye) / std::max(D, 1e-12);
@@ -254,11 +293,11 @@ struct Compositor::Impl {
       const std::string i = fmt::format("[{}]", l);
       for (GLuint prog : {prog_proxy, prog_object}) {
         glProgramUniform4f(prog, glGetUniformLocation(prog, ("u_light_dir" + i).c_str()), static_cast<float>(dir.x),
-                           static_cast<float>(dir.y), static_cast<float>(dir.z), h.distant ? 0.0f : 1.0f);
-        Vec3 off = h.position - light.centre;
+                           static_cast<float>(dir.y), static_cast<float>(dir.z), distant ? 0.0f : 1.0f);
+        Vec3 off = position - light.centre;
         glProgramUniform4f(prog, glGetUniformLocation(prog, ("u_light_pos" + i).c_str()),
-                           static_cast<float>(h.position.x), static_cast<float>(h.position.y),
-                           static_cast<float>(h.position.z), static_cast<float>(dot(off, off)));
+                           static_cast<float>(position.x), static_cast<float>(position.y),
+                           static_cast<float>(position.z), static_cast<float>(dot(off, off)));
         glProgramUniform4f(prog, glGetUniformLocation(prog, ("u_light_e" + i).c_str()),
                            static_cast<float>(h.irradiance.x), static_cast<float>(h.irradiance.y),
                            static_cast<float>(h.irradiance.z), 0.0f);
@@ -271,7 +310,7 @@ struct Compositor::Impl {
       set_mat(prog_depth, "u_view_projection", vp);
       set_vec3(prog_depth, "u_map_eye", lc.eye);
       set_vec3(prog_depth, "u_map_dir", dir);
-      set_int(prog_depth, "u_map_local", h.distant ? 0 : 1);
+      set_int(prog_depth, "u_map_local", distant ? 0 : 1);
       const float far[4] = {kFar, kFar, kFar, kFar};
       for (int pass = 0; pass < 2; ++pass) {
         glNamedFramebufferTextureLayer(fb_map, GL_COLOR_ATTACHMENT0, pass == 0 ? proxy_map : object_map, 0, l);
@@ -288,9 +327,10 @@ struct Compositor::Impl {
 };
 
 Compositor::Compositor(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy,
-                       const SplitLight& light, const Image& albedo, const GlCompositeDesc& desc)
+                       const SplitLight& light, const Image& albedo, const CompositeDesc& full_desc)
     : impl_(std::make_unique<Impl>()) {
   Impl& m = *impl_;
+  const GlOptions& desc = full_desc.gl;
   if (photo.width() != cam.width || photo.height() != cam.height || albedo.width() != cam.width ||
       albedo.height() != cam.height)
     fail(ErrorKind::Value, "the photograph ({}x{}), its albedo ({}x{}) and the camera's frame ({}x{}) must agree",
@@ -301,28 +341,32 @@ Compositor::Compositor(const Image& photo, const geometry::Camera& cam, const ge
     fail(ErrorKind::Value, "shadow map size {} must lie in 16..8192", desc.shadow_map_size);
   if (desc.pcf < 0 || desc.pcf > 4) fail(ErrorKind::Value, "pcf radius {} must lie in 0..4", desc.pcf);
   if (desc.msaa < 1 || desc.msaa > 16) fail(ErrorKind::Value, "msaa {} must lie in 1..16", desc.msaa);
-  if (!(desc.cut >= 0 && desc.cut < 1)) fail(ErrorKind::Value, "soft cut-off {} must lie in [0, 1)", desc.cut);
+  if (!(desc.soft_cutoff >= 0 && desc.soft_cutoff < 1))
+    fail(ErrorKind::Value, "soft cut-off {} must lie in [0, 1)", desc.soft_cutoff);
   if (proxy.triangle_count() == 0) fail(ErrorKind::Value, "the proxy has no triangles");
-  if (light.hard.size() > static_cast<size_t>(kMaxLights))
-    fail(ErrorKind::Value, "{} hard lights: the GL compositor takes at most {}", light.hard.size(), kMaxLights);
+  if (light.hard.lights.size() > static_cast<size_t>(kMaxLights))
+    fail(ErrorKind::Value, "{} hard lights: the GL compositor takes at most {}", light.hard.lights.size(), kMaxLights);
   m.desc = desc;
+  m.shadows = full_desc.shadows;
+  m.bounce = full_desc.bounce_samples > 0;
   m.cam = cam;
   m.light = light;
   m.W = cam.width;
   m.H = cam.height;
-  m.lights = static_cast<int>(light.hard.size());
+  m.lights = static_cast<int>(light.hard.lights.size());
   proxy.bounds(&m.proxy_lo, &m.proxy_hi);
   using render::gl::build_program;
   using render::gl::ShaderStage;
   const std::vector<std::string> common = {"augment_common.glsl"};
+  const std::string prelude = lights_prelude();
   m.prog_gbuffer =
       build_program({{GL_VERTEX_SHADER, "augment_mesh.vert", ""}, {GL_FRAGMENT_SHADER, "augment_gbuffer.frag", ""}});
   m.prog_depth =
       build_program({{GL_VERTEX_SHADER, "augment_mesh.vert", ""}, {GL_FRAGMENT_SHADER, "augment_depth.frag", ""}});
   m.prog_proxy = build_program(
-      {{GL_VERTEX_SHADER, "augment_quad.vert", ""}, {GL_FRAGMENT_SHADER, "augment_proxy.frag", "", common}});
+      {{GL_VERTEX_SHADER, "augment_quad.vert", ""}, {GL_FRAGMENT_SHADER, "augment_proxy.frag", prelude, common}});
   m.prog_object = build_program(
-      {{GL_VERTEX_SHADER, "augment_mesh.vert", ""}, {GL_FRAGMENT_SHADER, "augment_object.frag", "", common}});
+      {{GL_VERTEX_SHADER, "augment_mesh.vert", ""}, {GL_FRAGMENT_SHADER, "augment_object.frag", prelude, common}});
   m.prog_final =
       build_program({{GL_VERTEX_SHADER, "augment_quad.vert", ""}, {GL_FRAGMENT_SHADER, "augment_final.frag", ""}});
   glCreateVertexArrays(1, &m.empty_vao);
@@ -388,33 +432,31 @@ Compositor::Compositor(const Image& photo, const geometry::Camera& cam, const ge
     set_int(p, "u_light_count", m.lights);
     set_int(p, "u_map_size", S);
     set_int(p, "u_pcf", desc.pcf);
-    set_int(p, "u_object_map", 6);
-    set_int(p, "u_proxy_map", 7);
-    set_int(p, "u_soft_irradiance", 5);
+    set_int(p, "u_object_map", kUnitObjectMap);
+    set_int(p, "u_proxy_map", kUnitProxyMap);
+    set_int(p, "u_soft_irradiance", kUnitSoftIrradiance);
   }
-  set_int(m.prog_object, "u_object_texture", 8);
-  set_int(m.prog_object, "u_object_glossy", 9);
-  set_int(m.prog_proxy, "u_photo", 0);
-  set_int(m.prog_proxy, "u_albedo", 1);
-  set_int(m.prog_proxy, "u_gpos", 2);
-  set_int(m.prog_proxy, "u_gnormal", 3);
-  set_int(m.prog_proxy, "u_soft", 4);
-  set_int(m.prog_proxy, "u_facing_irradiance", 10);
-  set_float(m.prog_proxy, "u_cut", desc.cut);
+  set_int(m.prog_object, "u_object_texture", kUnitObjectTexture);
+  set_int(m.prog_object, "u_object_glossy", kUnitObjectGlossy);
+  set_int(m.prog_proxy, "u_photo", kUnitPhoto);
+  set_int(m.prog_proxy, "u_albedo", kUnitAlbedo);
+  set_int(m.prog_proxy, "u_gpos", kUnitGPosition);
+  set_int(m.prog_proxy, "u_gnormal", kUnitGNormal);
+  set_int(m.prog_proxy, "u_soft", kUnitSoft);
+  set_int(m.prog_proxy, "u_facing_irradiance", kUnitFacingIrradiance);
+  set_float(m.prog_proxy, "u_cut", desc.soft_cutoff);
   set_float(m.prog_proxy, "u_soft_texel", (2 * kPi / light.soft.width()) * (kPi / light.soft.height()));
-  set_int(m.prog_proxy, "u_bounce", desc.bounce ? 1 : 0);
-  set_int(m.prog_proxy, "u_shadows", desc.shadows ? 1 : 0);
-  set_int(m.prog_final, "u_proxy_composite", 0);
-  set_int(m.prog_final, "u_object", 1);
-  set_int(m.prog_final, "u_photo", 2);
+  set_int(m.prog_proxy, "u_bounce", m.bounce ? 1 : 0);
+  set_int(m.prog_proxy, "u_shadows", m.shadows ? 1 : 0);
+  set_int(m.prog_final, "u_proxy_composite", kUnitFinalProxyComposite);
+  set_int(m.prog_final, "u_object", kUnitFinalObject);
+  set_int(m.prog_final, "u_photo", kUnitFinalPhoto);
   set_int(m.prog_final, "u_height", H);
   GLenum err = glGetError();
   if (err != GL_NO_ERROR) fail(ErrorKind::Internal, "OpenGL error 0x{:x} while setting up the compositor", err);
 }
 
-Compositor::~Compositor() {
-  if (impl_) impl_->release();
-}
+Compositor::~Compositor() = default;  // Impl releases its GL objects
 
 void Compositor::set_object(const geometry::TriMesh& object, const render::Material& material,
                             const std::vector<Vec3>* soft_visibility) {
@@ -422,14 +464,9 @@ void Compositor::set_object(const geometry::TriMesh& object, const render::Mater
   if (soft_visibility && soft_visibility->size() != object.triangle_count())
     fail(ErrorKind::Value, "soft visibility for {} triangles given for an object of {}", soft_visibility->size(),
          object.triangle_count());
+  render::check_material(material);
   const Vec3 a = material.albedo, k = material.specular;
-  for (int c = 0; c < 3; ++c)
-    if (!(a[c] >= 0 && a[c] <= 1 && k[c] >= 0 && k[c] <= 1))
-      fail(ErrorKind::Value, "object albedo ({}, {}, {}) and gloss ({}, {}, {}) must lie in [0, 1]", a.x, a.y, a.z, k.x,
-           k.y, k.z);
   const bool glossy = max_component(k) > 0;
-  if (glossy && !(material.exponent >= 1 && material.exponent <= 10000))
-    fail(ErrorKind::Value, "glossy exponent {} must lie in 1..10000", material.exponent);
   Impl& m = *impl_;
   m.object.upload(object, soft_visibility);
   m.sphere = equivalent_sphere(object);
@@ -484,16 +521,17 @@ void Compositor::draw(Vec3 offset, bool gl_rows, GlFrameTiming* timing) {
   glDisable(GL_CULL_FACE);
   glDisable(GL_BLEND);
   m.shadow_maps(c);  // the object's own shadows need them even when the proxy's (desc.shadows) are off
-  const GLuint units[] = {m.photo_tex, m.albedo_tex, m.gpos,       m.gnormal,
-                          m.soft_tex,  m.irr_tex,    m.object_map, m.proxy_map};
-  glBindTextures(0, 8, units);
+  const std::pair<Unit, GLuint> bound[] = {
+      {kUnitPhoto, m.photo_tex},      {kUnitAlbedo, m.albedo_tex},  {kUnitGPosition, m.gpos},
+      {kUnitGNormal, m.gnormal},      {kUnitSoft, m.soft_tex},      {kUnitSoftIrradiance, m.irr_tex},
+      {kUnitObjectMap, m.object_map}, {kUnitProxyMap, m.proxy_map}, {kUnitFacingIrradiance, m.facing_tex}};
+  for (const auto& [unit, tex] : bound) glBindTextureUnit(unit, tex);
 
   // The proxy's pixels: photo + min(ρ, 1)/π ΔE.
   glBindFramebuffer(GL_FRAMEBUFFER, m.fb_proxy);
   glViewport(0, 0, m.W, m.H);
   glDisable(GL_DEPTH_TEST);
   glUseProgram(m.prog_proxy);
-  glBindTextureUnit(10, m.facing_tex);
   glProgramUniform4f(m.prog_proxy, glGetUniformLocation(m.prog_proxy, "u_sphere"), static_cast<float>(c.x),
                      static_cast<float>(c.y), static_cast<float>(c.z), static_cast<float>(m.sphere.radius));
   set_vec3(m.prog_proxy, "u_object_albedo", m.object_albedo);
@@ -516,8 +554,8 @@ void Compositor::draw(Vec3 offset, bool gl_rows, GlFrameTiming* timing) {
   glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
   glUseProgram(m.prog_object);
   set_vec3(m.prog_object, "u_offset", offset);
-  const GLuint mat_units[] = {m.object_texture, m.object_glossy};
-  glBindTextures(8, 2, mat_units);
+  glBindTextureUnit(kUnitObjectTexture, m.object_texture);
+  glBindTextureUnit(kUnitObjectGlossy, m.object_glossy);
   m.object.draw();
   glBlitNamedFramebuffer(m.fb_object_ms, m.fb_object, 0, 0, m.W, m.H, 0, 0, m.W, m.H, GL_COLOR_BUFFER_BIT, GL_NEAREST);
 
@@ -526,8 +564,9 @@ void Compositor::draw(Vec3 offset, bool gl_rows, GlFrameTiming* timing) {
   glDisable(GL_DEPTH_TEST);
   glUseProgram(m.prog_final);
   set_int(m.prog_final, "u_flip", gl_rows ? 1 : 0);
-  const GLuint fin[] = {m.proxy_comp, m.object_tex, m.photo_tex};
-  glBindTextures(0, 3, fin);
+  glBindTextureUnit(kUnitFinalProxyComposite, m.proxy_comp);
+  glBindTextureUnit(kUnitFinalObject, m.object_tex);
+  glBindTextureUnit(kUnitFinalPhoto, m.photo_tex);
   glBindVertexArray(m.empty_vao);
   glDrawArrays(GL_TRIANGLES, 0, 3);
   glEndQuery(GL_TIME_ELAPSED);

@@ -38,22 +38,6 @@
 
 namespace ibl::augment::gl {
 
-struct GlCompositeDesc {
-  SplitDesc split;            // hard lights (≤ 16) and their threshold
-  int shadow_map_size = 512;  // texels per side of each light's two maps (fitted to the object's bounding sphere)
-  int pcf = 1;                // (2·pcf + 1)² taps per shadow lookup
-  int msaa = 4;               // samples per pixel of the object pass (its coverage at edges)
-  double cut = 4e-3;    // the soft term is 0 where the sphere's cosine-weighted share is below this, whole above 2×
-  bool shadows = true;  // false: the object pasted without shadow or reflection (a baseline)
-  bool bounce = true;   // the object's light on the proxy
-  int albedo_samples = 64;      // composite(): light samples per pixel of the albedo estimate
-  int visibility_samples = -1;  // composite(): patch samples per object triangle of its soft light's factor
-                                // (augment::soft_visibility); 0: the object's soft light as the map's centre
-                                // sees it; −1: kVisibilityRays over the triangles, 16 to 1024 each
-  static constexpr int64_t kVisibilityRays = int64_t(1) << 22;  // 209 a triangle for the 20k-triangle blob
-  uint64_t seed = 1;
-};
-
 struct GlFrameTiming {
   double gpu_ms = 0;   // GL_TIME_ELAPSED over the frame (shadow maps, proxy pass, object pass, blend)
   double wall_ms = 0;  // CPU wall clock until glFinish (the figure that means something on llvmpipe)
@@ -62,9 +46,9 @@ struct GlFrameTiming {
 // The scene that stays while the object moves. Needs a current OpenGL 4.5 context that outlives it.
 class Compositor {
  public:
-  static constexpr int kMaxLights = 16;  // hard lights (augment_common.glsl's MAX_LIGHTS)
+  static constexpr int kMaxLights = 16;  // hard lights (the shaders' MAX_LIGHTS is generated from it)
   Compositor(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy, const SplitLight& light,
-             const Image& albedo, const GlCompositeDesc& desc = {});
+             const Image& albedo, const CompositeDesc& desc = {});
   ~Compositor();
   Compositor(const Compositor&) = delete;
   Compositor& operator=(const Compositor&) = delete;
@@ -97,15 +81,16 @@ class Compositor {
 };
 
 // The whole composite on the GPU (a headless context of its own): the albedo estimated on the CPU
-// (estimate_albedo), the light split, one frame read back. Throws ibl::Error (kind Unsupported) when no GL
-// context can be had, and as composite() does on bad input.
+// (estimate_albedo, desc.light_samples), the light split, one frame read back. desc.gl holds the GL
+// options; the sampling counts of the CPU path other than light_samples are not used. Throws ibl::Error (kind
+// Unsupported) when no GL context can be had, and as composite() does on bad input.
 CompositeResult composite(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy,
-                          const LocalLight& light, const geometry::TriMesh& object, const render::Material& material,
-                          const GlCompositeDesc& desc = {}, GlFrameTiming* timing = nullptr);
+                          const LocalRadiance& light, const geometry::TriMesh& object, const render::Material& material,
+                          const CompositeDesc& desc = {}, GlFrameTiming* timing = nullptr);
 // A Lambertian object of albedo `albedo`.
 inline CompositeResult composite(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy,
-                                 const LocalLight& light, const geometry::TriMesh& object, Vec3 albedo,
-                                 const GlCompositeDesc& desc = {}, GlFrameTiming* timing = nullptr) {
+                                 const LocalRadiance& light, const geometry::TriMesh& object, Vec3 albedo,
+                                 const CompositeDesc& desc = {}, GlFrameTiming* timing = nullptr) {
   return composite(photo, cam, proxy, light, object, render::Material{albedo, {0, 0, 0}}, desc, timing);
 }
 

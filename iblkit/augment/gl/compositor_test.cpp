@@ -10,10 +10,11 @@
 #include <memory>
 
 #include "iblkit/augment/gl/compositor.h"
-#include "iblkit/augment/object.h"
+#include "iblkit/augment/soft_visibility.h"
 #include "iblkit/augment/testing.h"
 #include "iblkit/core/error.h"
 #include "iblkit/render/gl/context.h"
+#include "iblkit/render/objects.h"
 
 namespace ibl::augment::gl {
 namespace {
@@ -43,12 +44,12 @@ geometry::TriMesh floor_mesh() { return geometry::make_quad({0, 0, 0}, {0, 1, 0}
 Image constant_photo(double v) { return testing::constant_photo(kW, kH, v); }
 using testing::sphere_at;
 
-LocalLight sky(Vec3 L, Vec3 sun, Vec3 centre) {
+LocalRadiance sky(Vec3 L, Vec3 sun, Vec3 centre) {
   Image img(64, 32, 3);
   for (int y = 0; y < 32; ++y)
     for (int x = 0; x < 64; ++x) img.set_rgb(x, y, L);
   if (max_component(sun) > 0) img.set_rgb(20, 8, sun);  // one texel ≈ 48° from the zenith
-  LocalLight l;
+  LocalRadiance l;
   l.map = sphere::EnvMap(img, sphere::Mapping(sphere::MappingKind::LatLong, 64, 32));
   l.centre = centre;
   l.source = "test sky";
@@ -83,7 +84,7 @@ TEST(AugmentGl, PixelsTheObjectDoesNotTouchAreThePhotographBitForBit) {
   EXPECT_GT(r.stats.object_pixels, 8);
 
   // No shadows (the pasted baseline): only the object's pixels change.
-  GlCompositeDesc none;
+  CompositeDesc none;
   none.shadows = false;
   auto p = augment::gl::composite(photo, cam, floor, sky({1, 1, 1}, {3000, 3000, 3000}, at), sphere_at(at, 0.3),
                                   {0.7, 0.7, 0.7}, none);
@@ -96,14 +97,12 @@ TEST(AugmentGl, SunUmbraFallsWhereTheCpuReferencePutsIt) {
   SKIP_WITHOUT_GL();
   const Vec3 at{0, 0.35, 0};
   Image photo = constant_photo(0.4);
-  LocalLight sun = sky({0, 0, 0}, {5000, 5000, 5000}, at);
+  LocalRadiance sun = sky({0, 0, 0}, {5000, 5000, 5000}, at);
   geometry::TriMesh object = sphere_at(at, 0.3);
   CompositeDesc cd;
   cd.bounce_samples = 0;
   auto cpu = augment::composite(photo, top_camera(), floor_mesh(), sun, object, {0.7, 0.7, 0.7}, cd);
-  GlCompositeDesc gd;
-  gd.bounce = false;
-  auto gl = augment::gl::composite(photo, top_camera(), floor_mesh(), sun, object, {0.7, 0.7, 0.7}, gd);
+  auto gl = augment::gl::composite(photo, top_camera(), floor_mesh(), sun, object, {0.7, 0.7, 0.7}, cd);
   // The CPU's umbra (≥ 90 % darker, off the object) against the GL's.
   int both = 0, either = 0;
   for (int y = 0; y < kH; ++y)
@@ -191,7 +190,7 @@ geometry::Camera frame_camera(Vec3 eye, Vec3 target, double fov_deg) {
 }
 
 // The CPU composite over the floor with 4096 light samples per object pixel (its object nearly noise-free).
-CompositeResult cpu_reference(const Image& photo, const geometry::Camera& cam, const LocalLight& light,
+CompositeResult cpu_reference(const Image& photo, const geometry::Camera& cam, const LocalRadiance& light,
                               const geometry::TriMesh& object, const render::Material& m) {
   CompositeDesc cd;
   cd.object_samples = 4096;
@@ -244,7 +243,7 @@ TEST(AugmentGl, TextureAndSunHighlightAgreeWithTheCpuReference) {
   // blue), a floor below: the GL object against the CPU's, summed over the pixels both cover.
   const Vec3 at{0, 0.35, 0};
   Image photo = constant_photo(0.4);
-  LocalLight light = sky({0.3, 0.3, 0.3}, {3000, 3000, 3000}, at);
+  LocalRadiance light = sky({0.3, 0.3, 0.3}, {3000, 3000, 3000}, at);
   auto tex = std::make_shared<Image>(8, 4, 3);
   for (int y = 0; y < 4; ++y)
     for (int x = 0; x < 8; ++x) tex->set_rgb(x, y, x < 4 ? Vec3{0.9, 0.1, 0.1} : Vec3{0.1, 0.1, 0.9});
@@ -297,16 +296,12 @@ TEST(AugmentGl, SoftVisibilityDarkensTheUndersideAsTheCpuReferenceDoes) {
   // of directions the CPU's patches leave dark) and without it.
   const Vec3 at{0, 0.25, 0};
   Image photo = constant_photo(0.4);
-  LocalLight light = sky({0.5, 0.5, 0.5}, {3000, 3000, 3000}, at);
-  ObjectDesc od;
-  od.size = 0.4;
-  od.triangles = 4000;
-  od.at = at;
-  geometry::TriMesh object = make_object(od);
+  LocalRadiance light = sky({0.5, 0.5, 0.5}, {3000, 3000, 3000}, at);
+  geometry::TriMesh object = render::make_object({"blob", 0.4, 4000, at});
   const geometry::Camera cam = frame_camera({0, 0.45, 1.4}, at, 25);
   auto cpu = cpu_reference(photo, cam, light, object, render::Material{{0.7, 0.7, 0.7}, {0, 0, 0}});
-  GlCompositeDesc with, without;
-  without.visibility_samples = 0;
+  CompositeDesc with, without;
+  without.gl.visibility_samples = 0;
   auto gl = augment::gl::composite(photo, cam, floor_mesh(), light, object, {0.7, 0.7, 0.7}, with);
   auto gl0 = augment::gl::composite(photo, cam, floor_mesh(), light, object, {0.7, 0.7, 0.7}, without);
   const double py = kH / 2.0;  // the blob's centre is the camera's target: the frame's centre row

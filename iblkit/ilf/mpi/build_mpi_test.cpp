@@ -1,4 +1,4 @@
-// The distributed ILF build against the serial one (issue 18): `mpirun --oversubscribe -np N iblkit
+// The distributed ILF build against the serial one: `mpirun --oversubscribe -np N iblkit
 // ilf build …` for N = 1, 2, 3 gives the serial build's coefficients to float rounding, fails on a bad
 // frame with the serial build's message once (or skips it with --skip-bad) without hanging, and a
 // re-run reuses the buckets. Runs the iblkit command beside this test binary under mpirun; skips

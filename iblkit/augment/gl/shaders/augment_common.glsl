@@ -2,7 +2,7 @@
 // (the object's and the proxy's, linear distances from the light, in one frustum fitted to the object),
 // lat-long lookups, and the sphere cap's cosine integral (augment/sphere_occlusion.h's twin).
 const float PI = 3.14159265358979;
-#define MAX_LIGHTS 16
+// MAX_LIGHTS comes from the program's prelude (compositor.cpp: Compositor::kMaxLights).
 uniform int u_light_count;
 uniform vec4 u_light_dir[MAX_LIGHTS];   // xyz: unit, from the centre towards the light; w: 1 local, 0 distant
 uniform vec4 u_light_pos[MAX_LIGHTS];   // xyz: position (local); w: |position − centre|²

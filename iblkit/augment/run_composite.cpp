@@ -1,0 +1,74 @@
+#include "iblkit/augment/run_composite.h"
+
+#include "iblkit/core/error.h"
+
+namespace ibl::augment {
+
+const char* backend_name(Backend b) {
+  switch (b) {
+    case Backend::Cpu:
+      return "cpu";
+    case Backend::Gl:
+      return "gl";
+    case Backend::Auto:
+      return "auto";
+  }
+  return "?";
+}
+
+Backend parse_backend(const std::string& name) {
+  if (name == "cpu") return Backend::Cpu;
+  if (name == "gl") return Backend::Gl;
+  if (name == "auto") return Backend::Auto;
+  fail(ErrorKind::Value, "backend {}: expected cpu, gl or auto", name);
+}
+
+CompositeScene prepare_composite(const CompositeJob& job) {
+  CompositeScene s;
+  render::check_material(job.material);
+  s.object = render::make_object(job.object);
+  Vec3 lo, hi;
+  s.object.bounds(&lo, &hi);
+  s.light = load_light(job.light, lo, hi);
+  if (job.median_cut < 0 || job.median_cut > 4096)
+    fail(ErrorKind::Value, "median cut {} must lie in 0..4096", job.median_cut);
+  if (job.median_cut > 0) s.light.light = as_median_cut(s.light.light, job.median_cut);
+  return s;
+}
+
+#ifndef IBLKIT_HAVE_GL
+bool gl_backend_available(std::string* why) {
+  if (why) *why = "iblkit was built without OpenGL (IBLKIT_WITH_GL)";
+  return false;
+}
+CompositeResult gl_backend_composite(const Image&, const geometry::Camera&, const geometry::TriMesh&,
+                                     const LocalRadiance&, const geometry::TriMesh&, const render::Material&,
+                                     const CompositeDesc&) {
+  fail(ErrorKind::Unsupported, "the GL backend: iblkit was built without OpenGL (IBLKIT_WITH_GL)");
+}
+#endif
+
+CompositeRun run_composite(const Image& photo, const geometry::Camera& cam, const CompositeJob& job,
+                           const CompositeScene& scene) {
+  CompositeRun run;
+  run.backend = job.backend;
+  if (run.backend == Backend::Auto) {
+    std::string why;
+    run.backend = gl_backend_available(&why) ? Backend::Gl : Backend::Cpu;
+    if (run.backend == Backend::Cpu)
+      run.notes.push_back("backend auto: no OpenGL context (" + why + "): the CPU composites");
+  }
+  const LoadedLight& L = scene.light;
+  run.result = run.backend == Backend::Gl
+                   ? gl_backend_composite(photo, cam, L.proxy, L.light, scene.object, job.material, job.desc)
+                   : composite(photo, cam, L.proxy, L.light, scene.object, job.material, job.desc);
+  run.result.warnings.insert(run.result.warnings.begin(), L.warnings.begin(), L.warnings.end());
+  run.light_source = L.light.source;
+  return run;
+}
+
+CompositeRun run_composite(const Image& photo, const geometry::Camera& cam, const CompositeJob& job) {
+  return run_composite(photo, cam, job, prepare_composite(job));
+}
+
+}  // namespace ibl::augment
