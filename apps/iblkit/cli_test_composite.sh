@@ -22,6 +22,25 @@ done
 check json ok '"object_pixels"' -- "$BIN" composite "$T/photo.exr" "${CAM[@]}" --probes "$T/fus/probes.json" "${OBJ[@]}" --samples 4 \
   --object-samples 4 --out "$T/comp.png" --json
 
+# Ordinary photographs in and out: an 8-bit JPEG and a 16-bit TIFF backplate, composited in linear light and
+# written back through the same response, bit depth and metadata; far pixels keep their codes (oiiotool --diff).
+if command -v oiiotool >/dev/null; then
+  oiiotool "$T/photo.exr" --mulc 0.4 --colorconvert linear sRGB -d uint8 --compression jpeg:85 -o "$T/photo.jpg" \
+    --attrib Make iblkit-test >/dev/null 2>&1
+  oiiotool "$T/photo.exr" --mulc 1.5 -d uint16 -o "$T/photo16.tif" >/dev/null 2>&1
+  check ldr-jpeg ok '"jpeg_quality": 85' -- "$BIN" composite "$T/photo.jpg" "${CAM[@]}" --probes "$T/fus/probes.json" "${OBJ[@]}" \
+    --samples 4 --object-samples 4 --out "$T/comp.jpg" --json
+  check ldr-jpeg-exif ok 'iblkit-test' -- iinfo -v "$T/comp.jpg"
+  check ldr-tiff16 ok '"bits": 16' -- "$BIN" composite "$T/photo16.tif" "${CAM[@]}" --probes "$T/fus/probes.json" "${OBJ[@]}" \
+    --response linear --samples 4 --object-samples 4 --out "$T/comp16.tif" --json
+  check ldr-tiff16-saturated ok '"saturated_pixels": [1-9]' -- "$BIN" composite "$T/photo16.tif" "${CAM[@]}" \
+    --probes "$T/fus/probes.json" "${OBJ[@]}" --response linear --samples 4 --object-samples 4 --out "$T/comp16b.tif" --json
+  check ldr-bad-response fail "no-such.json" -- "$BIN" composite "$T/photo.jpg" "${CAM[@]}" --probes "$T/fus/probes.json" \
+    "${OBJ[@]}" --response "$T/no-such.json" --out "$T/c_bad.jpg"
+else
+  echo "oiiotool not found (apt install openimageio-tools): the LDR backplate checks skipped"; skip=$((skip+1))
+fi
+
 # A camera file: the same frame; one of another size is refused.
 echo '{"format":"iblkit.camera/1","eye":[0,1.3,2.2],"target":[0,0.3,0],"up":[0,1,0],"fov_y_deg":40}' >"$T/cam.json"
 check camera-file ok "composited" -- "$BIN" composite "$T/photo.exr" --camera "$T/cam.json" --probes "$T/fus/probes.json" "${OBJ[@]}" \

@@ -1,6 +1,7 @@
 // iblkit composite PHOTO …: a virtual object inserted into a photograph with its shading, occlusion,
 // shadows and interreflection (differential rendering, augment/composite.h; docs/augment.md).
 #ifdef IBLKIT_HAVE_GEOMETRY
+#include <cctype>
 #include <filesystem>
 
 #include <fmt/format.h>
@@ -10,6 +11,7 @@
 #include "iblkit/augment/composite.h"
 #include "iblkit/augment/measure.h"
 #include "iblkit/augment/run_composite.h"
+#include "iblkit/capture/backplate.h"
 #include "iblkit/core/atomic_file.h"
 #include "iblkit/core/error.h"
 #include "iblkit/io/image_io.h"
@@ -22,7 +24,9 @@ namespace fs = std::filesystem;
 using ibl::Vec3;
 
 struct Opts {
-  std::string photo, probe_depth, object, at, albedo = "0.7,0.7,0.7", out = "composite.exr", layers, backend = "cpu";
+  std::string photo, probe_depth, object, at, albedo = "0.7,0.7,0.7", out = "composite.exr", layers, backend = "cpu",
+                                              response;
+  int quality = 0;
   iblcli::PhotoSceneOptions scene;
   std::vector<std::string> light, truth;
   std::string lobe = "phong", texture;
@@ -43,7 +47,8 @@ void run(const Opts& o, const ibl::io::EnvReadDesc& read) {
   if (o.light.size() > 1) ibl::fail(ibl::ErrorKind::Value, "--light: give one light file");
   ibl::augment::CompositeJob job = o.job;
   job.backend = ibl::augment::parse_backend(o.backend);
-  ibl::Image photo = ibl::io::read_image(o.photo);
+  const ibl::capture::Backplate plate = ibl::capture::read_backplate(o.photo, o.response);
+  const ibl::Image& photo = plate.linear;
   const ibl::geometry::Camera cam = iblcli::photo_camera(o.scene, photo, o.photo, "");
   const ibl::Vec3 at = iblcli::parse_vec3(o.at, "--at");
   job.object.scene = o.object;
@@ -59,10 +64,24 @@ void run(const Opts& o, const ibl::io::EnvReadDesc& read) {
   const ibl::augment::CompositeResult& r = run.result;
   const std::string backend = ibl::augment::backend_name(run.backend);
   for (const auto& w : r.warnings) iblcli::info("warning: " + w);
-  if (fs::path(o.out).extension() == ".png")
+  ibl::capture::BackplateReport br;
+  const bool photo_out = plate.encoded && ibl::capture::is_photo_extension(o.out);
+  if (photo_out) {  // back through the photograph's response, in its bit depth, with its metadata
+    std::string ext = fs::path(o.out).extension().string();
+    for (char& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+    const int bits = ext == ".jpg" || ext == ".jpeg" ? 8 : plate.photo.bits;
+    const ibl::Image codes = ibl::capture::encode_like(plate, r.composite, bits, &br);
+    ibl::capture::write_like(o.out, plate, codes, bits, o.quality);
+    if (br.saturated_darkened > 0)
+      iblcli::info(fmt::format(
+          "warning: {} saturated pixels of {} lie under the object's shadow: their light is at least what they show, "
+          "so the shadow there is a bound, too bright where the scene was brighter",
+          br.saturated_darkened, o.photo));
+  } else if (fs::path(o.out).extension() == ".png") {
     ibl::io::write_image(o.out, ibl::io::tonemap(r.composite));
-  else
+  } else {
     ibl::io::write_image(o.out, r.composite);
+  }
   if (!o.layers.empty()) {
     ibl::make_output_folders(fs::path(o.layers).string());
     fs::path dir(o.layers);
@@ -84,6 +103,15 @@ void run(const Opts& o, const ibl::io::EnvReadDesc& read) {
                       {"unlit_pixels", s.unlit},
                       {"warnings", r.warnings}};
   if (!o.layers.empty()) j["layers"] = o.layers;
+  if (plate.encoded)
+    j["backplate"] = {{"bits", plate.photo.bits},
+                      {"response", plate.response.kind},
+                      {"jpeg_quality", plate.photo.meta.jpeg_quality},
+                      {"saturated_pixels", br.saturated},
+                      {"saturated_changed", br.saturated_changed},
+                      {"saturated_darkened", br.saturated_darkened},
+                      {"kept_pixels", br.kept},
+                      {"encoded_pixels", br.encoded}};
   ibl::augment::CompositeErrors e, noise;
   if (!o.truth.empty()) {
     std::vector<ibl::Image> truths;
@@ -128,8 +156,15 @@ void run(const Opts& o, const ibl::io::EnvReadDesc& read) {
 
 void setup(CLI::App& app) {
   auto* o = iblcli::app_owned<Opts>();
-  app.add_option("photo", o->photo, "the background photograph (HDR, linear; any format OpenImageIO reads)")
+  app.add_option("photo", o->photo,
+                 "the background photograph: HDR (linear), or 8-bit JPEG/PNG, 16-bit TIFF/PNG code values (--response)")
       ->required();
+  app.add_option("--response", o->response,
+                 "how the photograph's code values become linear: srgb (the default for 8/16-bit files), linear (the "
+                 "default for float files), camera, or an iblkit.response/1 file (docs/formats.md)");
+  app.add_option("--quality", o->quality,
+                 "JPEG quality of a .jpg --out (default: the input JPEG's own, estimated from its tables; else 95)")
+      ->check(CLI::Range(1, 100));
   iblcli::add_photo_scene_options(app, &o->scene, "");
   app.add_option("--light", o->light, "an SH grid (.shgrid) or a probe image (with --at-probe), with --proxy");
   app.add_option("--probe-depth", o->probe_depth,
@@ -201,7 +236,10 @@ void setup(CLI::App& app) {
       ->check(CLI::Range(16, 8192))
       ->capture_default_str();
 #endif
-  app.add_option("-o,--out", o->out, "the composite (.exr linear, .png tone mapped)")->capture_default_str();
+  app.add_option("-o,--out", o->out,
+                 "the composite: .exr linear; for an 8/16-bit photograph .jpg/.png/.tif back through --response in its "
+                 "bit depth and metadata (unchanged pixels keep their codes); for an HDR one .png tone mapped")
+      ->capture_default_str();
   app.add_option("--layers", o->layers, "folder for mask, difference, albedo, render_with, render_without (.exr)");
   iblcli::outputs(app, {"--layers"});  // besides --out (cli.h)
   app.add_option(

@@ -107,6 +107,15 @@ Photo oiio_read_photo(const std::string& path) {
     if (p.meta.iso <= 0) p.meta.iso = spec.get_int_attribute(name, 0);
   p.meta.make = spec.get_string_attribute("Make");
   p.meta.model = spec.get_string_attribute("Model");
+  for (const OIIO::ParamValue& a : spec.extra_attribs) {
+    const std::string name = a.name().string();
+    if (name.rfind("oiio:", 0) == 0 || name.rfind("jpeg:", 0) == 0 || name == "Compression" ||
+        name == "CompressionQuality" || name == "ExposureTime" || name == "FNumber" || name == "Make" ||
+        name == "Model" || name == "Exif:ISOSpeedRatings" || name == "Exif:PhotographicSensitivity")
+      continue;
+    if (a.type().basetype == OIIO::TypeDesc::UNKNOWN || a.type().basetype == OIIO::TypeDesc::PTR) continue;
+    p.meta.attributes.push_back({name, a.type().c_str(), a.get_string(1 << 20)});
+  }
   in->close();
   return p;
 }
@@ -116,6 +125,7 @@ void oiio_write_photo(const std::string& path, const Image& codes, int bits, con
   if (!out) fail(ErrorKind::Format, "{}: no image writer for this extension ({})", path, OIIO::geterror());
   OIIO::ImageSpec spec(codes.width(), codes.height(), codes.channels(),
                        bits == 16 ? OIIO::TypeDesc::UINT16 : OIIO::TypeDesc::UINT8);
+  for (const PhotoAttribute& a : meta.attributes) spec.attribute(a.name, OIIO::TypeDesc(a.type), a.value);
   if (meta.exposure_time > 0) spec.attribute("ExposureTime", static_cast<float>(meta.exposure_time));
   if (meta.f_number > 0) spec.attribute("FNumber", static_cast<float>(meta.f_number));
   if (meta.iso > 0) spec.attribute("Exif:ISOSpeedRatings", static_cast<int>(std::lround(meta.iso)));

@@ -5,16 +5,28 @@
 // format holds it).
 #pragma once
 #include <string>
+#include <vector>
 
 #include "iblkit/core/image.h"
 
 namespace ibl::io {
+
+// One metadata field as OpenImageIO names it ("Exif:DateTimeOriginal", "Orientation", "XResolution"), its
+// type ("string", "float", "int", "rational", …) and its value written out as text.
+struct PhotoAttribute {
+  std::string name, type, value;
+};
 
 struct PhotoMeta {
   double exposure_time = 0;  // seconds; 0: not in the file
   double f_number = 0;       // 0: not in the file
   double iso = 0;            // 0: not in the file
   std::string make, model;   // camera
+  // Every other field the file carries (Exif, TIFF, IPTC, GPS; not OpenImageIO's own "oiio:" ones), kept so
+  // that a photograph written back (composite's LDR output) carries what the camera wrote. The five above
+  // are written after them and win.
+  std::vector<PhotoAttribute> attributes;
+  int jpeg_quality = 0;  // a JPEG's quality estimated from its luminance quantisation table (jpeg_quality.h); 0: none
 };
 
 struct Photo {

@@ -1,0 +1,113 @@
+#include "iblkit/capture/backplate.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <filesystem>
+
+#include "iblkit/core/error.h"
+#include "iblkit/io/image_io.h"
+
+namespace ibl::capture {
+
+namespace {
+
+std::string lower_extension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+  return ext;
+}
+
+double levels_of(int bits) { return bits == 16 ? 65535.0 : 255.0; }
+
+}  // namespace
+
+bool is_photo_extension(const std::string& path) {
+  const std::string e = lower_extension(path);
+  return e == ".jpg" || e == ".jpeg" || e == ".png" || e == ".tif" || e == ".tiff";
+}
+
+Backplate read_backplate(const std::string& path, const std::string& response) {
+  Backplate b;
+  b.path = path;
+  if (is_photo_extension(path)) {
+    try {
+      b.photo = io::read_photo(path);
+      b.encoded = true;
+    } catch (const Error& e) {
+      if (e.kind() != ErrorKind::Format) throw;  // a float TIFF: read below as linear; a broken file fails there
+    }
+  }
+  if (!b.encoded) {
+    b.response = response_by_name(response.empty() ? "linear" : response);
+    b.linear = io::read_image(path, {.max_channels = 3});
+    if (b.linear.channels() < 3) b.linear = b.linear.with_channels(3);
+    if (b.response.kind != "linear")  // a float file through a curve: its values are code values
+      for (size_t i = 0; i < b.linear.pixel_count(); ++i)
+        for (int c = 0; c < 3; ++c) {
+          float& v = b.linear.data()[3 * i + c];
+          v = static_cast<float>(b.response.invert(std::clamp(static_cast<double>(v), 0.0, 1.0), c));
+        }
+    return b;
+  }
+  b.response = response_by_name(response.empty() ? "srgb" : response);
+  const Image& codes = b.photo.codes;
+  b.linear = Image(codes.width(), codes.height(), 3);
+  for (size_t i = 0; i < codes.pixel_count(); ++i)
+    for (int c = 0; c < 3; ++c)
+      b.linear.data()[3 * i + c] = static_cast<float>(b.response.invert(codes.data()[3 * i + c], c));
+  return b;
+}
+
+Image encode_like(const Backplate& b, const Image& composite, int bits, BackplateReport* report) {
+  if (!b.encoded) fail(ErrorKind::Value, "{}: not a photograph of code values; nothing to encode like", b.path);
+  if (composite.width() != b.linear.width() || composite.height() != b.linear.height() || composite.channels() < 3)
+    fail(ErrorKind::Value, "the composite ({}x{}) is not the backplate's size ({}x{})", composite.width(),
+         composite.height(), b.linear.width(), b.linear.height());
+  if (bits == 0) bits = b.photo.bits;
+  if (bits != 8 && bits != 16) fail(ErrorKind::Value, "bit depth {}: 8 or 16", bits);
+  const bool same_depth = bits == b.photo.bits;
+  const double levels = levels_of(bits), in_levels = levels_of(b.photo.bits);
+  BackplateReport r;
+  Image out(composite.width(), composite.height(), 3);
+  const Image& codes = b.photo.codes;
+  for (int y = 0; y < composite.height(); ++y)
+    for (int x = 0; x < composite.width(); ++x) {
+      const float* lin = b.linear.pixel(x, y);
+      const float* comp = composite.pixel(x, y);
+      const float* in = codes.pixel(x, y);
+      float* o = out.pixel(x, y);
+      const bool same = comp[0] == lin[0] && comp[1] == lin[1] && comp[2] == lin[2];
+      bool saturated = false, darker = false;
+      for (int c = 0; c < 3; ++c) {
+        saturated = saturated || std::lround(in[c] * in_levels) >= static_cast<long>(in_levels);
+        darker = darker || comp[c] < lin[c];
+      }
+      r.saturated += saturated;
+      if (same && same_depth) {
+        for (int c = 0; c < 3; ++c) o[c] = in[c];
+        ++r.kept;
+        continue;
+      }
+      for (int c = 0; c < 3; ++c) {
+        const double z = b.response.apply(std::max(0.0, static_cast<double>(comp[c])), c);
+        o[c] = static_cast<float>(std::lround(std::clamp(z, 0.0, 1.0) * levels) / levels);
+      }
+      ++r.encoded;
+      if (saturated && !same) {
+        ++r.saturated_changed;
+        r.saturated_darkened += darker;
+      }
+    }
+  if (report) *report = r;
+  return out;
+}
+
+void write_like(const std::string& path, const Backplate& b, const Image& codes, int bits, int quality) {
+  if (!b.encoded) fail(ErrorKind::Value, "{}: not a photograph of code values", b.path);
+  if (bits == 0) bits = b.photo.bits;
+  if (quality == 0) quality = b.photo.meta.jpeg_quality > 0 ? b.photo.meta.jpeg_quality : 95;
+  io::write_photo(path, codes, bits, b.photo.meta, quality);
+}
+
+}  // namespace ibl::capture
