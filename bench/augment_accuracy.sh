@@ -10,12 +10,14 @@
 # Usage: bench/augment_accuracy.sh BUILD/iblkit [WIDTHxHEIGHT] [TRUTH_SAMPLES]
 set -eu
 # PHOTO_ARGS / CAPTURE_ARGS / COMPOSITE_ARGS (environment): extra options of every photograph / capture /
-# composite. By default the photographs carry two bounces and the probes one (the photograph reflects the
+# composite (default --match off: the lab's photographs and probes are radiance in one unit by construction, and
+# the probes carry one bounce fewer, which the match would read as a +0.3-stop gain; the rows measure the
+# compositor, docs/augment.md "Radiometric match" the match). By default the photographs carry two bounces and the probes one (the photograph reflects the
 # light the probes see, and light that reaches the floor via the object has the bounces the composite gives it),
 # and every probe texel is the mean of 4×4 rays (a camera's pixel integrates; one ray per texel misses or
 # doubles small lamps and the sun).
 BIN=$1; SIZE=${2:-160x120}; TS=${3:-32}; OUT=${OUT:-/tmp/augment_accuracy}
-read -ra PA <<<"${PHOTO_ARGS---bounces 2}"; read -ra CA <<<"${CAPTURE_ARGS---bounces 1 --samples 4}"; read -ra XA <<<"${COMPOSITE_ARGS:-}"
+read -ra PA <<<"${PHOTO_ARGS---bounces 2}"; read -ra CA <<<"${CAPTURE_ARGS---bounces 1 --samples 4}"; read -ra XA <<<"${COMPOSITE_ARGS---match off}"
 # BACKEND=gl|cpu (environment, default cpu): which compositor the rows measure (--backend); REUSE=1 keeps the
 # photographs, captures and grids a previous run left under $OUT (the GL rows measured on the CPU rows' truths).
 BACKEND=${BACKEND:-cpu}

@@ -35,6 +35,16 @@ if command -v oiiotool >/dev/null; then
     --response linear --samples 4 --object-samples 4 --out "$T/comp16.tif" --json
   check ldr-tiff16-saturated ok '"saturated_pixels": [1-9]' -- "$BIN" composite "$T/photo16.tif" "${CAM[@]}" \
     --probes "$T/fus/probes.json" "${OBJ[@]}" --response linear --samples 4 --object-samples 4 --out "$T/comp16b.tif" --json
+  # A photograph one stop brighter than the probe: the match's gain doubles (the lab's probe here carries fewer
+  # bounces than its photograph, so the gain of the photograph as it is is not 1 but their ratio).
+  oiiotool "$T/photo.exr" --mulc 2 -o "$T/photo_x2.exr" >/dev/null 2>&1
+  g1=$("$BIN" composite "$T/photo.exr" "${CAM[@]}" --probes "$T/fus/probes.json" "${OBJ[@]}" --samples 4 --object-samples 4 \
+    --out "$T/c_x1.exr" --json 2>/dev/null | python3 -c 'import json,sys; print(json.load(sys.stdin)["match"]["gain"][1])')
+  g2=$("$BIN" composite "$T/photo_x2.exr" "${CAM[@]}" --probes "$T/fus/probes.json" "${OBJ[@]}" --samples 4 --object-samples 4 \
+    --out "$T/c_x2.exr" --json 2>/dev/null | python3 -c 'import json,sys; print(json.load(sys.stdin)["match"]["gain"][1])')
+  check match-one-stop ok "" -- python3 -c "import sys; r = $g2 / $g1; print(r); sys.exit(0 if abs(r - 2) < 0.02 else 1)"
+  check match-off ok "composited" -- "$BIN" composite "$T/photo_x2.exr" "${CAM[@]}" --probes "$T/fus/probes.json" "${OBJ[@]}" \
+    --samples 4 --object-samples 4 --match off --out "$T/c_x2off.exr"
   check ldr-bad-response fail "no-such.json" -- "$BIN" composite "$T/photo.jpg" "${CAM[@]}" --probes "$T/fus/probes.json" \
     "${OBJ[@]}" --response "$T/no-such.json" --out "$T/c_bad.jpg"
 else

@@ -25,7 +25,7 @@ using ibl::Vec3;
 
 struct Opts {
   std::string photo, probe_depth, object, at, albedo = "0.7,0.7,0.7", out = "composite.exr", layers, backend = "cpu",
-                                              response;
+                                              response, match = "auto";
   int quality = 0;
   iblcli::PhotoSceneOptions scene;
   std::vector<std::string> light, truth;
@@ -57,6 +57,11 @@ void run(const Opts& o, const ibl::io::EnvReadDesc& read) {
   job.light.probe_depth = o.probe_depth;
   job.light.read = read;
   job.material = iblcli::object_material(o.albedo, o.gloss, o.exponent, o.lobe, o.texture);
+  job.match = o.match == "off" ? ibl::augment::Match::Off : ibl::augment::Match::Auto;
+  if (plate.encoded) {  // the photograph's top code, linear: saturated pixels say nothing of the light's scale
+    job.saturated = 1e30;
+    for (int c = 0; c < 3; ++c) job.saturated = std::min(job.saturated, plate.response.invert(1.0, c) * (1 - 1e-6));
+  }
   job.desc.progress = iblcli::progress_bar();
   const ibl::augment::CompositeRun run = ibl::augment::run_composite(photo, cam, job);
   iblcli::progress_done();
@@ -103,6 +108,12 @@ void run(const Opts& o, const ibl::io::EnvReadDesc& read) {
                       {"unlit_pixels", s.unlit},
                       {"warnings", r.warnings}};
   if (!o.layers.empty()) j["layers"] = o.layers;
+  if (run.match.points > 0 || run.matched)
+    j["match"] = {{"gain", {run.match.gain.x, run.match.gain.y, run.match.gain.z}},
+                  {"stops", std::log2(ibl::luminance(run.match.gain))},
+                  {"points", run.match.points},
+                  {"spread_stops", run.match.spread},
+                  {"applied", run.matched}};
   if (plate.encoded)
     j["backplate"] = {{"bits", plate.photo.bits},
                       {"response", plate.response.kind},
@@ -162,6 +173,11 @@ void setup(CLI::App& app) {
   app.add_option("--response", o->response,
                  "how the photograph's code values become linear: srgb (the default for 8/16-bit files), linear (the "
                  "default for float files), camera, or an iblkit.response/1 file (docs/formats.md)");
+  app.add_option("--match", o->match,
+                 "auto: the light's scale and per-channel gains estimated from the proxy points the photograph and the "
+                 "probe both see, and applied (a probe's map; not an SH grid); off: the light as captured")
+      ->check(CLI::IsMember({"auto", "off"}))
+      ->capture_default_str();
   app.add_option("--quality", o->quality,
                  "JPEG quality of a .jpg --out (default: the input JPEG's own, estimated from its tables; else 95)")
       ->check(CLI::Range(1, 100));

@@ -95,6 +95,7 @@ nlohmann::json lab_case(iblcli::DemoContext& ctx, const fs::path& dir, const ibl
   sd.out_dir = (dir / (name + "_probe")).string();
   ibl::lab::write_probe_set(scene, {at}, sd);
   job.light.probes = (fs::path(sd.out_dir) / "probes.json").string();
+  job.match = ibl::augment::Match::Off;  // the lab's probe and photograph are one unit (its probe: one bounce fewer)
   const ibl::augment::CompositeResult r = ibl::augment::run_composite(photo, cam, job).result;
   ibl::augment::CompositeErrors e = ibl::augment::measure(photo, r.composite, truth, r.mask);
   std::string png = (dir / (name + ".png")).string();

@@ -361,7 +361,8 @@ void run_composite(const ViewOpts& o, const ibl::io::EnvReadDesc& rd) {
   job.light = iblcli::photo_light_input(o.scene, o.lights);
   job.light.read = rd;
   job.desc.gl.split.lights = o.gl_lights;
-  const augment::CompositeScene scene = augment::prepare_composite(job);
+  const augment::CompositeScene scene = augment::prepare_composite(job, &photo, &cam);
+  for (const auto& n : scene.notes) iblcli::info(n);
   const augment::LoadedLight& L = scene.light;
   const geometry::TriMesh& object = scene.object;
   for (const auto& w : L.warnings) iblcli::info("warning: " + w);

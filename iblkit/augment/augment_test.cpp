@@ -10,6 +10,7 @@
 
 #include "iblkit/augment/composite.h"
 #include "iblkit/augment/light.h"
+#include "iblkit/augment/match.h"
 #include "iblkit/augment/measure.h"
 #include "iblkit/augment/testing.h"
 #include "iblkit/core/error.h"
@@ -361,6 +362,32 @@ TEST(AugmentComposite, AnObjectRestingOnTheFloorIsAccepted) {
   EXPECT_NO_THROW(composite(photo, top_camera(), floor_mesh(), sky, blob, {0.5, 0.5, 0.5}, d));
   blob.transform(1.0, {0, -0.01, 0});
   EXPECT_THROW(composite(photo, top_camera(), floor_mesh(), sky, blob, {0.5, 0.5, 0.5}, d), Error);
+}
+
+TEST(AugmentMatch, TheGainsAreWhatThePhotographAndTheProbeSeeOfTheSameFloor) {
+  // A probe 0.5 m above a floor sees it as 0.25 (its lower hemisphere) under a sky of 1; the photograph,
+  // another exposure and white balance, shows the floor as (0.5, 0.45, 0.3): the gains are their ratio.
+  LocalRadiance probe = constant_sky({1, 1, 1}, {0, 0.5, 0});
+  for (int y = 16; y < 32; ++y)
+    for (int x = 0; x < 64; ++x) probe.map.image.set_rgb(x, y, {0.25, 0.25, 0.25});
+  Image photo(kW, kH, 3);
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x) photo.set_rgb(x, y, {0.5, 0.45, 0.3});
+  const MatchResult m = estimate_match(photo, top_camera(), floor_mesh(), probe);
+  ASSERT_TRUE(m.valid);
+  EXPECT_EQ(m.points, kW * kH);
+  EXPECT_NEAR(m.gain.x, 2.0, 1e-6);
+  EXPECT_NEAR(m.gain.y, 1.8, 1e-6);
+  EXPECT_NEAR(m.gain.z, 1.2, 1e-6);
+  EXPECT_NEAR(m.spread, 0, 1e-9);
+  const LocalRadiance matched = scaled(probe, m.gain);
+  EXPECT_NEAR(matched.map.image.at(3, 20, 1), 0.45, 1e-6);
+  // Saturated pixels are left out, and a probe that sees none of the points gives no gain.
+  EXPECT_FALSE(estimate_match(photo, top_camera(), floor_mesh(), probe, 0.2).valid);
+  LocalRadiance under = probe;
+  under.centre = {0, -0.5, 0};  // below the floor: the floor hides every point from it
+  EXPECT_FALSE(estimate_match(photo, top_camera(), floor_mesh(), under).valid);
+  EXPECT_THROW(estimate_match(Image(4, 4, 3), top_camera(), floor_mesh(), probe), Error);
 }
 
 TEST(AugmentMeasure, PerfectCompositeHasNoErrorAndShadowErrorIsRelative) {

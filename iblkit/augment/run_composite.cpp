@@ -1,5 +1,9 @@
 #include "iblkit/augment/run_composite.h"
 
+#include <cmath>
+
+#include <fmt/format.h>
+
 #include "iblkit/core/error.h"
 
 namespace ibl::augment {
@@ -23,7 +27,26 @@ Backend parse_backend(const std::string& name) {
   fail(ErrorKind::Value, "backend {}: expected cpu, gl or auto", name);
 }
 
-CompositeScene prepare_composite(const CompositeJob& job) {
+void match_light(CompositeScene& s, const Image& photo, const geometry::Camera& cam, const CompositeJob& job) {
+  if (job.match == Match::Off || s.light.light.source == "SH grid") return;  // a grid's map is band-limited
+  s.match = estimate_match(photo, cam, s.light.proxy, s.light.light, job.saturated);
+  if (!s.match.valid) {
+    s.notes.push_back(fmt::format(
+        "match: the photograph and the light see only {} proxy points in common (< {}): the light is used as "
+        "captured",
+        s.match.points, kMinMatchPoints));
+    return;
+  }
+  s.light.light = scaled(s.light.light, s.match.gain);
+  s.matched = true;
+  const Vec3 g = s.match.gain;
+  s.notes.push_back(fmt::format(
+      "match: the light times ({:.4g}, {:.4g}, {:.4g}) ({:+.2f} stops) to the photograph's units, from {} proxy "
+      "points both see (spread {:.2f} stops; --match off keeps it as captured)",
+      g.x, g.y, g.z, std::log2(luminance(g)), s.match.points, s.match.spread));
+}
+
+CompositeScene prepare_composite(const CompositeJob& job, const Image* photo, const geometry::Camera* cam) {
   CompositeScene s;
   render::check_material(job.material);
   s.object = render::make_object(job.object);
@@ -32,6 +55,7 @@ CompositeScene prepare_composite(const CompositeJob& job) {
   s.light = load_light(job.light, lo, hi);
   if (job.median_cut < 0 || job.median_cut > 4096)
     fail(ErrorKind::Value, "median cut {} must lie in 0..4096", job.median_cut);
+  if (photo && cam) match_light(s, *photo, *cam, job);
   if (job.median_cut > 0) s.light.light = as_median_cut(s.light.light, job.median_cut);
   return s;
 }
@@ -64,11 +88,14 @@ CompositeRun run_composite(const Image& photo, const geometry::Camera& cam, cons
                    : composite(photo, cam, L.proxy, L.light, scene.object, job.material, job.desc);
   run.result.warnings.insert(run.result.warnings.begin(), L.warnings.begin(), L.warnings.end());
   run.light_source = L.light.source;
+  run.match = scene.match;
+  run.matched = scene.matched;
+  run.notes.insert(run.notes.begin(), scene.notes.begin(), scene.notes.end());
   return run;
 }
 
 CompositeRun run_composite(const Image& photo, const geometry::Camera& cam, const CompositeJob& job) {
-  return run_composite(photo, cam, job, prepare_composite(job));
+  return run_composite(photo, cam, job, prepare_composite(job, &photo, &cam));
 }
 
 }  // namespace ibl::augment

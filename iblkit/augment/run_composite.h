@@ -7,6 +7,7 @@
 
 #include "iblkit/augment/composite.h"
 #include "iblkit/augment/load.h"
+#include "iblkit/augment/match.h"
 #include "iblkit/core/image.h"
 #include "iblkit/geometry/camera.h"
 #include "iblkit/geometry/mesh.h"
@@ -28,11 +29,18 @@ Backend parse_backend(const std::string& name);
 // or floor at y = 0 (a hand-sized object; `iblkit render`'s 0.8 m, 100k-triangle blob is a showpiece).
 inline render::ObjectDesc inserted_object_defaults() { return {"blob", 0.3, 20000, {0, 0.15, 0}}; }
 
+// The radiometric match of the light to the photograph (match.h): Auto estimates the gains whenever the
+// light is a probe's map (one probe, fused probes, a probe image: maps that see the proxy; not an SH grid's,
+// which is band-limited) and multiplies the light by them; Off leaves the light as captured.
+enum class Match { Auto, Off };
+
 struct CompositeJob {
   render::ObjectDesc object = inserted_object_defaults();  // made by render::make_object
   render::Material material{{0.7, 0.7, 0.7}, {0, 0, 0}};   // its surface (render::check_material)
   LightInput light;                                        // the captured light and the proxy, from files (load.h)
-  int median_cut = 0;                                      // > 0: the baseline of this many median-cut lights
+  int median_cut = 0;         // > 0: the baseline of this many median-cut lights (cut after the match)
+  Match match = Match::Auto;  // the light put in the photograph's units (match.h)
+  double saturated = 0;       // linear value at which the photograph saturates (0: never), left out of the match
   Backend backend = Backend::Cpu;
   CompositeDesc desc;  // sampling, seed, shadows, the GL options, progress
 };
@@ -41,21 +49,30 @@ struct CompositeJob {
 struct CompositeScene {
   geometry::TriMesh object;
   LoadedLight light;
+  MatchResult match;               // the gains estimated (match.valid false: none)
+  bool matched = false;            // the light was multiplied by match.gain
+  std::vector<std::string> notes;  // the match, in words
 };
-// Makes the object and reads the light (checked against where the object goes), then the median cut.
-CompositeScene prepare_composite(const CompositeJob& job);
+// Makes the object and reads the light (checked against where the object goes); with the photograph and
+// its camera, the radiometric match (job.match); then the median cut.
+CompositeScene prepare_composite(const CompositeJob& job, const Image* photo = nullptr,
+                                 const geometry::Camera* cam = nullptr);
+// The match alone, on a scene made otherwise (Python's in-memory light): estimates and applies job.match.
+void match_light(CompositeScene& scene, const Image& photo, const geometry::Camera& cam, const CompositeJob& job);
 
 struct CompositeRun {
   CompositeResult result;          // its warnings begin with the light's
   Backend backend = Backend::Cpu;  // the one that ran (Auto resolved)
   std::string light_source;        // LocalRadiance::source
-  std::vector<std::string> notes;  // what the caller may tell the user (the backend auto chose)
+  std::vector<std::string> notes;  // what the caller may tell the user (the backend auto chose, the match)
+  MatchResult match;               // the gains estimated (match.valid false: none)
+  bool matched = false;            // the light was multiplied by match.gain
 };
 // `photo` (linear RGB) seen by `cam` (its size the photograph's). Throws ibl::Error on bad input, and
 // (ErrorKind::Unsupported) for Backend::Gl when iblkit has no OpenGL or no context can be made.
 CompositeRun run_composite(const Image& photo, const geometry::Camera& cam, const CompositeJob& job);
 // The same with the scene already in memory (Python's LocalRadiance and TriMesh); job.object, job.light and
-// job.median_cut are not read.
+// job.median_cut and job.match are not read (prepare_composite's and match_light's).
 CompositeRun run_composite(const Image& photo, const geometry::Camera& cam, const CompositeJob& job,
                            const CompositeScene& scene);
 

@@ -105,7 +105,7 @@ void init_augment(py::module_& m) {
          py::object light, py::object proxy, py::object at_probe, const std::string& probe_depth, py::handle albedo,
          int median_cut, int light_samples, int object_samples, int bounce_samples, int triangle_samples,
          int pixel_samples, uint64_t seed, bool shadows, const std::string& backend, int gl_lights, double gl_threshold,
-         int gl_visibility, py::object progress) {
+         int gl_visibility, const std::string& match, py::object progress) {
         ibl::Image ph = to_checked_image(photo, "composite: photo");
         camera.width = ph.width();
         camera.height = ph.height();
@@ -115,6 +115,8 @@ void init_augment(py::module_& m) {
         ibl::render::check_material(job.material, "composite: albedo");
         job.backend = ag::parse_backend(backend);
         job.median_cut = median_cut;
+        if (match != "auto" && match != "off") throw py::value_error("composite: match must be \"auto\" or \"off\"");
+        job.match = match == "off" ? ag::Match::Off : ag::Match::Auto;
         ag::CompositeDesc& d = job.desc;
         d.light_samples = light_samples;
         d.object_samples = object_samples;
@@ -134,6 +136,7 @@ void init_augment(py::module_& m) {
             throw py::value_error("composite: a LocalRadiance needs proxy= (a TriMesh or a mesh file)");
           scene.light.proxy = py::isinstance<py::str>(proxy) ? ibl::geometry::read_mesh(proxy.cast<std::string>())
                                                              : proxy.cast<ibl::geometry::TriMesh>();
+          ag::match_light(scene, ph, camera, job);
           if (median_cut > 0) scene.light.light = ag::as_median_cut(scene.light.light, median_cut);
         } else {  // files, as the CLI takes them
           if (!probes.is_none()) job.light.probes = py::str(probes);
@@ -145,6 +148,7 @@ void init_augment(py::module_& m) {
           object.bounds(&lo, &hi);
           py::gil_scoped_release nogil;
           scene.light = ag::load_light(job.light, lo, hi);
+          ag::match_light(scene, ph, camera, job);
           if (median_cut > 0) scene.light.light = ag::as_median_cut(scene.light.light, median_cut);
         }
         Progress pr(progress);
@@ -167,7 +171,8 @@ void init_augment(py::module_& m) {
       py::arg("seed") = kDefaults.seed, py::arg("shadows") = kDefaults.shadows,
       py::arg("backend") = std::string(ag::backend_name(kJob.backend)),
       py::arg("gl_lights") = kDefaults.gl.split.lights, py::arg("gl_threshold") = kDefaults.gl.split.threshold,
-      py::arg("gl_visibility") = kDefaults.gl.visibility_samples, py::arg("progress") = py::none(),
+      py::arg("gl_visibility") = kDefaults.gl.visibility_samples,
+      py::arg("match") = std::string(kJob.match == ag::Match::Auto ? "auto" : "off"), py::arg("progress") = py::none(),
       R"doc(Composites `object` (a TriMesh, e.g. TriMesh.object(at=…)) into the photograph (H, W, 3) seen by
 `camera` (its size becomes the photograph's), as `iblkit composite` (Debevec 1998): a CompositeResult
 with the composite, mask, difference, albedo and render layers.
@@ -178,7 +183,8 @@ proxy= a TriMesh or mesh file. median_cut > 0: the N-light baseline. Sampling: l
 object_samples, bounce_samples (0: no bounce), triangle_samples, pixel_samples, seed; shadows=False
 pastes the object without its shadow. backend= "cpu" (the ray-traced reference), "gl" (OpenGL: shadow
 maps and the soft sphere term; gl_lights, gl_threshold, gl_visibility as --gl-lights, --gl-threshold,
---gl-visibility) or "auto". Every default is the library's (augment::CompositeJob). Releases the GIL;
+--gl-visibility) or "auto". match="auto" puts the light in the photograph's units (the gains from the
+proxy points both see; result.warnings says them), "off" keeps it as captured. Every default is the library's (augment::CompositeJob). Releases the GIL;
 progress(stage, fraction).)doc");
 
   m.def(

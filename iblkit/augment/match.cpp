@@ -1,0 +1,99 @@
+#include "iblkit/augment/match.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <vector>
+
+#include "iblkit/augment/rays.h"
+#include "iblkit/core/error.h"
+#include "iblkit/geometry/raytracer.h"
+
+namespace ibl::augment {
+
+namespace {
+
+double median(std::vector<double>& v) {
+  const size_t mid = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid), v.end());
+  return v[mid];
+}
+
+double median_of_image(const Image& img) {
+  std::vector<double> y;
+  const size_t step = std::max<size_t>(1, img.pixel_count() / 20000);
+  for (size_t i = 0; i < img.pixel_count(); i += step) {
+    const float* p = img.data() + i * static_cast<size_t>(img.channels());
+    y.push_back(luminance(Vec3{p[0], p[std::min(1, img.channels() - 1)], p[std::min(2, img.channels() - 1)]}));
+  }
+  return y.empty() ? 0 : median(y);
+}
+
+}  // namespace
+
+MatchResult estimate_match(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy,
+                           const LocalRadiance& light, double saturated, int64_t max_points) {
+  if (photo.channels() < 3 || photo.width() != cam.width || photo.height() != cam.height)
+    fail(ErrorKind::Value, "match: the photograph ({}x{}) and the camera's frame ({}x{}) must agree", photo.width(),
+         photo.height(), cam.width, cam.height);
+  if (proxy.triangle_count() == 0) fail(ErrorKind::Value, "match: the proxy has no triangles");
+  geometry::RayTracer rt;
+  rt.add(proxy);
+  rt.commit();
+  const double photo_floor = 0.01 * median_of_image(photo), light_floor = 0.01 * median_of_image(light.map.image);
+  const bool have_depth = !light.depth.empty();
+  const int64_t pixels = static_cast<int64_t>(photo.width()) * photo.height();
+  const int64_t stride = std::max<int64_t>(1, pixels / std::max<int64_t>(1, max_points));
+  std::array<std::vector<double>, 3> ratio;
+  std::vector<double> log_ratio;
+  for (int64_t i = 0; i < pixels; i += stride) {
+    const int x = static_cast<int>(i % photo.width()), y = static_cast<int>(i / photo.width());
+    const Vec3 d = cam.pixel_direction(x, y);
+    const geometry::Hit h = rt.intersect(cam.eye, d);
+    if (!h.hit) continue;
+    const Vec3 at = cam.eye + d * h.t;
+    Vec3 w = at - light.centre;
+    const double dist = length(w);
+    if (!(dist > 1e-6)) continue;
+    w = w / dist;
+    const Vec3 n = proxy.normal(h.triangle);
+    if (dot(n, d) * dot(n, w) <= 0) continue;  // the probe sees the other side of the surface (or grazes it)
+    if (rt.occluded(light.centre, w, kRayEpsilon, dist * (1 - kShadowShorten))) continue;  // hidden from the probe
+    if (have_depth) {
+      double px, py;
+      if (!light.map.mapping.to_pixel(w, &px, &py)) continue;
+      const int ix = std::clamp(static_cast<int>(px), 0, light.depth.width() - 1),
+                iy = std::clamp(static_cast<int>(py), 0, light.depth.height() - 1);
+      const double t = light.depth.at(ix, iy, 0);
+      if (t > 0 && std::abs(t - dist) > 0.05 * dist) continue;  // something else along that direction
+    }
+    const Vec3 lp = light.map.sample_rgb(w), ph = photo.rgb(x, y);
+    if (saturated > 0 && (ph.x >= saturated || ph.y >= saturated || ph.z >= saturated)) continue;
+    if (luminance(ph) < photo_floor || luminance(lp) < light_floor) continue;
+    bool ok = true;
+    for (int c = 0; c < 3; ++c) ok = ok && lp[c] > 0 && ph[c] > 0;
+    if (!ok) continue;
+    for (int c = 0; c < 3; ++c) ratio[c].push_back(ph[c] / lp[c]);
+    log_ratio.push_back(std::log2(luminance(ph) / luminance(lp)));
+  }
+  MatchResult r;
+  r.points = static_cast<int64_t>(log_ratio.size());
+  if (r.points < kMinMatchPoints) return r;
+  for (int c = 0; c < 3; ++c) r.gain[c] = median(ratio[c]);
+  const double m = median(log_ratio);
+  for (double& v : log_ratio) v = std::abs(v - m);
+  r.spread = median(log_ratio);
+  r.valid = true;
+  return r;
+}
+
+LocalRadiance scaled(const LocalRadiance& light, Vec3 gain) {
+  LocalRadiance out = light;
+  Image& img = out.map.image;
+  for (size_t i = 0; i < img.pixel_count(); ++i)
+    for (int c = 0; c < std::min(3, img.channels()); ++c)
+      img.data()[i * static_cast<size_t>(img.channels()) + c] *= static_cast<float>(gain[c]);
+  return out;
+}
+
+}  // namespace ibl::augment

@@ -1,0 +1,42 @@
+// The radiometric match between the captured light and the photograph (docs/augment.md, "Radiometric
+// match"): the probe and the backplate come from different exposures, often different cameras, so their
+// values differ by a scale and per-channel gains. Both see the proxy — the probe in its lower hemisphere,
+// the photograph where its pixels meet it — and a Lambertian surface's radiance is the same from every
+// side, so the gains are the ratio of what the two see at the same points:
+//
+//   g_c = median over proxy points y seen by both of  photo_c(y) / L_c(centre → y)
+//
+// y is where a pixel's ray meets the proxy; the probe sees it when it is on the side of the surface the
+// camera sees and nothing of the proxy lies between its centre and y (and, with a depth map, when the map's depth along that direction is y's distance within
+// 5 %, so that a lamp in front of the proxy is not taken for the floor). Pixels too dark in either
+// (below 1 % of their image's median) or saturated in the photograph are left out. The median and
+// the spread (the median absolute deviation of log2 of the ratios) are reported; multiplying the light
+// by g puts it in the photograph's units, so that the object is rendered as bright as the photograph's
+// surfaces and the shadows are right (a 1-stop mismatch: docs/augment.md).
+#pragma once
+#include <cstdint>
+
+#include "iblkit/augment/light.h"
+#include "iblkit/core/image.h"
+#include "iblkit/geometry/camera.h"
+#include "iblkit/geometry/mesh.h"
+
+namespace ibl::augment {
+
+struct MatchResult {
+  Vec3 gain{1, 1, 1};  // photograph / light, per channel
+  int64_t points = 0;  // proxy points both saw
+  double spread = 0;   // median absolute deviation of log2(ratio), stops (luminance)
+  bool valid = false;  // enough points (≥ kMinMatchPoints) for a gain
+};
+inline constexpr int64_t kMinMatchPoints = 64;
+
+// saturated: a photograph value at or above this (in any channel) is left out (the photograph's top code
+// linearised; 0: none is). At most max_points pixels, evenly spread, are used.
+MatchResult estimate_match(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy,
+                           const LocalRadiance& light, double saturated = 0, int64_t max_points = 40000);
+
+// The light times the gains (its map; the depth stays).
+LocalRadiance scaled(const LocalRadiance& light, Vec3 gain);
+
+}  // namespace ibl::augment
