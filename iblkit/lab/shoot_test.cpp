@@ -1,0 +1,156 @@
+// lab shoot against the lab's exact probe at the ball's centre (issue 29 §2–3): the whole geometric
+// chain `shoot → probe from-ball` in linear radiance.
+#include "iblkit/lab/shoot.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+#include "iblkit/capture/ball.h"
+#include "iblkit/core/parallel.h"
+#include "iblkit/lab/scene_io.h"
+#include "iblkit/lab/truth.h"
+#include "iblkit/sphere/pointset.h"
+
+namespace ibl::lab {
+namespace {
+
+// low-scene1 without its projector (a 3 cm aperture the photograph would point-sample): the ceiling's
+// area light, the room and its furniture.
+Scene scene_without_projector() {
+  Scene s = load_scene("low-scene1", false);
+  s.emitters.erase(std::remove_if(s.emitters.begin(), s.emitters.end(),
+                                  [](const Emitter& e) { return e.type == EmitterType::Projector; }),
+                   s.emitters.end());
+  return s;
+}
+
+std::vector<Vec3> irradiance_all(const sphere::EnvMap& map, const std::vector<Vec3>& normals, const Image* alpha) {
+  std::vector<Vec3> dirs, vals;
+  std::vector<double> sa;
+  for (int y = 0; y < map.image.height(); ++y)
+    for (int x = 0; x < map.image.width(); ++x) {
+      Vec3 d;
+      double s = map.mapping.solid_angle(x, y);
+      if (s <= 0 || !map.mapping.to_direction(x + 0.5, y + 0.5, &d)) continue;
+      double a = alpha ? alpha->at(x, y, 3) : 1.0;
+      dirs.push_back(d);
+      vals.push_back(map.image.rgb(x, y) * a);
+      sa.push_back(s);
+    }
+  std::vector<Vec3> E(normals.size());
+  parallel_for(0, static_cast<int64_t>(normals.size()), [&](int64_t i) {
+    Vec3 e;
+    for (size_t p = 0; p < dirs.size(); ++p) {
+      double c = dot(normals[i], dirs[p]);
+      if (c > 0) e += vals[p] * (c * sa[p]);
+    }
+    E[i] = e;
+  });
+  return E;
+}
+
+double mean_relative(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
+  double s = 0;
+  for (size_t i = 0; i < a.size(); ++i) s += std::abs(luminance(a[i]) - luminance(b[i])) / luminance(b[i]);
+  return s / a.size();
+}
+
+capture::BallView view_of(const Shot& s, std::string name, const Image* img = nullptr) {
+  return {img ? *img : s.radiance, s.ball, s.distance_radii, s.angle_deg, std::move(name)};
+}
+
+TEST(LabShoot, OneViewAgainstTheProbeAtTheBallsCentre) {
+  Scene base = scene_without_projector();
+  ShootDesc d;
+  d.ball_center = {0, 1, 0};
+  d.ball_radius = 0.05;
+  d.distance = 0.25;  // 5 radii
+  d.width = d.height = 256;
+  d.photographer = false;
+  d.render = base.render;
+  auto shots = shoot(base, d);
+  ASSERT_EQ(shots.size(), 1u);
+  const Shot& s = shots[0];
+  EXPECT_NEAR(s.distance_radii, 5, 1e-12);
+  capture::FromBallDesc fd;
+  fd.size = 64;
+  fd.reflectance = d.reflectance;
+  auto persp = capture::probe_from_ball({view_of(s, "persp")}, fd);
+  auto ortho = capture::probe_from_ball({{s.radiance, s.ball, 0, 0, "ortho"}}, fd);
+  Scene truth_scene = scene_without_projector();
+  truth_scene.build();
+  TruthDesc td;
+  td.size = 64;
+  td.bands = 0;
+  Truth t = ground_truth(truth_scene, d.ball_center, td);
+  auto normals = sphere::fibonacci_sphere(20480);
+  // The truth seen through the probe's validity (the blind cone behind the ball left out of both).
+  auto Et = irradiance_all(t.radiance, normals, &persp.probe.image);
+  double ep = mean_relative(irradiance_all(persp.probe, normals, &persp.probe.image), Et);
+  double eo = mean_relative(irradiance_all(ortho.probe, normals, &ortho.probe.image), Et);
+  std::printf("lab, one view at 5 radii, 20480 normals: perspective %.2f %%, orthographic %.2f %%\n", 100 * ep,
+              100 * eo);
+  EXPECT_LT(ep, 0.03);
+  EXPECT_GT(eo, 2 * ep);
+}
+
+TEST(LabShoot, TwoViewsLeaveNoPixelOfThePhotographer) {
+  Scene base = scene_without_projector();
+  ShootDesc d;
+  d.ball_center = {0, 1, 0};
+  d.ball_radius = 0.05;
+  d.distance = 2.0;  // 40 radii: a standing photographer stays within 37° of the lens axis
+  d.width = d.height = 256;
+  d.views_deg = {0, 90};
+  d.render = base.render;
+  auto shots = shoot(base, d);
+  ASSERT_EQ(shots.size(), 2u);
+  // Each photograph shows its own photographer.
+  for (const Shot& s : shots) {
+    double occ = 0;
+    for (size_t i = 0; i < s.occluder.size(); ++i) occ += s.occluder.data()[i];
+    EXPECT_GT(occ, 50) << "view " << s.angle_deg;
+  }
+  capture::FromBallDesc fd;
+  fd.size = 64;
+  fd.reflectance = d.reflectance;
+  auto probe = capture::probe_from_ball({view_of(shots[0], "a"), view_of(shots[1], "b")}, fd);
+  EXPECT_EQ(probe.invalid_pixels, 0);
+  // The occluder masks through the same unwarp and blend (a mask is no radiance: no Fresnel division).
+  capture::FromBallDesc md = fd;
+  md.reflectance.fresnel = false;
+  md.reflectance.r0 = Vec3{1, 1, 1};
+  Image m0(256, 256, 3), m1(256, 256, 3);
+  for (int y = 0; y < 256; ++y)
+    for (int x = 0; x < 256; ++x) {
+      float a = shots[0].occluder.at(x, y, 0), b = shots[1].occluder.at(x, y, 0);
+      m0.set_rgb(x, y, {a, a, a});
+      m1.set_rgb(x, y, {b, b, b});
+    }
+  auto mask = capture::probe_from_ball({view_of(shots[0], "a", &m0), view_of(shots[1], "b", &m1)}, md);
+  float most = 0;
+  for (int y = 0; y < mask.probe.image.height(); ++y)
+    for (int x = 0; x < mask.probe.image.width(); ++x) most = std::max(most, mask.probe.image.at(x, y, 0));
+  EXPECT_EQ(most, 0.0f) << "a pixel of the probe comes from a photographer";
+  // One view alone keeps its photographer.
+  auto single = capture::probe_from_ball({view_of(shots[0], "a", &m0)}, md);
+  float one = 0;
+  for (int y = 0; y < single.probe.image.height(); ++y)
+    for (int x = 0; x < single.probe.image.width(); ++x) one = std::max(one, single.probe.image.at(x, y, 0));
+  EXPECT_GT(one, 0.5f);
+  // Irradiance against the exact probe at the ball's centre (the scene without photographers).
+  Scene truth_scene = scene_without_projector();
+  truth_scene.build();
+  TruthDesc td;
+  td.size = 64;
+  td.bands = 0;
+  Truth t = ground_truth(truth_scene, d.ball_center, td);
+  auto normals = sphere::fibonacci_sphere(20480);
+  double e = mean_relative(irradiance_all(probe.probe, normals, nullptr), irradiance_all(t.radiance, normals, nullptr));
+  std::printf("lab, two views at 40 radii, 20480 normals: %.2f %% mean relative irradiance\n", 100 * e);
+  EXPECT_LT(e, 0.03);
+}
+
+}  // namespace
+}  // namespace ibl::lab
