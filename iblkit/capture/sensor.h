@@ -1,0 +1,48 @@
+// The camera's forward model: radiance in the scene -> the code values a camera writes. The lab's
+// `lab shoot` photographs through it, and `hdr merge` inverts it (merge.h); its tests measure one
+// against the other exactly.
+//
+// For pixel p and channel c the sensor collects the relative exposure
+//   X = L_c(p) · t · (ISO / 100) / N² · wb_c · v(p),   v(p) = 1 − vignetting · r(p)²,
+// where t is the exposure time in seconds, N the f-number, r the distance from the image centre
+// over the half-diagonal (so 1 s at f/1, ISO 100 turns radiance 1 into X = 1, which saturates).
+// Noise (Gaussian approximations, independent per pixel and channel):
+//   shot noise: variance X / electrons, electrons = full_well · 100 / ISO (photo-electrons at
+//               saturation; 0 turns shot noise off);
+//   read noise: standard deviation read_noise (in units of the saturation level), added after.
+// Then X is clamped to [0, 1], sent through the response curve and quantised to `bits` bits:
+// code = round(response.apply(X) · (2^bits − 1)) / (2^bits − 1).
+#pragma once
+#include <cstdint>
+
+#include "iblkit/capture/response.h"
+#include "iblkit/core/image.h"
+#include "iblkit/core/vec.h"
+
+namespace ibl::capture {
+
+struct SensorDesc {
+  double exposure_s = 1.0;  // exposure time t, seconds
+  double f_number = 1.0;    // N
+  double iso = 100.0;       // ISO speed
+  Vec3 wb_gains{1, 1, 1};   // white-balance gains applied to the linear signal
+  double full_well = 0.0;   // photo-electrons at saturation at ISO 100 (0: no shot noise)
+  double read_noise = 0.0;  // read noise σ, in units of the saturation level
+  double vignetting = 0.0;  // v = 1 − vignetting · r²; in [0, 1)
+  Response response = srgb_response();
+  int bits = 8;       // 8 or 16
+  uint64_t seed = 0;  // noise stream; same seed, same pixels
+
+  // Relative exposure per unit radiance: t · (ISO / 100) / N².
+  double exposure_factor() const { return exposure_s * (iso / 100.0) / (f_number * f_number); }
+};
+
+// Fails (ibl::Error) unless every field is in range (positive time, f-number, ISO, gains; bits 8 or
+// 16; vignetting in [0, 1); noise >= 0; a valid response).
+void validate(const SensorDesc& s);
+
+// The code values (in [0, 1], 3 channels; a grey radiance image is repeated) the sensor writes for
+// `radiance` (linear RGB, finite and non-negative). Deterministic given s.seed.
+Image expose(const Image& radiance, const SensorDesc& s);
+
+}  // namespace ibl::capture
