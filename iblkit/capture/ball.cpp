@@ -122,8 +122,11 @@ CircleFit find_ball(const Image& photo, const std::string& file, const std::stri
         double ay = (ll(-1, 1) + 2 * ll(0, 1) + ll(1, 1)) - (ll(-1, -1) + 2 * ll(0, -1) + ll(1, -1));
         return std::hypot(ax, ay);
       };
-      if (g < gm(x + sx, y + sy) || g < gm(x - sx, y - sy)) continue;
-      edges.push_back({x + 0.5, y + 0.5, g});
+      const double gp = gm(x + sx, y + sy), gn = gm(x - sx, y - sy);
+      if (g < gp || g < gn) continue;
+      // Sub-pixel: the peak of the parabola through the three magnitudes along the gradient's step.
+      const double curv = gn - 2 * g + gp, t = curv < 0 ? std::clamp(0.5 * (gn - gp) / curv, -0.5, 0.5) : 0.0;
+      edges.push_back({x + 0.5 + t * sx, y + 0.5 + t * sy, g});  // t in units of the step (sx, sy)
     }
   if (edges.size() < 16) say("too few edges");
   // The strongest 4 · (W + H) edge points: a ball's outline is a long strong edge.

@@ -7,6 +7,9 @@
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
 
+#include <cmath>
+#include <string>
+
 #include "iblkit/core/error.h"
 #include "iblkit/io/codecs.h"
 
@@ -75,7 +78,27 @@ bool oiio_draw_text(Image& img, int x, int y, const std::string& text, int size,
                                          OIIO::cspan<float>(col, img.channels() >= 4 ? 4 : 3));
 }
 
-const OiioCodec kCodec{oiio_read, oiio_read_header, oiio_write, oiio_draw_text};
+void oiio_write_photo(const std::string& path, const Image& img, const PhotoMeta& m) {
+  std::string ext = OIIO::Strutil::lower(OIIO::Filesystem::extension(path));
+  auto out = OIIO::ImageOutput::create(path);
+  if (!out) fail(ErrorKind::Format, "{}: no image writer for extension '{}' ({})", path, ext, OIIO::geterror());
+  OIIO::ImageSpec spec(img.width(), img.height(), img.channels(),
+                       m.bits == 16 ? OIIO::TypeDesc::UINT16 : OIIO::TypeDesc::UINT8);
+  if (m.srgb) spec.attribute("oiio:ColorSpace", "sRGB");
+  if (ext == ".jpg" || ext == ".jpeg") {
+    spec.attribute("Compression", "jpeg:" + std::to_string(m.quality));
+    spec.attribute("CompressionQuality", m.quality);
+  }
+  if (m.exposure_s > 0) spec.attribute("ExposureTime", static_cast<float>(m.exposure_s));
+  if (m.f_number > 0) spec.attribute("FNumber", static_cast<float>(m.f_number));
+  if (m.iso > 0) spec.attribute("Exif:ISOSpeedRatings", static_cast<int>(std::lround(m.iso)));
+  if (!out->open(path, spec)) fail(ErrorKind::Io, "{}: cannot write ({})", path, out->geterror());
+  if (!out->write_image(OIIO::TypeDesc::FLOAT, img.data()))
+    fail(ErrorKind::Io, "{}: write failed ({})", path, out->geterror());
+  if (!out->close()) fail(ErrorKind::Io, "{}: close failed ({})", path, out->geterror());
+}
+
+const OiioCodec kCodec{oiio_read, oiio_read_header, oiio_write, oiio_draw_text, oiio_write_photo};
 [[maybe_unused]] const bool kProvided = (oiio_codec.provide(&kCodec), true);
 
 }  // namespace

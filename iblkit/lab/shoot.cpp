@@ -111,4 +111,53 @@ std::vector<Shot> shoot(const Scene& base, const ShootDesc& d, const ProgressFn&
   return shots;
 }
 
+std::vector<double> bracket_times(int n, double ev_step, double middle_s) {
+  if (n < 1 || n > 64) fail(ErrorKind::Value, "bracket of {} frames is out of range [1, 64] (--bracket)", n);
+  if (!(ev_step > 0 && ev_step <= 8)) fail(ErrorKind::Value, "EV step {} must lie in (0, 8] (--ev-step)", ev_step);
+  if (!(middle_s > 0 && std::isfinite(middle_s))) fail(ErrorKind::Value, "exposure {} s must be positive", middle_s);
+  std::vector<double> t;
+  for (int k = 0; k < n; ++k) t.push_back(middle_s * std::exp2(ev_step * (k - (n - 1) / 2.0)));
+  return t;
+}
+
+double middle_grey_exposure(const Image& radiance, const capture::BallCircle& ball, const capture::SensorDesc& s) {
+  std::vector<double> lum;
+  for (int y = 0; y < radiance.height(); ++y)
+    for (int x = 0; x < radiance.width(); ++x)
+      if (std::hypot(x + 0.5 - ball.cx, y + 0.5 - ball.cy) < ball.r) lum.push_back(luminance(radiance.rgb(x, y)));
+  if (lum.empty()) fail(ErrorKind::Value, "the ball covers no pixel");
+  std::nth_element(lum.begin(), lum.begin() + lum.size() / 2, lum.end());
+  double med = lum[lum.size() / 2];
+  if (!(med > 0)) fail(ErrorKind::Value, "the ball is black in the linear photograph: give the exposure (--exposure)");
+  return 0.18 * s.f_number * s.f_number / (s.iso / 100.0) / med;
+}
+
+std::vector<BracketFrame> bracket(const Image& radiance, const BracketDesc& desc) {
+  if (desc.exposures_s.empty()) fail(ErrorKind::Value, "a bracket needs at least one exposure");
+  if (desc.shift_px < 0 || desc.shift_px > 256)
+    fail(ErrorKind::Value, "hand-held shift {} px is out of range [0, 256] (--shift)", desc.shift_px);
+  Rng rng(stream_key(desc.sensor.seed, 0x7368696674u /* "shift" */, 0, 0));
+  std::vector<BracketFrame> frames;
+  const int W = radiance.width(), H = radiance.height();
+  for (size_t k = 0; k < desc.exposures_s.size(); ++k) {
+    BracketFrame f;
+    f.exposure_s = desc.exposures_s[k];
+    if (k > 0 && desc.shift_px > 0) {
+      f.dx = static_cast<int>(std::floor(rng.uniform() * (2 * desc.shift_px + 1))) - desc.shift_px;
+      f.dy = static_cast<int>(std::floor(rng.uniform() * (2 * desc.shift_px + 1))) - desc.shift_px;
+    }
+    Image moved = radiance;
+    if (f.dx != 0 || f.dy != 0)
+      for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x)
+          moved.set_rgb(x, y, radiance.rgb(std::clamp(x - f.dx, 0, W - 1), std::clamp(y - f.dy, 0, H - 1)));
+    capture::SensorDesc s = desc.sensor;
+    s.exposure_s = f.exposure_s;
+    s.seed = desc.sensor.seed + k;
+    f.codes = capture::expose(moved, s);
+    frames.push_back(std::move(f));
+  }
+  return frames;
+}
+
 }  // namespace ibl::lab

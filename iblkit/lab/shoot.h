@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "iblkit/capture/ball.h"
+#include "iblkit/capture/sensor.h"
 #include "iblkit/core/image.h"
 #include "iblkit/core/progress.h"
 #include "iblkit/geometry/camera.h"
@@ -46,5 +47,31 @@ struct Shot {
 
 // The views of desc.views_deg. `scene` is not built (its copies get the boxes and are built here).
 std::vector<Shot> shoot(const Scene& scene, const ShootDesc& desc, const ProgressFn& progress = {});
+
+// A bracket of exposures through capture/'s sensor model (the code `hdr merge` inverts): frame k is
+// expose(radiance shifted by shifts[k], sensor with exposure_s = exposures_s[k] and noise seed
+// sensor.seed + k). Hand-held: frames after the first are moved by whole pixels, each offset uniform in
+// [−shift_px, shift_px] along x and y (fixed seed; the edge pixels repeat), as Ward's alignment undoes.
+struct BracketDesc {
+  std::vector<double> exposures_s;  // seconds, one per frame
+  capture::SensorDesc sensor;       // f-number, ISO, response, noise, vignetting, white balance, bits
+  int shift_px = 0;                 // hand-held shift bound, pixels (0: a tripod)
+};
+
+struct BracketFrame {
+  Image codes;         // code values in [0, 1], 3 channels
+  double exposure_s;   // this frame's exposure time
+  int dx = 0, dy = 0;  // its shift: frame pixel (x, y) shows the scene's (x − dx, y − dy)
+};
+
+std::vector<BracketFrame> bracket(const Image& radiance, const BracketDesc& desc);
+
+// Exposure times of n frames `ev_step` stops apart around `middle_s` (n odd: the middle frame is
+// middle_s), shortest first.
+std::vector<double> bracket_times(int n, double ev_step, double middle_s);
+
+// The exposure time that puts the median luminance of the ball's pixels (inside `ball`) at relative
+// exposure 0.18 (middle grey) for this sensor's f-number and ISO.
+double middle_grey_exposure(const Image& radiance, const capture::BallCircle& ball, const capture::SensorDesc& s);
 
 }  // namespace ibl::lab
