@@ -7,8 +7,12 @@
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <string>
+
+#include <fmt/format.h>
 
 #include "iblkit/core/error.h"
 #include "iblkit/io/codecs.h"
@@ -78,6 +82,12 @@ bool oiio_draw_text(Image& img, int x, int y, const std::string& text, int size,
                                          OIIO::cspan<float>(col, img.channels() >= 4 ? 4 : 3));
 }
 
+const uint16_t& iso16(double iso) {
+  static thread_local uint16_t v;
+  v = static_cast<uint16_t>(std::clamp(std::lround(iso), 1L, 65535L));
+  return v;
+}
+
 void oiio_write_photo(const std::string& path, const Image& img, const PhotoMeta& m) {
   std::string ext = OIIO::Strutil::lower(OIIO::Filesystem::extension(path));
   auto out = OIIO::ImageOutput::create(path);
@@ -91,7 +101,14 @@ void oiio_write_photo(const std::string& path, const Image& img, const PhotoMeta
   }
   if (m.exposure_s > 0) spec.attribute("ExposureTime", static_cast<float>(m.exposure_s));
   if (m.f_number > 0) spec.attribute("FNumber", static_cast<float>(m.f_number));
-  if (m.iso > 0) spec.attribute("Exif:ISOSpeedRatings", static_cast<int>(std::lround(m.iso)));
+  if (m.iso > 0) {  // EXIF 2.3 tag 0x8827 (ISOSpeedRatings before 2.3): OpenImageIO's name for it
+    spec.attribute("Exif:PhotographicSensitivity", OIIO::TypeDesc::UINT16, &iso16(m.iso));
+  }
+  // OpenImageIO 2.4's TIFF writer leaves the ISO tag out (it writes ExposureTime and FNumber): the
+  // description carries all three in every format.
+  spec.attribute("ImageDescription", "iblkit camera: ExposureTime=" + fmt::format("{:.9g}", m.exposure_s) +
+                                         " FNumber=" + fmt::format("{:.9g}", m.f_number) +
+                                         " ISO=" + fmt::format("{:.9g}", m.iso));
   if (!out->open(path, spec)) fail(ErrorKind::Io, "{}: cannot write ({})", path, out->geterror());
   if (!out->write_image(OIIO::TypeDesc::FLOAT, img.data()))
     fail(ErrorKind::Io, "{}: write failed ({})", path, out->geterror());

@@ -80,7 +80,7 @@ void write_png(const std::string& path, const Image& img, bool srgb = true);
 
 // OpenImageIO's side, provided by the oiio plugin (io/codec_oiio.cpp).
 // A camera's file: code values written as they are (no transfer curve applied here), 8 or 16 bits,
-// with the exposure in EXIF (ExposureTime, FNumber, Exif:ISOSpeedRatings).
+// with the exposure in EXIF (ExposureTime, FNumber, Exif:PhotographicSensitivity = ISOSpeedRatings).
 struct PhotoMeta {
   int bits = 8;
   int quality = 95;                              // JPEG quality 1–100
