@@ -18,6 +18,7 @@
 #include "iblkit/core/json_file.h"
 #include "iblkit/geometry/camera_io.h"
 #include "iblkit/io/image_io.h"
+#include "iblkit/io/photo.h"
 #include "iblkit/io/tonemap.h"
 #include "iblkit/lab/capture.h"
 #include "iblkit/lab/scene_io.h"
@@ -355,14 +356,13 @@ void run_shoot(const ShootOpts& o) {
       nlohmann::json jf = nlohmann::json::array();
       for (size_t k = 0; k < frames.size(); ++k) {
         std::string name = fmt::format("{}_e{}.{}", base, k, o.format);
-        ibl::io::PhotoDesc pd;
-        pd.bits = sd.bits;
-        pd.quality = o.quality;
-        pd.srgb = sd.response.kind == "srgb";
-        pd.exposure_s = frames[k].exposure_s;
-        pd.f_number = sd.f_number;
-        pd.iso = sd.iso;
-        ibl::io::write_photo((out / name).string(), frames[k].codes, pd);
+        ibl::io::PhotoMeta pm;
+        pm.exposure_time = frames[k].exposure_s;
+        pm.f_number = sd.f_number;
+        pm.iso = sd.iso;
+        pm.make = "iblkit";
+        pm.model = "lab shoot";
+        ibl::io::write_photo((out / name).string(), frames[k].codes, sd.bits, pm, o.quality);
         jf.push_back({{"file", name},
                       {"exposure_s", frames[k].exposure_s},
                       {"f_number", sd.f_number},

@@ -7,12 +7,7 @@
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
 
-#include <algorithm>
 #include <cmath>
-#include <cstdint>
-#include <string>
-
-#include <fmt/format.h>
 
 #include "iblkit/core/error.h"
 #include "iblkit/io/codecs.h"
@@ -82,40 +77,74 @@ bool oiio_draw_text(Image& img, int x, int y, const std::string& text, int size,
                                          OIIO::cspan<float>(col, img.channels() >= 4 ? 4 : 3));
 }
 
-const uint16_t& iso16(double iso) {
-  static thread_local uint16_t v;
-  v = static_cast<uint16_t>(std::clamp(std::lround(iso), 1L, 65535L));
-  return v;
+Photo oiio_read_photo(const std::string& path) {
+  auto in = open_input(path);
+  const OIIO::ImageSpec& spec = in->spec();
+  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0)
+    fail(ErrorKind::Format, "{}: image has no pixels ({}x{}x{})", path, spec.width, spec.height, spec.nchannels);
+  const auto base = spec.format.basetype;
+  if (base != OIIO::TypeDesc::UINT8 && base != OIIO::TypeDesc::UINT16)
+    fail(ErrorKind::Format,
+         "{}: holds {} pixels, not the 8- or 16-bit code values of a photograph (for an HDR image use it as a probe)",
+         path, spec.format.c_str());
+  check_decoded_size(path, spec.width, spec.height, spec.nchannels);
+  Image raw(spec.width, spec.height, spec.nchannels);
+  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, raw.data())) {
+    std::string err = in->geterror();
+    fail(ErrorKind::Format, "{}: corrupt or truncated image data ({})", path, err.empty() ? "read failed" : err);
+  }
+  Photo p;
+  p.bits = base == OIIO::TypeDesc::UINT8 ? 8 : 16;
+  p.format = in->format_name();
+  p.codes = Image(spec.width, spec.height, 3);
+  const int nc = spec.nchannels;
+  for (size_t i = 0; i < raw.pixel_count(); ++i)
+    for (int c = 0; c < 3; ++c) p.codes.data()[3 * i + c] = raw.data()[i * nc + (nc >= 3 ? c : 0)];
+  p.meta.exposure_time = spec.get_float_attribute("ExposureTime", 0.0f);
+  p.meta.f_number = spec.get_float_attribute("FNumber", 0.0f);
+  // Exif 2.3 renamed ISOSpeedRatings (tag 0x8827) PhotographicSensitivity; OpenImageIO 2.4 reads it so.
+  for (const char* name : {"Exif:ISOSpeedRatings", "Exif:PhotographicSensitivity"})
+    if (p.meta.iso <= 0) p.meta.iso = spec.get_int_attribute(name, 0);
+  p.meta.make = spec.get_string_attribute("Make");
+  p.meta.model = spec.get_string_attribute("Model");
+  in->close();
+  return p;
 }
 
-void oiio_write_photo(const std::string& path, const Image& img, const PhotoMeta& m) {
-  std::string ext = OIIO::Strutil::lower(OIIO::Filesystem::extension(path));
+void oiio_write_photo(const std::string& path, const Image& codes, int bits, const PhotoMeta& meta, int quality) {
   auto out = OIIO::ImageOutput::create(path);
-  if (!out) fail(ErrorKind::Format, "{}: no image writer for extension '{}' ({})", path, ext, OIIO::geterror());
-  OIIO::ImageSpec spec(img.width(), img.height(), img.channels(),
-                       m.bits == 16 ? OIIO::TypeDesc::UINT16 : OIIO::TypeDesc::UINT8);
-  if (m.srgb) spec.attribute("oiio:ColorSpace", "sRGB");
-  if (ext == ".jpg" || ext == ".jpeg") {
-    spec.attribute("Compression", "jpeg:" + std::to_string(m.quality));
-    spec.attribute("CompressionQuality", m.quality);
+  if (!out) fail(ErrorKind::Format, "{}: no image writer for this extension ({})", path, OIIO::geterror());
+  OIIO::ImageSpec spec(codes.width(), codes.height(), codes.channels(),
+                       bits == 16 ? OIIO::TypeDesc::UINT16 : OIIO::TypeDesc::UINT8);
+  if (meta.exposure_time > 0) spec.attribute("ExposureTime", static_cast<float>(meta.exposure_time));
+  if (meta.f_number > 0) spec.attribute("FNumber", static_cast<float>(meta.f_number));
+  if (meta.iso > 0) spec.attribute("Exif:ISOSpeedRatings", static_cast<int>(std::lround(meta.iso)));
+  if (!meta.make.empty()) spec.attribute("Make", meta.make);
+  if (!meta.model.empty()) spec.attribute("Model", meta.model);
+  if (std::string(out->format_name()) == "jpeg") {
+    spec.attribute("Compression", fmt::format("jpeg:{}", quality));
+    spec.attribute("CompressionQuality", quality);
+  } else if (std::string(out->format_name()) == "tiff") {
+    spec.attribute("Compression", "zip");  // lossless
   }
-  if (m.exposure_s > 0) spec.attribute("ExposureTime", static_cast<float>(m.exposure_s));
-  if (m.f_number > 0) spec.attribute("FNumber", static_cast<float>(m.f_number));
-  if (m.iso > 0) {  // EXIF 2.3 tag 0x8827 (ISOSpeedRatings before 2.3): OpenImageIO's name for it
-    spec.attribute("Exif:PhotographicSensitivity", OIIO::TypeDesc::UINT16, &iso16(m.iso));
-  }
-  // OpenImageIO 2.4's TIFF writer leaves the ISO tag out (it writes ExposureTime and FNumber): the
-  // description carries all three in every format.
-  spec.attribute("ImageDescription", "iblkit camera: ExposureTime=" + fmt::format("{:.9g}", m.exposure_s) +
-                                         " FNumber=" + fmt::format("{:.9g}", m.f_number) +
-                                         " ISO=" + fmt::format("{:.9g}", m.iso));
   if (!out->open(path, spec)) fail(ErrorKind::Io, "{}: cannot write ({})", path, out->geterror());
-  if (!out->write_image(OIIO::TypeDesc::FLOAT, img.data()))
-    fail(ErrorKind::Io, "{}: write failed ({})", path, out->geterror());
+  // Rounded here: OpenImageIO's float -> integer conversion is not round-to-nearest everywhere.
+  const double levels = bits == 16 ? 65535.0 : 255.0;
+  bool ok;
+  if (bits == 16) {
+    std::vector<uint16_t> q(codes.size());
+    for (size_t i = 0; i < q.size(); ++i) q[i] = static_cast<uint16_t>(std::lround(codes.data()[i] * levels));
+    ok = out->write_image(OIIO::TypeDesc::UINT16, q.data());
+  } else {
+    std::vector<uint8_t> q(codes.size());
+    for (size_t i = 0; i < q.size(); ++i) q[i] = static_cast<uint8_t>(std::lround(codes.data()[i] * levels));
+    ok = out->write_image(OIIO::TypeDesc::UINT8, q.data());
+  }
+  if (!ok) fail(ErrorKind::Io, "{}: write failed ({})", path, out->geterror());
   if (!out->close()) fail(ErrorKind::Io, "{}: close failed ({})", path, out->geterror());
 }
 
-const OiioCodec kCodec{oiio_read, oiio_read_header, oiio_write, oiio_draw_text, oiio_write_photo};
+const OiioCodec kCodec{oiio_read, oiio_read_header, oiio_write, oiio_draw_text, oiio_read_photo, oiio_write_photo};
 [[maybe_unused]] const bool kProvided = (oiio_codec.provide(&kCodec), true);
 
 }  // namespace

@@ -17,6 +17,7 @@
 #include "iblkit/core/error.h"
 #include "iblkit/core/image.h"
 #include "iblkit/core/plugin.h"
+#include "iblkit/io/photo.h"
 
 namespace ibl::io::detail {
 
@@ -79,15 +80,6 @@ void write_rgbe(const std::string& path, const Image& img);            // 3 chan
 void write_png(const std::string& path, const Image& img, bool srgb = true);
 
 // OpenImageIO's side, provided by the oiio plugin (io/codec_oiio.cpp).
-// A camera's file: code values written as they are (no transfer curve applied here), 8 or 16 bits,
-// with the exposure in EXIF (ExposureTime, FNumber, Exif:PhotographicSensitivity = ISOSpeedRatings).
-struct PhotoMeta {
-  int bits = 8;
-  int quality = 95;                              // JPEG quality 1–100
-  bool srgb = true;                              // tag the file as sRGB-encoded (oiio:ColorSpace)
-  double exposure_s = 0, f_number = 0, iso = 0;  // 0: not written
-};
-
 struct OiioCodec {
   Decoded (*read)(const std::string& path);
   Header (*read_header)(const std::string& path);
@@ -96,8 +88,9 @@ struct OiioCodec {
   void (*write)(const std::string& path, const Image& img, bool ldr, bool half);
   // Draws text as io/draw.h's draw_text documents, with the TrueType font at `font`.
   bool (*draw_text)(Image& img, int x, int y, const std::string& text, int size, const char* font, Vec3 rgb);
-  // Writes code values in [0, 1] as a camera's file (JPEG, TIFF, PNG: the extension's format).
-  void (*write_photo)(const std::string& path, const Image& codes, const PhotoMeta& meta);
+  // A photograph's code values and Exif exposure data (io/photo.h), and the writer of one.
+  Photo (*read_photo)(const std::string& path);
+  void (*write_photo)(const std::string& path, const Image& codes, int bits, const PhotoMeta& meta, int quality);
 };
 extern plugin::Provided<OiioCodec> oiio_codec;
 

@@ -198,30 +198,4 @@ void write_image(const std::string& path, const Image& img, const WriteDesc& des
   file.commit();
 }
 
-void write_photo(const std::string& path, const Image& codes, const PhotoDesc& desc) {
-  if (codes.empty()) fail(ErrorKind::Value, "{}: refusing to write an empty image", path);
-  if (desc.bits != 8 && desc.bits != 16) fail(ErrorKind::Value, "{}: {} bits per channel (8 or 16)", path, desc.bits);
-  if (desc.quality < 1 || desc.quality > 100)
-    fail(ErrorKind::Value, "{}: JPEG quality {} is out of range [1, 100]", path, desc.quality);
-  std::string ext = fs::path(path).extension().string();
-  for (auto& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
-  const bool jpeg = ext == ".jpg" || ext == ".jpeg";
-  if (!jpeg && ext != ".tif" && ext != ".tiff" && ext != ".png")
-    fail(ErrorKind::Value, "{}: a camera's file is .jpg, .tif or .png", path);
-  if (jpeg && desc.bits != 8) fail(ErrorKind::Value, "{}: JPEG holds 8 bits per channel; use .tif for 16", path);
-  Image src = codes;
-  for (size_t i = 0; i < src.size(); ++i) src.data()[i] = std::clamp(src.data()[i], 0.0f, 1.0f);
-  detail::PhotoMeta m{desc.bits, desc.quality, desc.srgb, desc.exposure_s, desc.f_number, desc.iso};
-  AtomicFile file(path);
-  try {
-    detail::oiio_codec.get().write_photo(file.temp_path(), src, m);
-  } catch (const Error& e) {
-    std::string msg = e.what();
-    for (size_t at; (at = msg.find(file.temp_path())) != std::string::npos;)
-      msg.replace(at, file.temp_path().size(), path);
-    throw Error(e.kind(), msg);
-  }
-  file.commit();
-}
-
 }  // namespace ibl::io

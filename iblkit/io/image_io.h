@@ -48,18 +48,6 @@ struct WriteDesc {
 // (use io/tonemap.h first for HDR content). Creates no folders.
 void write_image(const std::string& path, const Image& img, const WriteDesc& desc = {});
 
-// A camera's file (issue 29 §3, lab shoot): `codes` are the code values in [0, 1] the sensor wrote
-// (capture::expose), stored as they are — no transfer curve is applied — at 8 or 16 bits in the
-// extension's format (.jpg at `quality`, .tif, .png), with the exposure as EXIF metadata
-// (ExposureTime, FNumber, ISOSpeedRatings) through OpenImageIO. Atomic, as write_image.
-struct PhotoDesc {
-  int bits = 8;                                  // 8, or 16 (.tif, .png)
-  int quality = 95;                              // .jpg quality, 1–100
-  bool srgb = true;                              // tag the file as sRGB-encoded
-  double exposure_s = 0, f_number = 0, iso = 0;  // EXIF; 0: left out
-};
-void write_photo(const std::string& path, const Image& codes, const PhotoDesc& desc);
-
 // sRGB transfer function (IEC 61966-2-1).
 float srgb_to_linear(float v);
 float linear_to_srgb(float v);
