@@ -129,8 +129,8 @@ CircleFit find_ball(const Image& photo, const std::string& file, const std::stri
       edges.push_back({x + 0.5 + t * sx, y + 0.5 + t * sy, g});  // t in units of the step (sx, sy)
     }
   if (edges.size() < 16) say("too few edges");
-  // The strongest 4 · (W + H) edge points: a ball's outline is a long strong edge.
-  size_t keep = std::min(edges.size(), static_cast<size_t>(4 * (W + H)));
+  // The strongest 12 · (W + H) edge points: a ball's outline is a long edge, if not the strongest one.
+  size_t keep = std::min(edges.size(), static_cast<size_t>(12 * (W + H)));
   std::nth_element(edges.begin(), edges.begin() + (keep - 1), edges.end(),
                    [](const Edge& a, const Edge& b) { return a.g > b.g; });
   edges.resize(keep);
@@ -156,18 +156,40 @@ CircleFit find_ball(const Image& photo, const std::string& file, const std::stri
     }
     return std::count(bins.begin(), bins.end(), 1) / 360.0;
   };
+  // Candidates drawn in a fixed order, scored in parallel (the best by coverage, ties to the first).
   std::mt19937_64 rng(12345);
   std::uniform_int_distribution<size_t> pick(0, edges.size() - 1);
   const double rmin = 8, rmax = 0.5 * std::max(W, H);
-  BallCircle best;
-  double best_cov = 0;
-  std::vector<int> inl;
+  std::vector<BallCircle> cand;
   for (int it = 0; it < 4000; ++it) {
     BallCircle c;
     if (!circle3(edges[pick(rng)], edges[pick(rng)], edges[pick(rng)], &c)) continue;
     if (c.r < rmin || c.r > rmax) continue;
-    double cov = coverage(c, &inl);
-    if (cov > best_cov) best_cov = cov, best = c;
+    cand.push_back(c);
+  }
+  std::vector<double> score(cand.size(), 0);
+  BallCircle best;
+  double best_cov = 0;
+  std::vector<int> inl;
+  // In chunks of 256, stopping once a circle has edges along 90 % of its outline.
+  for (size_t start = 0; start < cand.size() && best_cov < 0.9; start += 256) {
+    const size_t end = std::min(cand.size(), start + 256);
+    parallel_for(
+        static_cast<int64_t>(start), static_cast<int64_t>(end),
+        [&](int64_t i) {
+          const BallCircle& c = cand[static_cast<size_t>(i)];
+          const double lo = std::max(0.0, c.r - tol), hi = c.r + tol, lo2 = lo * lo, hi2 = hi * hi;
+          std::vector<char> bins(360, 0);
+          for (const Edge& e : edges) {
+            double dx = e.x - c.cx, dy = e.y - c.cy, d2 = dx * dx + dy * dy;
+            if (d2 < lo2 || d2 > hi2) continue;
+            bins[static_cast<int>((std::atan2(dy, dx) + kPi) / (2 * kPi) * 360) % 360] = 1;
+          }
+          score[static_cast<size_t>(i)] = std::count(bins.begin(), bins.end(), 1) / 360.0;
+        },
+        16);
+    for (size_t i = start; i < end; ++i)
+      if (score[i] > best_cov) best_cov = score[i], best = cand[i];
   }
   if (best_cov < 0.5)
     say(fmt::format("the best circle covers {:.0f} % of its outline with edges, need 50 %", 100 * best_cov));
