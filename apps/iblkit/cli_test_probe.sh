@@ -27,6 +27,8 @@ check from-ball-two ok "0 invalid pixels" -- "$BIN" probe from-ball "$S/view0.ex
 [ -f "$T/w.exr" ] && pass=$((pass+1)) || { echo "FAIL from-ball-weights: no map"; fail=$((fail+1)); }
 check from-ball-fit ok "residual" -- "$BIN" probe from-ball "$S/view0.exr" --distance 40 --size 32 \
   --mapping mirrorball --out "$T/p1.exr"
+check from-ball-auto-angle ok "estimated from the overlap" -- "$BIN" probe from-ball "$S/view0.exr" "$S/view1.exr" \
+  --distance 40 --angle auto --size 16 --out "$T/pa.exr"
 check from-ball-lens ok "camera at" -- "$BIN" probe from-ball "$S/view0.exr" --ball 64,64,57.6 --focal-mm 200 \
   --sensor-mm 36 --size 16 --out "$T/p3.exr"
 check from-ball-info ok "4 channels|RGBA|channels" -- "$BIN" info "$T/p2.exr"

@@ -34,8 +34,8 @@ std::vector<double> parse_numbers(const std::string& s, const std::string& what)
 
 struct Opts {
   std::vector<std::string> photos, balls;
-  std::string out, weights, mapping = "latlong", reflectance, fresnel = "chrome";
-  double distance = 0, focal_mm = 0, sensor_mm = 0, angle = 90, rotate = 0, exclude = 40;
+  std::string out, weights, mapping = "latlong", reflectance, fresnel = "chrome", angle = "90";
+  double distance = 0, focal_mm = 0, sensor_mm = 0, rotate = 0, exclude = 40;
   int size = 256, samples = 2;
   bool orthographic = false, half = false;
 };
@@ -92,12 +92,27 @@ void run(const Opts& o) {
         ibl::fail(ibl::ErrorKind::Value, "--focal-mm and --sensor-mm go together (the sensor's width in mm)");
       v.distance = ibl::capture::distance_from_lens(v.ball.r, v.photo.width(), o.focal_mm, o.sensor_mm);
     }
-    v.angle_deg = i == 0 ? 0 : o.angle;
+    v.angle_deg = 0;
     jv["ball"] = {v.ball.cx, v.ball.cy, v.ball.r};
     jv["distance_radii"] = v.distance;
     jv["angle_deg"] = v.angle_deg;
     jviews.push_back(jv);
     views.push_back(std::move(v));
+  }
+  nlohmann::json jangle;
+  if (views.size() == 2) {
+    if (o.angle == "auto") {
+      ibl::capture::AngleEstimate e = ibl::capture::estimate_angle(views, d);
+      views[1].angle_deg = e.angle_deg;
+      jangle = {{"estimated", true}, {"mean_abs_log_difference", e.residual}, {"directions", e.directions}};
+    } else {
+      auto a = parse_numbers(o.angle, "--angle");
+      if (a.size() != 1) ibl::fail(ibl::ErrorKind::Value, "--angle: expected degrees or auto, got \"{}\"", o.angle);
+      views[1].angle_deg = a[0];
+      jangle = {{"estimated", false}};
+    }
+    jangle["angle_deg"] = views[1].angle_deg;
+    jviews[1]["angle_deg"] = views[1].angle_deg;
   }
   ibl::capture::FromBallResult r = ibl::capture::probe_from_ball(views, d);
   ibl::io::write_image(o.out, r.probe.image, {o.half});
@@ -110,6 +125,7 @@ void run(const Opts& o) {
                       {"blind_cone_deg", r.blind_cone_deg},
                       {"invalid_pixels", r.invalid_pixels}};
   if (!o.weights.empty()) j["weights"] = o.weights;
+  if (!jangle.is_null()) j["angle"] = jangle;
   iblcli::emit(j, [&] {
     for (const auto& jv : jviews) {
       fmt::print("{}: ball ({:.2f}, {:.2f}) r {:.2f} px ({}", jv["photo"].get<std::string>(),
@@ -122,6 +138,11 @@ void run(const Opts& o) {
       fmt::print("), camera at {}\n",
                  dist > 0 ? fmt::format("{:.2f} radii", dist) : std::string("infinity (orthographic)"));
     }
+    if (!jangle.is_null() && jangle["estimated"].get<bool>())
+      fmt::print(
+          "second view at {:.2f}° (estimated from the overlap: mean |log difference| {:.3f} over {} directions)\n",
+          jangle["angle_deg"].get<double>(), jangle["mean_abs_log_difference"].get<double>(),
+          jangle["directions"].get<int>());
     fmt::print("wrote {} ({} {}x{}, RGBA: alpha 0 where no view sees)", o.out, ibl::sphere::mapping_name(d.mapping),
                r.probe.image.width(), r.probe.image.height());
     if (views.size() == 1 && r.blind_cone_deg > 0) fmt::print("; blind cone {:.2f}° around −Z", r.blind_cone_deg);
@@ -150,7 +171,8 @@ void setup(CLI::App& app) {
   c->add_option("--fresnel", o->fresnel, "the rise towards grazing: chrome, steel, none or n,k")->capture_default_str();
   c->add_option("--angle", o->angle,
                 "two views: where the second camera stood, degrees about +Y from the first (+90: to the first "
-                "view's +X, the photographer walked to their right)")
+                "view's +X, the photographer walked to their right), or auto (estimated from the overlap in "
+                "[45, 135])")
       ->capture_default_str();
   c->add_option("--exclude", o->exclude,
                 "two views: directions within this many degrees of a view's camera axis come from the other view")

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <sstream>
 
@@ -9,6 +10,7 @@
 #include "iblkit/core/error.h"
 #include "iblkit/core/parallel.h"
 #include "iblkit/ilf/ball.h"
+#include "iblkit/sphere/pointset.h"
 
 namespace ibl::capture {
 
@@ -352,6 +354,73 @@ FromBallResult probe_from_ball(const std::vector<BallView>& views, const FromBal
   res.probe = sphere::EnvMap(std::move(out), m);
   res.weights = std::move(weights);
   return res;
+}
+
+AngleEstimate estimate_angle(const std::vector<BallView>& views, const FromBallDesc& desc, double lo_deg,
+                             double hi_deg) {
+  if (views.size() != 2) fail(ErrorKind::Value, "estimating the angle needs two photographs, got {}", views.size());
+  if (!(lo_deg < hi_deg)) fail(ErrorKind::Value, "angle search range [{}, {}] is empty", lo_deg, hi_deg);
+  const std::vector<Vec3> dirs = sphere::fibonacci_sphere(2048);
+  const double s_full = std::sin((desc.exclude_deg + desc.ramp_deg) * kPi / 180);
+  // Log luminance of a view along direction dv (its own frame), or false where it is not trusted.
+  auto sample = [&](const BallView& v, Vec3 dv, double* out) {
+    if (std::sqrt(std::max(0.0, 1 - dv.z * dv.z)) < s_full) return false;
+    ilf::BallOptics o = v.distance > 0 ? ilf::BallOptics{1.0, v.distance} : ilf::BallOptics{};
+    Vec3 view, nrm;
+    if (!ilf::ball_view_for(o, dv, &view, &nrm)) return false;
+    double px, py;
+    ilf::ball_image_point(o, view, nrm, v.ball.cx, v.ball.cy, v.ball.r, &px, &py);
+    float rgb[4] = {0, 0, 0, 0};
+    v.photo.view().bilinear(px, py, Wrap::Clamp, rgb);
+    Vec3 R = desc.reflectance.at(-dot(view, nrm));
+    *out = luminance(rgb[0] / R.x, rgb[1] / R.y, rgb[2] / R.z);
+    return true;
+  };
+  std::vector<double> first(dirs.size());
+  std::vector<char> first_ok(dirs.size());
+  std::vector<double> seen;
+  for (size_t i = 0; i < dirs.size(); ++i)
+    if ((first_ok[i] = sample(views[0], dirs[i], &first[i]))) seen.push_back(first[i]);
+  if (seen.empty()) fail(ErrorKind::Value, "the first view sees nothing to register; give the angle with --angle");
+  // Dark directions (below 1 % of the median) are noise: they count at that floor.
+  std::nth_element(seen.begin(), seen.begin() + seen.size() / 2, seen.end());
+  const double floor = std::max(1e-12, 0.01 * seen[seen.size() / 2]);
+  for (double& v : first) v = std::log(std::max(v, floor));
+  auto cost = [&](double angle, int* count) {
+    const Mat3 to_view = Mat3::rotation({0, 1, 0}, angle * kPi / 180).transposed();
+    double ss = 0;
+    int n = 0;
+    for (size_t i = 0; i < dirs.size(); ++i) {
+      double b;
+      if (!first_ok[i] || !sample(views[1], to_view * dirs[i], &b)) continue;
+      b = std::log(std::max(b, floor));
+      ss += std::abs(first[i] - b);
+      ++n;
+    }
+    if (count) *count = n;
+    return n >= 32 ? ss / n : std::numeric_limits<double>::infinity();
+  };
+  double best = lo_deg, best_c = std::numeric_limits<double>::infinity();
+  for (double a = lo_deg; a <= hi_deg + 1e-9; a += 1) {
+    double c = cost(a, nullptr);
+    if (c < best_c) best_c = c, best = a;
+  }
+  if (!std::isfinite(best_c))
+    fail(ErrorKind::Value, "the two views share no directions to register; give the angle with --angle");
+  double a = best - 1, b = best + 1;
+  const double g = 0.5 * (std::sqrt(5.0) - 1);
+  double x1 = b - g * (b - a), x2 = a + g * (b - a), f1 = cost(x1, nullptr), f2 = cost(x2, nullptr);
+  while (b - a > 0.01) {
+    if (f1 < f2) {
+      b = x2, x2 = x1, f2 = f1, x1 = b - g * (b - a), f1 = cost(x1, nullptr);
+    } else {
+      a = x1, x1 = x2, f1 = f2, x2 = a + g * (b - a), f2 = cost(x2, nullptr);
+    }
+  }
+  AngleEstimate e;
+  e.angle_deg = 0.5 * (a + b);
+  e.residual = cost(e.angle_deg, &e.directions);
+  return e;
 }
 
 }  // namespace ibl::capture

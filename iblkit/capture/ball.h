@@ -100,6 +100,18 @@ struct FromBallResult {
 // The probe. One or two views (the second's angle_deg says where it stood).
 FromBallResult probe_from_ball(const std::vector<BallView>& views, const FromBallDesc& desc);
 
+// The second view's angle (degrees about +Y) estimated from the views' overlap: over 2048 Fibonacci
+// directions that both views see away from their axes (weight 1 under desc's exclusion cones), the
+// mean squared difference of log luminance (each view divided by its reflectance) is minimised over
+// [lo_deg, hi_deg] in 1° steps, then refined by golden-section search to 0.01°. `residual` is that mean
+// absolute log difference at the optimum. views[1].angle_deg is ignored.
+struct AngleEstimate {
+  double angle_deg = 0, residual = 0;
+  int directions = 0;  // overlap directions at the optimum
+};
+AngleEstimate estimate_angle(const std::vector<BallView>& views, const FromBallDesc& desc, double lo_deg = 45,
+                             double hi_deg = 135);
+
 // Output size of a mapping from FromBallDesc::size (lat-long 2s × s, crosses 4s × 3s, …).
 sphere::Mapping output_mapping(sphere::MappingKind kind, int size);
 

@@ -256,6 +256,11 @@ TEST(CaptureBall, TwoViewsCoverTheSphere) {
   EXPECT_FLOAT_EQ(share({0, 0, -1}), 0.0f);
   EXPECT_FLOAT_EQ(share({1, 0, 0}), 1.0f);
   EXPECT_FLOAT_EQ(share({-1, 0, 0}), 1.0f);
+  // The angle from the overlap.
+  AngleEstimate est = estimate_angle({{a, {192, 192, 180}, D, 0, "a"}, {b, {192, 192, 180}, D, 0, "b"}}, fd);
+  std::printf("estimated angle %.3f° (true 90°), mean |log difference| %.4f over %d directions\n", est.angle_deg,
+              est.residual, est.directions);
+  EXPECT_NEAR(est.angle_deg, 90, 0.5);
   // A wrong angle shows: the views disagree.
   FromBallResult wrong = probe_from_ball({{a, {192, 192, 180}, D, 0, "a"}, {b, {192, 192, 180}, D, -90, "b"}}, fd);
   EXPECT_GT(mean_relative(irradiance(wrong.probe, normals), irradiance(truth, normals)), 5 * e);

@@ -167,6 +167,10 @@ TEST(LabShoot, TwoViewsLeaveNoPixelOfThePhotographer) {
     v.ball = f.circle;
   }
   auto fit_probe = capture::probe_from_ball(fitted, fd);
+  capture::AngleEstimate est = capture::estimate_angle(fitted, fd);
+  std::printf("  angle from the overlap: %.2f° (true 90°), mean |log difference| %.3f over %d directions\n",
+              est.angle_deg, est.residual, est.directions);
+  EXPECT_NEAR(est.angle_deg, 90, 3);  // noise and each side's photographer's shadows
   double ef =
       mean_relative(irradiance_all(fit_probe.probe, normals, nullptr), irradiance_all(t.radiance, normals, nullptr));
   std::printf("  with the fitted circles: %.2f %% mean relative irradiance\n", 100 * ef);
