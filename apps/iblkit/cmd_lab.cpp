@@ -10,15 +10,19 @@
 #include <fmt/format.h>
 
 #include "cli.h"
+#include "iblkit/capture/response.h"
+#include "iblkit/capture/sensor.h"
 #include "iblkit/core/atomic_file.h"
 #include "iblkit/core/error.h"
 #include "iblkit/core/json_file.h"
 #include "iblkit/geometry/camera_io.h"
 #include "iblkit/io/image_io.h"
+#include "iblkit/io/photo.h"
 #include "iblkit/io/tonemap.h"
 #include "iblkit/lab/capture.h"
 #include "iblkit/lab/scene_io.h"
 #include "iblkit/lab/sequence.h"
+#include "iblkit/lab/shoot.h"
 #include "iblkit/lab/truth.h"
 #include "iblkit/lab/view.h"
 #include "iblkit/render/objects.h"
@@ -257,6 +261,170 @@ void run_photograph(const PhotoOpts& o) {
   });
 }
 
+struct ShootOpts {
+  std::string scene, out, at = "0,1,0", views = "0", reflectance, fresnel = "chrome", response = "srgb", format = "jpg",
+                          wb = "1,1,1", exposure;
+  double ball_radius = 0.05, distance = 0.5, distance_radii = 0, azimuth = 0, elevation = 0, fill = 0.9, ev_step = 2,
+         fnumber = 8, iso = 100, full_well = 0, read_noise = 0, vignetting = 0;
+  int width = 512, height = 512, samples = 2, truth_size = 128, bracket = 0, quality = 95, shift = 0, area_samples = 0,
+      bounces = -1;
+  uint64_t seed = 1;
+  bool two_sides = false, no_photographer = false, noise = false;
+};
+
+std::vector<double> parse_doubles(const std::string& s, const std::string& what) {
+  std::vector<double> v;
+  std::stringstream ss(s);
+  std::string part;
+  while (std::getline(ss, part, ',')) {
+    size_t used = 0;
+    double x = 0;
+    try {
+      x = std::stod(part, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != part.size() || !std::isfinite(x))
+      ibl::fail(ibl::ErrorKind::Value, "{}: \"{}\" is not a list of numbers", what, s);
+    v.push_back(x);
+  }
+  return v;
+}
+
+void run_shoot(const ShootOpts& o) {
+  ibl::lab::Scene scene = ibl::lab::load_scene(o.scene, false);
+  ibl::lab::ShootDesc d;
+  d.ball_center = iblcli::parse_vec3(o.at, "--at");
+  d.ball_radius = o.ball_radius;
+  d.distance = o.distance_radii > 0 ? o.distance_radii * o.ball_radius : o.distance;
+  d.azimuth_deg = o.azimuth;
+  d.elevation_deg = o.elevation;
+  d.views_deg = o.two_sides ? std::vector<double>{0, 90} : parse_doubles(o.views, "--views");
+  d.width = o.width;
+  d.height = o.height;
+  d.fill = o.fill;
+  d.samples = o.samples;
+  d.photographer = !o.no_photographer;
+  d.render = scene.render;
+  if (o.area_samples > 0) d.render.area_samples = o.area_samples;
+  if (o.bounces >= 0) d.render.bounces = o.bounces;
+  d.render.seed = o.seed;
+  ibl::capture::parse_fresnel(o.fresnel, &d.reflectance);
+  if (!o.reflectance.empty()) {
+    auto r = parse_doubles(o.reflectance, "--reflectance");
+    if (r.size() != 1 && r.size() != 3)
+      ibl::fail(ibl::ErrorKind::Value, "--reflectance: expected r or r,g,b, got \"{}\"", o.reflectance);
+    d.reflectance.r0 = r.size() == 1 ? Vec3{r[0], r[0], r[0]} : Vec3{r[0], r[1], r[2]};
+  }
+  ibl::lab::BracketDesc bd;
+  if (o.bracket > 0) {
+    bd.sensor.f_number = o.fnumber;
+    bd.sensor.iso = o.iso;
+    bd.sensor.response = ibl::capture::response_by_name(o.response);
+    bd.sensor.bits = o.format == "jpg" ? 8 : 16;
+    if (o.format != "jpg" && o.format != "tif")
+      ibl::fail(ibl::ErrorKind::Value, "--format: expected jpg (8-bit) or tif (16-bit), got {}", o.format);
+    bd.sensor.full_well = o.noise && o.full_well == 0 ? 20000 : o.full_well;
+    bd.sensor.read_noise = o.noise && o.read_noise == 0 ? 0.001 : o.read_noise;
+    bd.sensor.vignetting = o.vignetting;
+    bd.sensor.wb_gains = iblcli::parse_vec3(o.wb, "--wb");
+    bd.sensor.seed = o.seed;
+    bd.shift_px = o.shift;
+    ibl::capture::validate(bd.sensor);
+  }
+  auto t0 = std::chrono::steady_clock::now();
+  auto shots = ibl::lab::shoot(scene, d, iblcli::progress_bar());
+  iblcli::progress_done();
+  fs::path out(o.out);
+  ibl::make_output_folders(out.string());
+  nlohmann::json jviews = nlohmann::json::array();
+  for (size_t v = 0; v < shots.size(); ++v) {
+    const auto& s = shots[v];
+    std::string base = fmt::format("view{}", v);
+    ibl::io::write_image((out / (base + ".exr")).string(), s.radiance);
+    ibl::io::write_image((out / (base + "_occluder.exr")).string(), s.occluder);
+    ibl::io::write_image((out / (base + ".png")).string(), ibl::io::tonemap(s.radiance));
+    nlohmann::json jv = {{"radiance", base + ".exr"},          {"occluder", base + "_occluder.exr"},
+                         {"angle_deg", s.angle_deg},           {"ball", {s.ball.cx, s.ball.cy, s.ball.r}},
+                         {"distance_radii", s.distance_radii}, {"camera", ibl::geometry::camera_to_json(s.camera)}};
+    if (o.bracket > 0) {
+      double middle = o.exposure.empty() ? ibl::lab::middle_grey_exposure(s.radiance, s.ball, bd.sensor)
+                                         : parse_doubles(o.exposure, "--exposure").at(0);
+      if (v == 0 || o.exposure.empty()) bd.exposures_s = ibl::lab::bracket_times(o.bracket, o.ev_step, middle);
+      ibl::capture::SensorDesc sd = bd.sensor;
+      ibl::lab::BracketDesc b = bd;
+      b.sensor.seed = bd.sensor.seed + 1000 * v;
+      auto frames = ibl::lab::bracket(s.radiance, b);
+      nlohmann::json jf = nlohmann::json::array();
+      for (size_t k = 0; k < frames.size(); ++k) {
+        std::string name = fmt::format("{}_e{}.{}", base, k, o.format);
+        ibl::io::PhotoMeta pm;
+        pm.exposure_time = frames[k].exposure_s;
+        pm.f_number = sd.f_number;
+        pm.iso = sd.iso;
+        pm.make = "iblkit";
+        pm.model = "lab shoot";
+        ibl::io::write_photo((out / name).string(), frames[k].codes, sd.bits, pm, o.quality);
+        jf.push_back({{"file", name},
+                      {"exposure_s", frames[k].exposure_s},
+                      {"f_number", sd.f_number},
+                      {"iso", sd.iso},
+                      {"shift", {frames[k].dx, frames[k].dy}}});
+      }
+      jv["frames"] = jf;
+    }
+    jviews.push_back(jv);
+  }
+  if (o.bracket > 0) ibl::capture::write_response((out / "response.json").string(), bd.sensor.response);
+  nlohmann::json j = {{"scene", scene.name},
+                      {"ball_center", {d.ball_center.x, d.ball_center.y, d.ball_center.z}},
+                      {"ball_radius", d.ball_radius},
+                      {"distance_m", d.distance},
+                      {"photographer", d.photographer},
+                      {"width", d.width},
+                      {"height", d.height},
+                      {"views", jviews}};
+  if (o.bracket > 0)
+    j["sensor"] = {{"response", bd.sensor.response.kind},
+                   {"response_file", "response.json"},
+                   {"f_number", bd.sensor.f_number},
+                   {"iso", bd.sensor.iso},
+                   {"full_well", bd.sensor.full_well},
+                   {"read_noise", bd.sensor.read_noise},
+                   {"vignetting", bd.sensor.vignetting},
+                   {"wb_gains", {bd.sensor.wb_gains.x, bd.sensor.wb_gains.y, bd.sensor.wb_gains.z}},
+                   {"bits", bd.sensor.bits},
+                   {"quality", o.quality},
+                   {"shift_px", bd.shift_px}};
+  if (o.truth_size > 0) {
+    ibl::lab::Scene ts = ibl::lab::load_scene(o.scene, true);
+    ibl::lab::TruthDesc td;
+    td.size = o.truth_size;
+    td.bands = 0;
+    td.seed = o.seed;
+    auto t = ibl::lab::ground_truth(ts, d.ball_center, td, iblcli::progress_bar());
+    iblcli::progress_done();
+    ibl::io::write_image((out / "truth.exr").string(), t.radiance.image);
+    j["truth"] = "truth.exr";
+  }
+  j["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  ibl::write_json_file((out / "shoot.json").string(), j);
+  j["out"] = o.out;
+  iblcli::emit(j, [&] {
+    fmt::print(
+        "shot a chrome ball (r {} m) in {} at ({}, {}, {}) from {:.3f} m ({:.1f} radii), {} view{}, {}x{} in {:.2f} "
+        "s\n",
+        d.ball_radius, scene.name, d.ball_center.x, d.ball_center.y, d.ball_center.z, d.distance,
+        d.distance / d.ball_radius, shots.size(), shots.size() == 1 ? "" : "s", d.width, d.height,
+        j["seconds"].get<double>());
+    for (size_t v = 0; v < shots.size(); ++v)
+      fmt::print("  view{}: {}°, ball {:.1f},{:.1f},{:.1f} px{}\n", v, shots[v].angle_deg, shots[v].ball.cx,
+                 shots[v].ball.cy, shots[v].ball.r,
+                 o.bracket > 0 ? fmt::format(", {} {} frames", o.bracket, o.format) : std::string());
+    fmt::print("  wrote {}/shoot.json{}\n", o.out, o.truth_size > 0 ? ", truth.exr (the lab's probe at the ball)" : "");
+  });
+}
+
 void setup(CLI::App& app) {
   app.require_subcommand(1);
   app.footer(
@@ -331,6 +499,59 @@ void setup(CLI::App& app) {
   t->add_option("-o,--out", to->out, "folder for radiance.exr/.png, sh.json, truth.json");
   t->footer("Example:\n  iblkit lab truth low-scene1 --at 0,1,0 --size 64 --out truth");
   t->callback([to] { run_truth(*to); });
+
+  auto* sh = app.add_subcommand("shoot",
+                                "Photograph a chrome ball in a scene like a camera: linear radiance, brackets through "
+                                "a sensor model, and the lab's probe at the ball's centre");
+  auto* so = iblcli::app_owned<ShootOpts>();
+  sh->add_option("scene", so->scene, "scene file or built-in name")->required();
+  sh->add_option("--at", so->at, "the ball's centre x,y,z")->capture_default_str();
+  sh->add_option("--ball-radius", so->ball_radius, "ball radius, metres")->capture_default_str();
+  sh->add_option("--distance", so->distance, "camera (pinhole) to ball centre, metres")->capture_default_str();
+  sh->add_option("--distance-radii", so->distance_radii, "the same in ball radii (overrides --distance)");
+  sh->add_option("--azimuth", so->azimuth, "view 0's camera direction from the ball, degrees about +Y (0: +Z)")
+      ->capture_default_str();
+  sh->add_option("--elevation", so->elevation, "the camera's height above the ball's horizon, degrees")
+      ->capture_default_str();
+  sh->add_option("--views", so->views, "the views' turns about +Y from view 0, degrees: \"0\" or \"0,90\"")
+      ->capture_default_str();
+  sh->add_flag("--two-sides", so->two_sides, "two views 90° apart (--views 0,90)");
+  sh->add_option("--width", so->width, "photograph width, pixels")->capture_default_str();
+  sh->add_option("--height", so->height, "photograph height, pixels")->capture_default_str();
+  sh->add_option("--fill", so->fill, "the ball's diameter over the frame's height")->capture_default_str();
+  sh->add_option("--samples", so->samples, "n×n rays per pixel")->capture_default_str();
+  sh->add_option("--reflectance", so->reflectance, "normal-incidence reflectance r or r,g,b (default: the metal's)");
+  sh->add_option("--fresnel", so->fresnel, "chrome, steel, none or n,k")->capture_default_str();
+  sh->add_flag("--no-photographer", so->no_photographer, "leave the camera body and the photographer out");
+  sh->add_option("--area-samples", so->area_samples, "shadow rays per area light per hit (default: the scene's)");
+  sh->add_option("--bounces", so->bounces, "indirect bounces (default: the scene's)");
+  sh->add_option("--truth-size", so->truth_size, "lat-long height of truth.exr, the lab's probe at the ball (0: none)")
+      ->capture_default_str();
+  sh->add_option("--bracket", so->bracket, "N exposures through the sensor model (0: linear radiance only)")
+      ->capture_default_str();
+  sh->add_option("--ev-step", so->ev_step, "stops between exposures")->capture_default_str();
+  sh->add_option("--exposure", so->exposure,
+                 "the middle exposure, seconds (default: the ball's median at middle grey)");
+  sh->add_option("--fnumber", so->fnumber, "f-number (EXIF FNumber)")->capture_default_str();
+  sh->add_option("--iso", so->iso, "ISO (EXIF ISOSpeedRatings)")->capture_default_str();
+  sh->add_option("--response", so->response, "srgb, camera (toe and shoulder) or an iblkit.response/1 file")
+      ->capture_default_str();
+  sh->add_option("--format", so->format, "jpg (8-bit) or tif (16-bit)")->capture_default_str();
+  sh->add_option("--quality", so->quality, "JPEG quality")->check(CLI::Range(1, 100))->capture_default_str();
+  sh->add_flag("--noise", so->noise, "shot and read noise (full well 20000 e⁻ at ISO 100, read noise 0.001)");
+  sh->add_option("--full-well", so->full_well, "photo-electrons at saturation at ISO 100 (shot noise)");
+  sh->add_option("--read-noise", so->read_noise, "read noise σ in units of saturation");
+  sh->add_option("--vignetting", so->vignetting, "v = 1 − vignetting · r² (r over the half-diagonal)")
+      ->capture_default_str();
+  sh->add_option("--wb", so->wb, "white-balance gains r,g,b")->capture_default_str();
+  sh->add_option("--shift", so->shift, "hand-held: frames move by up to this many pixels")->capture_default_str();
+  sh->add_option("--seed", so->seed, "random seed")->capture_default_str();
+  sh->add_option("-o,--out", so->out, "output folder")->required();
+  sh->footer(
+      "Examples:\n  iblkit lab shoot low-scene1 --at 0,1,0 --distance-radii 8 --out ball\n"
+      "  iblkit lab shoot low-scene2 --two-sides --distance 2 --bracket 5 --ev-step 2 --noise --quality 95 --out "
+      "brackets");
+  sh->callback([so] { run_shoot(*so); });
 
   auto* ph = app.add_subcommand(
       "photograph",

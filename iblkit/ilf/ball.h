@@ -27,6 +27,26 @@ struct BallOptics {
 // ball (relative to the centre; zero when radius is 0) and its unit direction. False outside the disc.
 bool ball_ray(const BallOptics& o, int width, int height, double px, double py, Vec3* start, Vec3* dir);
 
+// The same optics for any view ray: a ray from the pinhole C = (0, 0, distance) along unit v (probe
+// frame) meets the ball at `start` (relative to the centre, radius·n) and leaves along `dir`. False when
+// it misses. Needs a perspective camera (distance > radius > 0). ball_ray uses it; capture/'s chrome
+// ball unwarp and the lab's photographs of a chrome ball (lab shoot) do too.
+bool ball_reflect(const BallOptics& o, Vec3 v, Vec3* start, Vec3* dir);
+
+// The inverse: the view ray that leaves the ball along unit direction d. Writes the unit view ray
+// (from the pinhole; (0, 0, −1) for the orthographic camera) and the unit normal at the reflection
+// point. The normal lies in the plane of +Z and d, at the angle from +Z where the reflection turns
+// +Z into d (a monotonic function of it, solved by bisection to 1e-12 rad); orthographic:
+// n = normalize(d + (0, 0, 1)). False for directions in the blind cone (within asin(r/D) of −Z; for
+// the orthographic camera only −Z itself).
+bool ball_view_for(const BallOptics& o, Vec3 d, Vec3* view, Vec3* normal);
+
+// Where a view ray lands in the image of a ball whose silhouette has centre (cx, cy) and radius r
+// (continuous pixel coordinates, y down): the unit-disc point (a, b) of ball_ray scaled to the
+// silhouette. Perspective: (a, b) = (v.x, v.y)/(−v.z·tan α); orthographic: (a, b) = (n.x, n.y).
+void ball_image_point(const BallOptics& o, Vec3 view, Vec3 normal, double cx, double cy, double r, double* px,
+                      double* py);
+
 // Solid angle (sr) of the directions pixel (x, y) sees under a perspective camera: the area of the
 // reflected-direction map over the pixel, ∫|∂d/∂px × ∂d/∂py|, by n×n sub-points with central
 // differences (sub-points off the disc count zero). Over the whole frame it sums to 2π(1 + cos α).

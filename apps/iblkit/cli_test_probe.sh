@@ -1,0 +1,52 @@
+#!/usr/bin/env bash
+# End-to-end checks of `iblkit lab shoot` and `iblkit probe from-ball` (issue 29 §2–3; CTest cli_probe,
+# a few seconds): a lab shoot of two sides with a bracket, the probe from its linear views (ball given
+# and found), the blend weights, EXIF in the frames, and the bad inputs' one-line errors naming the flag.
+set -u
+source "$(dirname "$0")/cli_check.sh" "$1"
+
+S="$T/shot"
+check shoot ok "2 views" -- "$BIN" lab shoot low-scene1 --two-sides --distance 2 --width 128 --height 128 \
+  --samples 1 --bracket 3 --noise --truth-size 32 --out "$S"
+for f in view0.exr view1.exr view0_occluder.exr view0_e0.jpg view0_e2.jpg view1_e1.jpg truth.exr shoot.json \
+  response.json; do
+  if [ -f "$S/$f" ]; then pass=$((pass+1)); else echo "FAIL shoot-files: $S/$f missing"; fail=$((fail+1)); fi
+done
+check shoot-json ok '"distance_radii": 40' -- cat "$S/shoot.json"
+if command -v exiftool >/dev/null; then
+  check shoot-exif ok "F Number +: 8.0" -- exiftool -FNumber -ExposureTime -ISO "$S/view0_e1.jpg"
+else
+  echo "skip shoot-exif: exiftool absent"; skip=$((skip+1))
+fi
+check shoot-tif ok "2 tif frames" -- "$BIN" lab shoot low-scene1 --width 64 --height 64 --samples 1 --bracket 2 \
+  --format tif --truth-size 0 --out "$T/tif"
+[ -f "$T/tif/view0_e1.tif" ] && pass=$((pass+1)) || { echo "FAIL shoot-tif: no frame"; fail=$((fail+1)); }
+
+check from-ball-two ok "0 invalid pixels" -- "$BIN" probe from-ball "$S/view0.exr" "$S/view1.exr" --distance 40 \
+  --ball 64,64,57.6 --ball 64,64,57.6 --size 32 --weights "$T/w.exr" --out "$T/p2.exr"
+[ -f "$T/w.exr" ] && pass=$((pass+1)) || { echo "FAIL from-ball-weights: no map"; fail=$((fail+1)); }
+check from-ball-fit ok "residual" -- "$BIN" probe from-ball "$S/view0.exr" --distance 40 --size 32 \
+  --mapping mirrorball --out "$T/p1.exr"
+check from-ball-auto-angle ok "estimated from the overlap" -- "$BIN" probe from-ball "$S/view0.exr" "$S/view1.exr" \
+  --distance 40 --angle auto --size 16 --out "$T/pa.exr"
+check from-ball-lens ok "camera at" -- "$BIN" probe from-ball "$S/view0.exr" --ball 64,64,57.6 --focal-mm 200 \
+  --sensor-mm 36 --size 16 --out "$T/p3.exr"
+check from-ball-info ok "4 channels|RGBA|channels" -- "$BIN" info "$T/p2.exr"
+
+# Bad inputs: one line naming what to do; nothing written.
+"$BIN" convert "$S/truth.exr" "$T/flat.exr" --size 32 >/dev/null 2>&1  # a lat-long map: no ball in it
+check from-ball-no-ball fail "no chrome ball found.*--ball" -- "$BIN" probe from-ball "$T/flat.exr" --distance 10 \
+  --out "$T/nb.exr"
+[ ! -e "$T/nb.exr" ] && pass=$((pass+1)) || { echo "FAIL from-ball-no-ball: output written"; fail=$((fail+1)); }
+check from-ball-outside fail "partly outside.*--ball" -- "$BIN" probe from-ball "$S/view0.exr" --distance 40 \
+  --ball 120,64,57 --out "$T/o.exr"
+check from-ball-no-lens fail "--distance" -- "$BIN" probe from-ball "$S/view0.exr" --out "$T/o.exr"
+check from-ball-ball-count fail "one cx,cy,r per photograph" -- "$BIN" probe from-ball "$S/view0.exr" \
+  "$S/view1.exr" --distance 40 --ball 64,64,57 --out "$T/o.exr"
+check from-ball-fresnel fail "--fresnel" -- "$BIN" probe from-ball "$S/view0.exr" --distance 40 --fresnel gold \
+  --out "$T/o.exr"
+check from-ball-missing fail "no such file" -- "$BIN" probe from-ball "$T/nothere.exr" --distance 40 --out "$T/o.exr"
+check shoot-close fail "--distance" -- "$BIN" lab shoot low-scene1 --distance 0.01 --out "$T/bad"
+
+echo "cli_probe: $pass passed, $fail failed, $skip skipped"
+[ $fail -eq 0 ]
