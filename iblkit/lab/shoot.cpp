@@ -9,7 +9,7 @@
 #include "iblkit/geometry/mesh.h"
 #include "iblkit/ilf/ball.h"
 #include "iblkit/lab/radiance.h"
-#include "iblkit/lab/rng.h"
+#include "iblkit/core/rng.h"
 #include "iblkit/lab/view.h"
 
 namespace ibl::lab {
