@@ -5,7 +5,8 @@
 # files the examples name and do not make themselves are put first (probe.exr and forest.exr: 32-pixel
 # lat-longs of Blender's forest; path.json; cam.json; room.obj and floor.obj: a box room and a floor at
 # y = 0; grid.shgrid: an SH grid of low-scene2 over x, z in [-1, 1], y in [0.1, 1.5]; fusion/: a
-# low-scene2 probe set at (0.1, 0.3, 0.1), what composite's examples composite into) and ../shared is
+# low-scene2 probe set at (0.1, 0.3, 0.1), what composite's examples composite into; ball/ and brackets/: lab
+# shoot's chrome-ball photographs) and ../shared is
 # the shared data. A failing example fails the test with its command and message. Skipped, with a message:
 # `view` without --frames (an interactive window), examples that need OpenGL where it is absent, and
 # those that read ../shared where it is absent. Each example may take IBLKIT_EXAMPLE_TIMEOUT seconds
@@ -37,6 +38,10 @@ printf 'v -2 0 -2\nv 2 0 -2\nv 2 0 2\nv -2 0 2\nf 1 3 2\nf 1 4 3\n' > floor.obj
 "$BIN" --quiet lab capture low-scene2 --grid 2,2,2 --volume "-1,0.1,-1;1,1.5,1" --mapping mirrorball --size 16 --out gridcap >/dev/null &&
   "$BIN" --quiet ilf build gridcap/sequence.json --grid 4 --bands 3 --out grid.shgrid >/dev/null || echo "FAIL setup: grid.shgrid"
 "$BIN" --quiet lab capture low-scene2 --fusion --probe 0.1,0.3,0.1 --size 32 --out fusion >/dev/null || echo "FAIL setup: fusion/"
+# ball/ and brackets/: what `lab shoot`'s examples write, which `probe from-ball`'s examples read (its --help comes first)
+"$BIN" --quiet lab shoot low-scene1 --at 0,1,0 --distance-radii 8 --out ball >/dev/null || echo "FAIL setup: ball/"
+"$BIN" --quiet lab shoot low-scene2 --two-sides --distance 2 --bracket 5 --ev-step 2 --noise --quality 95 --out brackets \
+  >/dev/null || echo "FAIL setup: brackets/"
 have_gl=yes
 "$BIN" --quiet render blob --light probe.exr --backend gl --size 16x16 --out "$T/gl.png" >/dev/null 2>&1 || have_gl=no
 

@@ -191,9 +191,9 @@ void setup(CLI::App& app) {
   c->add_flag("--half", o->half, "write .exr as 16-bit half floats");
   iblcli::outputs(*c, {"--weights"});
   c->footer(
-      "Examples:\n  iblkit probe from-ball ball.exr --distance 8 --out probe.exr\n"
-      "  iblkit probe from-ball front.exr side.exr --ball 512,512,480 --ball 510,515,478 --focal-mm 200 "
-      "--sensor-mm 36 --angle 90 --weights w.exr --out probe.exr");
+      "Examples:\n  iblkit probe from-ball ball/view0.exr --distance 8 --out probe.exr\n"
+      "  iblkit probe from-ball brackets/view0.exr brackets/view1.exr --ball 256,256,230.4 --ball 256,256,230.4 "
+      "--distance 40 --angle 90 --weights w.exr --out probe2.exr");
   c->callback([o] { run(*o); });
 }
 

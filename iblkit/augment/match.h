@@ -7,9 +7,9 @@
 //   g_c = median over proxy points y seen by both of  photo_c(y) / L_c(centre → y)
 //
 // y is where a pixel's ray meets the proxy; the probe sees it when it is on the side of the surface the
-// camera sees and nothing of the proxy lies between its centre and y (and, with a depth map, when the map's depth along that direction is y's distance within
-// 5 %, so that a lamp in front of the proxy is not taken for the floor). Pixels too dark in either
-// (below 1 % of their image's median) or saturated in the photograph are left out. The median and
+// camera sees and nothing of the proxy lies between its centre and y (and, with a depth map, when the map's depth along
+// that direction is y's distance within 5 %, so that a lamp in front of the proxy is not taken for the floor). Pixels
+// too dark in either (below 1 % of their image's median) or saturated in the photograph are left out. The median and
 // the spread (the median absolute deviation of log2 of the ratios) are reported; multiplying the light
 // by g puts it in the photograph's units, so that the object is rendered as bright as the photograph's
 // surfaces and the shadows are right (a 1-stop mismatch: docs/augment.md).

@@ -6,10 +6,10 @@
 #include "iblkit/core/check.h"
 #include "iblkit/core/error.h"
 #include "iblkit/core/parallel.h"
+#include "iblkit/core/rng.h"
 #include "iblkit/geometry/mesh.h"
 #include "iblkit/ilf/ball.h"
 #include "iblkit/lab/radiance.h"
-#include "iblkit/core/rng.h"
 #include "iblkit/lab/view.h"
 
 namespace ibl::lab {
