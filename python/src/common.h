@@ -103,6 +103,7 @@ void init_io(py::module_& m);
 void init_sh(py::module_& m);
 void init_lights(py::module_& m);
 void init_ilf(py::module_& m);
+void init_capture_ball(py::module_& m);
 #ifdef IBLKIT_HAVE_GEOMETRY
 void init_geometry(py::module_& m);
 void init_lab(py::module_& m);
