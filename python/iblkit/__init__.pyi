@@ -1,5 +1,5 @@
 # Type stubs of the iblkit package (the extension iblkit._iblkit re-exported); docs/python.md.
-from typing import Callable, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, Optional, Sequence, Tuple, Union
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -33,6 +33,10 @@ def convert(img: ArrayLike, src: str = "latlong", dst: str = "latlong", size: in
 def detect_mapping(width: int, height: int, file_name: str = "") -> str: ...
 def solid_angles(mapping: str, width: int, height: int, dead_angle: float = 0.0) -> np.ndarray: ...
 def tonemap(img: ArrayLike, exposure: float = 0.0, auto_exposure: bool = True, key: float = 0.18, curve: str = "aces") -> np.ndarray: ...
+
+# ---- capture ----------------------------------------------------------------------------------------
+def hdr_merge(images: Sequence[ArrayLike], exposures: Sequence[float], response: str = "", method: str = "debevec",
+              align: bool = True) -> Tuple[np.ndarray, Dict[str, Any]]: ...
 
 # ---- spherical harmonics ------------------------------------------------------------------------
 class SHCoeffs:
