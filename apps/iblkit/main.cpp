@@ -37,6 +37,7 @@ constexpr Subcommand kSubcommands[] = {
     {"sh", "Project a probe onto spherical harmonics; export, window, render irradiance", nullptr},
     {"eval", "Irradiance error of light sets against the exact ground truth (Madsen & Laursen Fig. 4)", nullptr},
     {"ilf", "Incident light fields: probe sequences -> SH grids, queries, slices", nullptr},
+    {"hdr", "HDR images from brackets of photographs: response recovery, alignment, merge (hdr merge)", nullptr},
     {"probe", "Probes from photographs: a chrome ball's one or two views unwarped with the real optics", nullptr},
     {"specular", "Engine maps: GGX-prefiltered specular cube map (KTX2, all mips), irradiance cube, DFG table",
      nullptr},

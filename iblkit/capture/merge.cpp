@@ -81,20 +81,40 @@ Response finish_curve(const char* kind, std::array<std::vector<double>, 3> lng) 
   return r;
 }
 
-// The reference pixels the curve is recovered from: one per cell of a g × g grid, at a position
-// within the cell drawn from a fixed stream (docs/capture.md).
-std::vector<std::array<int, 2>> sample_pixels(int w, int h, int samples) {
+// The reference pixels the curve is recovered from: one per cell of a g × g grid, the flattest pixel
+// of the cell (smallest green range in its 3 × 3 neighbourhood in the frame of middle exposure), as Debevec &
+// Malik advise: edges carry misalignment, blur and JPEG's ringing and chroma subsampling.
+std::vector<std::array<int, 2>> sample_pixels(const std::vector<Shifted>& fr, int w, int h, int samples) {
+  // The flatness is judged in the frame of middle exposure.
+  std::vector<int> order(fr.size());
+  for (size_t j = 0; j < fr.size(); ++j) order[j] = static_cast<int>(j);
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return fr[a].f->exposure < fr[b].f->exposure; });
+  const int ref = order[order.size() / 2];
   const int g = std::max(1, static_cast<int>(std::lround(std::sqrt(static_cast<double>(samples)))));
-  std::vector<std::array<int, 2>> px;
-  Rng rng(mix64(0x29d));
-  for (int i = 0; i < g; ++i)
+  std::vector<std::array<int, 2>> px(static_cast<size_t>(g) * g, {-1, -1});
+  parallel_for(0, g, [&](int64_t i) {
     for (int j = 0; j < g; ++j) {
       const int x0 = static_cast<int>(int64_t(j) * w / g), x1 = static_cast<int>(int64_t(j + 1) * w / g);
       const int y0 = static_cast<int>(int64_t(i) * h / g), y1 = static_cast<int>(int64_t(i + 1) * h / g);
-      if (x1 <= x0 || y1 <= y0) continue;
-      px.push_back({x0 + std::min(x1 - x0 - 1, static_cast<int>(rng.uniform() * (x1 - x0))),
-                    y0 + std::min(y1 - y0 - 1, static_cast<int>(rng.uniform() * (y1 - y0)))});
+      double best = 1e300;
+      for (int y = y0; y < y1; ++y)
+        for (int x = x0; x < x1; ++x) {
+          double r = 0;
+          for (const Shifted& f : {fr[ref]}) {
+            float lo = 2, hi = -2;
+            for (int v = std::max(0, y - 1); v <= std::min(h - 1, y + 1); ++v)
+              for (int u = std::max(0, x - 1); u <= std::min(w - 1, x + 1); ++u) {
+                const float z = f.code(u, v, 1);
+                if (z < 0) continue;
+                lo = std::min(lo, z), hi = std::max(hi, z);
+              }
+            r += hi >= lo ? hi - lo : 1.0;
+          }
+          if (r < best) best = r, px[size_t(i) * g + j] = {x, y};
+        }
     }
+  });
+  px.erase(std::remove_if(px.begin(), px.end(), [](const auto& p) { return p[0] < 0; }), px.end());
   return px;
 }
 
@@ -104,7 +124,7 @@ std::vector<double> debevec_channel(const std::vector<Shifted>& fr, const std::v
                                     const RecoverDesc& d, const std::vector<double>* snr);
 
 Response debevec(const std::vector<Shifted>& fr, int w, int h, const RecoverDesc& d) {
-  const auto px = sample_pixels(w, h, d.samples);
+  const auto px = sample_pixels(fr, w, h, d.samples);
   std::array<std::vector<double>, 3> lng;
   for (int c = 0; c < 3; ++c) {
     const std::vector<double> first = debevec_channel(fr, px, c, d, nullptr);
@@ -131,6 +151,9 @@ std::vector<double> debevec_channel(const std::vector<Shifted>& fr, const std::v
       for (int j = 0; j < P; ++j) {
         const double z = fr[j].code(p[0], p[1], c);
         wj[j] = z < 0 ? 0.0 : hat_weight(z);
+        // A code no higher than a shorter exposure's is clipping noise (JPEG ringing in a saturated area).
+        for (int q = 0; q < P && wj[j] > 0; ++q)
+          if (fr[q].f->exposure < fr[j].f->exposure && fr[q].code(p[0], p[1], c) >= z) wj[j] = 0;
         if (snr && wj[j] > 0) {
           const double f = z * (B - 1);
           const int k = std::min(static_cast<int>(f), B - 2);

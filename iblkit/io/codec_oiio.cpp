@@ -126,8 +126,14 @@ void oiio_write_photo(const std::string& path, const Image& codes, int bits, con
   OIIO::ImageSpec spec(codes.width(), codes.height(), codes.channels(),
                        bits == 16 ? OIIO::TypeDesc::UINT16 : OIIO::TypeDesc::UINT8);
   for (const PhotoAttribute& a : meta.attributes) spec.attribute(a.name, OIIO::TypeDesc(a.type), a.value);
-  if (meta.exposure_time > 0) spec.attribute("ExposureTime", static_cast<float>(meta.exposure_time));
-  if (meta.f_number > 0) spec.attribute("FNumber", static_cast<float>(meta.f_number));
+  // OpenImageIO 2.4 turns a float that is an exact power of two below 1 (1/4, 1/64 s) into the Exif
+  // rational x/0 (read back as inf); one part in 10^7 more gives it 1/4, 1/64 exactly.
+  auto rational_safe = [](double v) {
+    int e;
+    return static_cast<float>(std::frexp(v, &e) == 0.5 && v < 1 ? v * (1 + 1e-7) : v);
+  };
+  if (meta.exposure_time > 0) spec.attribute("ExposureTime", rational_safe(meta.exposure_time));
+  if (meta.f_number > 0) spec.attribute("FNumber", rational_safe(meta.f_number));
   if (meta.iso > 0) spec.attribute("Exif:ISOSpeedRatings", static_cast<int>(std::lround(meta.iso)));
   if (!meta.make.empty()) spec.attribute("Make", meta.make);
   if (!meta.model.empty()) spec.attribute("Model", meta.model);

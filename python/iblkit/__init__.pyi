@@ -1,5 +1,5 @@
 # Type stubs of the iblkit package (the extension iblkit._iblkit re-exported); docs/python.md.
-from typing import Callable, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, Optional, Sequence, Tuple, Union
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -40,6 +40,9 @@ def probe_from_ball(photos: Sequence[ArrayLike], balls: Optional[Sequence[Vec3]]
                     angle: float = 90.0, reflectance: Optional[Sequence[float]] = None, fresnel: str = "chrome",
                     mapping: str = "latlong", size: int = 256, samples: int = 2, rotate: float = 0.0,
                     exclude: float = 40.0) -> Tuple[np.ndarray, np.ndarray]: ...
+# ---- capture ----------------------------------------------------------------------------------------
+def hdr_merge(images: Sequence[ArrayLike], exposures: Sequence[float], response: str = "", method: str = "debevec",
+              align: bool = True) -> Tuple[np.ndarray, Dict[str, Any]]: ...
 
 # ---- spherical harmonics ------------------------------------------------------------------------
 class SHCoeffs:

@@ -101,6 +101,7 @@ void init_errors(py::module_& m);
 void init_core(py::module_& m);
 void init_io(py::module_& m);
 void init_sh(py::module_& m);
+void init_capture(py::module_& m);
 void init_lights(py::module_& m);
 void init_ilf(py::module_& m);
 void init_capture_ball(py::module_& m);

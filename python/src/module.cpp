@@ -11,6 +11,7 @@ PYBIND11_MODULE(_iblkit, m) {
   iblpy::init_lights(m);
   iblpy::init_ilf(m);
   iblpy::init_capture_ball(m);
+  iblpy::init_capture(m);
 #ifdef IBLKIT_HAVE_GEOMETRY
   iblpy::init_geometry(m);
   iblpy::init_lab(m);

@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# End-to-end checks of `iblkit hdr` (CTest cli_hdr): a bracket shot through the sensor model (hdr bracket),
+# merged from its Exif exposures and from --exposures, the curve written and reused, the report, and the
+# bad brackets of issue 29 (one image, no spread, no exposure, different sizes, all saturated): one line,
+# nothing written.
+set -u
+source "$(dirname "$0")/cli_check.sh" "$1"
+[ -f "$PROBE" ] || { echo "SKIP: blender-data probe missing"; exit 0; }
+
+check bracket ok "wrote .*/b-4.jpg" -- \
+  "$BIN" hdr bracket "$PROBE" -o "$T/b" --response camera --full-well 30000 --read-noise 3e-4 --exposures 1/64,1/16,1/4,1,4
+check merge-exif ok "dynamic range +[0-9.]+ stops" -- "$BIN" hdr merge "$T"/b-?.jpg --out "$T/m.exr" --response-out "$T/c.json"
+check merge-wrote ok "m.exr" -- ls "$T"
+check curve-file ok '"format":"iblkit.response/1"' -- cat "$T/c.json"
+check merge-reuse ok "response debevec" -- "$BIN" hdr merge "$T"/b-?.jpg --out "$T/m2.exr" --response "$T/c.json" --no-align
+check merge-json ok '"exposure_source": ?"ev"' -- \
+  "$BIN" --json hdr merge "$T"/b-?.jpg --out "$T/m3.exr" --exposures ev:0,2,4,6,8 --method robertson
+check merge-grey-card ok '"gains"' -- \
+  "$BIN" --json hdr merge "$T"/b-?.jpg --out "$T/m4.exr" --grey-card 10,300,20,20 --reflectance 0.18
+check one-image fail "b-0.jpg: one photograph only" -- "$BIN" hdr merge "$T/b-0.jpg" --out "$T/x1.exr"
+check no-spread fail "no exposure spread" -- "$BIN" hdr merge "$T/b-0.jpg" "$T/b-0.jpg" --out "$T/x2.exr"
+check wrong-count fail "--exposures gives 3 values for 2" -- \
+  "$BIN" hdr merge "$T/b-0.jpg" "$T/b-1.jpg" --exposures 1,2,3 --out "$T/x3.exr"
+"$BIN" hdr bracket "$PROBE" -o "$T/p" --format png --exposures 1/8,1/2 > /dev/null
+check no-exif fail "p-0.png: no exposure time .*--exposures" -- "$BIN" hdr merge "$T/p-0.png" "$T/p-1.png" --out "$T/x4.exr"
+check png-exposures ok "wrote" -- "$BIN" hdr merge "$T/p-0.png" "$T/p-1.png" --exposures 1/8,1/2 --response srgb --out "$T/x5.exr"
+if command -v oiiotool > /dev/null; then
+  for t in 1 4; do
+    oiiotool --pattern constant:color=1,1,1 64x32 3 -d uint8 --attrib:type=float ExposureTime $t -o "$T/s-$t.jpg"
+  done
+  check all-saturated fail "s-1.jpg: even the darkest photograph is saturated" -- \
+    "$BIN" hdr merge "$T/s-1.jpg" "$T/s-4.jpg" --out "$T/x6.exr"
+else
+  echo "SKIP all-saturated: oiiotool missing"
+fi
+check nothing-written ok "^none$" -- sh -c "ls '$T' | grep '^x[0-46]' || echo none"
+check bad-grey-card fail "grey-card" -- "$BIN" hdr merge "$T"/b-?.jpg --out "$T/x7.exr" --grey-card 1,2,3
+
+echo "cli_hdr: $pass passed, $fail failed"
+[ $fail -eq 0 ]

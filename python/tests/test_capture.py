@@ -1,0 +1,43 @@
+"""iblkit.hdr_merge on numpy brackets (issue 29 §1): a known radiance through the sRGB curve, exact truth."""
+import numpy as np
+import pytest
+
+import iblkit
+
+
+def srgb_encode(x):
+    x = np.clip(x, 0, 1)
+    return np.where(x <= 0.0031308, 12.92 * x, 1.055 * np.power(x, 1 / 2.4) - 0.055)
+
+
+def bracket():
+    h, w = 64, 128
+    ramp = np.exp2(np.linspace(-8, 4, w))[None, :, None] * np.ones((h, 1, 3))
+    tex = 0.6 + 0.4 * np.sin(np.arange(h) * 0.7)[:, None, None]
+    L = (ramp * tex).astype(np.float64)
+    ex = [2.0 ** (2 * j - 8) for j in range(5)]
+    imgs = [np.round(srgb_encode(L * e) * 255).astype(np.float32) / 255 for e in ex]
+    return L, imgs, ex
+
+
+def test_known_curve_gives_radiance():
+    L, imgs, ex = bracket()
+    hdr, rep = iblkit.hdr_merge(imgs, ex, response="srgb", align=False)
+    assert hdr.shape == L.shape and np.all(np.isfinite(hdr))
+    X = np.stack([L * e for e in ex])
+    ok = np.any((X > 0.05) & (X < 0.95), axis=0)
+    # 8-bit quantisation only: well under 1 %
+    assert np.median(np.abs(hdr[ok] / L[ok] - 1)) < 0.01
+    assert rep["response"] == "srgb" and rep["curve"].shape == (1, 4096, 3)
+
+
+def test_recovered_and_errors():
+    L, imgs, ex = bracket()
+    hdr, rep = iblkit.hdr_merge(imgs, ex, align=False)
+    assert rep["response"] == "debevec" and len(rep["shifts"]) == 5
+    with pytest.raises(ValueError, match="one exposure per image"):
+        iblkit.hdr_merge(imgs, ex[:4])
+    with pytest.raises(ValueError, match="one photograph"):
+        iblkit.hdr_merge(imgs[:1], ex[:1])
+    with pytest.raises(ValueError, match="outside"):
+        iblkit.hdr_merge([i * 255 for i in imgs], ex)
