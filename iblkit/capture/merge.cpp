@@ -6,9 +6,9 @@
 
 #include <Eigen/Dense>
 
-#include "iblkit/capture/rng.h"
 #include "iblkit/core/error.h"
 #include "iblkit/core/parallel.h"
+#include "iblkit/core/rng.h"
 
 namespace ibl::capture {
 

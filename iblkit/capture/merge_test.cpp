@@ -5,9 +5,9 @@
 
 #include <gtest/gtest.h>
 
-#include "iblkit/capture/rng.h"
 #include "iblkit/capture/sensor.h"
 #include "iblkit/core/error.h"
+#include "iblkit/core/rng.h"
 
 namespace ibl::capture {
 namespace {

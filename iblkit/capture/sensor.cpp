@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
-#include "iblkit/capture/rng.h"
 #include "iblkit/core/error.h"
 #include "iblkit/core/parallel.h"
+#include "iblkit/core/rng.h"
 
 namespace ibl::capture {
 

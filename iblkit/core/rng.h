@@ -6,6 +6,7 @@
 // state advances by the golden-ratio increment and each output is the state through mix64, a bijective
 // 64-bit finaliser.
 #pragma once
+#include <cmath>
 #include <cstdint>
 #include <iterator>
 #include <utility>
@@ -41,6 +42,12 @@ class Rng {
   }
   // Uniform in [0, 1), 53 bits.
   constexpr double uniform() { return static_cast<double>(next() >> 11) * 0x1.0p-53; }
+  // Standard normal: Box–Muller, one of the pair (two uniforms per draw).
+  double normal() {
+    const double u1 = 1.0 - uniform();  // (0, 1]
+    const double u2 = uniform();
+    return std::sqrt(-2.0 * std::log(u1)) * std::cos(6.283185307179586 * u2);
+  }
   // Uniform in [0, n) for n ≥ 1, without modulo bias (Lemire's multiply-and-reject, 2019).
   uint64_t below(uint64_t n) {
     unsigned __int128 m = static_cast<unsigned __int128>(next()) * n;
