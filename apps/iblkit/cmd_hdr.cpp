@@ -45,6 +45,9 @@ void setup_bracket(CLI::App& app) {
   b->add_option("--bits", o->bits, "8 or 16")->check(CLI::IsMember({8, 16}))->capture_default_str();
   b->add_option("--quality", o->quality, "JPEG quality")->capture_default_str();
   b->add_option("--seed", o->seed, "noise seed (frame j uses seed + j)")->capture_default_str();
+  b->footer(
+      "Examples:\n  iblkit hdr bracket probe.exr --out ball\n"
+      "  iblkit hdr bracket probe.exr --format tif --bits 16 --response linear --exposures 1/250,1/60,1/15 --out t");
   b->callback([o] {
     const ibl::Image L = ibl::io::read_image(o->in, {false, 3});
     const auto ex = ibl::capture::parse_exposures(o->exposures);
@@ -96,7 +99,7 @@ void setup(CLI::App& app) {
   iblcli::outputs(*m, {"--response-out"});
   m->footer(
       "Example:\n  iblkit hdr merge ball-*.jpg --out ball.exr --response-out ball-curve.json\n"
-      "  iblkit hdr merge a.tif b.tif c.tif --exposures 1/250,1/60,1/15 --response linear --out probe.exr");
+      "  iblkit hdr merge t-0.tif t-1.tif t-2.tif --exposures 1/250,1/60,1/15 --response linear --out probe_t.exr");
   m->callback([o] {
     ibl::capture::BracketDesc bd;
     if (!o->exposures.empty()) bd = ibl::capture::parse_exposures(o->exposures);
