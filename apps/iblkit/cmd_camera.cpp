@@ -144,11 +144,16 @@ void run_solve(const SolveOpts& o) {
   } catch (const ibl::Error& e) {
     fail(e.kind(), "{}: {}", source, e.what());
   }
-  if (!o.board.spec.empty() && dot(s.camera.eye - board.origin, cross(board.u, board.v)) <= 0)
-    fail(ErrorKind::Value,
-         "--board-axes {}: the camera comes out behind the board (u × v must point out of its printed face, "
-         "towards the camera)",
-         o.board.axes);
+  // The corners are labelled so that the camera sees the side u × v points to; on a floor (+Y up,
+  // docs/conventions.md) axes whose u × v points down put the camera under it.
+  if (!o.board.spec.empty()) {
+    Vec3 n = cross(board.u, board.v);
+    if (n.y < -0.9 && s.camera.eye.y < board.origin.y)
+      fail(ErrorKind::Value,
+           "--board-axes {}: u × v points down, so the camera comes out under the floor; give axes whose u × v "
+           "points up (out of the board's printed face)",
+           o.board.axes);
+  }
   if (!(s.error.rms_px <= o.max_error))
     fail(ErrorKind::Value,
          "{}: the points disagree: reprojection error {:.3g} px RMS (worst: point {}, {:.3g} px) exceeds "
