@@ -5,15 +5,18 @@ remap), independent of iblkit's own Camera.
   camera_test_tool.py points CAM.json OUT.json {depth|floor} [SHIFT_PX]  world points projected through CAM
   camera_test_tool.py board CAM.json OUT.png COLS ROWS SQUARE ORIGIN U V  a chessboard photographed by CAM
   camera_test_tool.py compare TRUTH.json SOLVED.json [EYE_M DEG FX_PX]   differences; exit 1 beyond them
+  camera_test_tool.py overlap A.exr B.exr MIN MAX                         masks' intersection over union in [MIN, MAX]
 
 CAM is an iblkit.camera/1 file (fov_y_deg, or intrinsics and distortion). Pixels are iblkit's continuous
 coordinates (OpenCV's + 0.5). The board follows docs/camera.md: COLS x ROWS inner corners, the first at
 ORIGIN, columns along U, rows along V (comma lists), the square between the first four corners dark.
 """
 import json
+import os
 import sys
 
-import cv2
+os.environ.setdefault("OPENCV_IO_ENABLE_OPENEXR", "1")  # the masks are EXR files
+import cv2  # noqa: E402
 import numpy as np
 
 
@@ -112,5 +115,13 @@ def compare(truth_path, solved_path, eye_tol="inf", deg_tol="inf", fx_tol="inf")
         sys.exit(1)
 
 
+def overlap(a_path, b_path, lo, hi):
+    a, b = (cv2.imread(p, cv2.IMREAD_UNCHANGED) for p in (a_path, b_path))
+    a, b = ((m if m.ndim == 2 else m[..., 0]) > 0.5 for m in (a, b))
+    iou = (a & b).sum() / max(1, (a | b).sum())
+    print(f"mask overlap {iou:.4f} ({(a ^ b).sum()} of {a.sum()} pixels differ)")
+    sys.exit(0 if float(lo) <= iou <= float(hi) else 1)
+
+
 if __name__ == "__main__":
-    {"points": points, "board": board, "compare": compare}[sys.argv[1]](*sys.argv[2:])
+    {"points": points, "board": board, "compare": compare, "overlap": overlap}[sys.argv[1]](*sys.argv[2:])

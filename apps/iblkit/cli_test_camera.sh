@@ -67,6 +67,29 @@ check solve-calibrated-lens ok "reprojection" -- \
 check solve-calibrated-camera ok "eye" -- $PY "$TOOL" compare "$T/v7.json" "$T/d2.json" 0.005 0.3 2
 check distorted-file-keeps-lens ok '"distortion"' -- cat "$T/d1.json"
 
+# composite through a distorted lens (CPU): the object lands where the lab photographs it through the same lens
+# (its mask overlaps the truth's by > 0.95); the same intrinsics without distortion miss (< 0.9).
+if "$BIN" --help | grep -q "^  composite"; then
+  LENS='"eye":[0,1.3,2.2],"target":[0,0.3,0],"up":[0,1,0],"width":192,"height":144,"intrinsics":{"fx":176,"fy":176,"cx":96.6,"cy":71.6}'
+  echo "{\"format\":\"iblkit.camera/1\",$LENS,\"distortion\":[-0.45,0.15,0.002,-0.001,0]}" > "$T/dist.json"
+  echo "{\"format\":\"iblkit.camera/1\",$LENS}" > "$T/undist.json"
+  OBJ=(--object blob --at -0.6,0.25,0.6 --object-size 0.3 --triangles 2000)
+  "$BIN" lab photograph low-scene2 --camera "$T/dist.json" --samples 1 --out "$T/dphoto.exr" >/dev/null
+  "$BIN" lab photograph low-scene2 --camera "$T/dist.json" --samples 2 "${OBJ[@]}" --mask "$T/dmask.exr" --out "$T/dtruth.exr" >/dev/null
+  "$BIN" lab capture low-scene2 --fusion --probe 0,0.5,0 --size 16 --out "$T/fus" --quiet >/dev/null 2>&1
+  for c in dist undist; do
+    check composite-$c ok "composited" -- "$BIN" composite "$T/dphoto.exr" --camera "$T/$c.json" --backend cpu \
+      --probes "$T/fus/probes.json" "${OBJ[@]}" --samples 4 --object-samples 4 --out "$T/c_$c.exr" --layers "$T/L_$c"
+  done
+  check composite-distorted-lines-up ok "mask overlap" -- $PY "$TOOL" overlap "$T/dmask.exr" "$T/L_dist/mask.exr" 0.95 1
+  check composite-undistorted-misses ok "mask overlap" -- $PY "$TOOL" overlap "$T/dmask.exr" "$T/L_undist/mask.exr" 0 0.9
+  check composite-gl-refuses fail "\-\-backend gl cannot render .*distortion.*use --backend cpu" -- "$BIN" composite \
+    "$T/dphoto.exr" --camera "$T/dist.json" --backend gl --probes "$T/fus/probes.json" "${OBJ[@]}" --out "$T/bad_gl.exr"
+  check composite-auto-cpu ok "" -- "$BIN" composite "$T/dphoto.exr" --camera "$T/dist.json" --backend auto \
+    --probes "$T/fus/probes.json" "${OBJ[@]}" --samples 2 --object-samples 2 --out "$T/c_auto.exr"
+  [ -e "$T/bad_gl.exr" ] && { echo "FAIL composite-gl-refuses wrote its output"; fail=$((fail+1)); }
+fi
+
 # Bad input: one line naming the option, nothing written.
 $PY -c 'import json,sys; j=json.load(open(sys.argv[1])); j["points"]=j["points"][:5]; json.dump(j,open(sys.argv[2],"w"))' \
   "$T/depth.json" "$T/five.json"
