@@ -277,7 +277,9 @@ void setup(CLI::App& app) {
   s->add_option("-o,--out", so->out, "the camera file to write (iblkit.camera/1)")->required();
   s->footer(
       "Without --fov or --intrinsics one focal length is solved with the pose (centred principal point, no "
-      "distortion).");
+      "distortion).\nExamples:\n  iblkit camera solve photo.jpg --points pts.json --fov 40 --out cam.json\n"
+      "  iblkit camera solve photo.jpg --board checker:9x6:0.05 --board-origin 0,0,0 --board-axes 1,0,0,0,0,-1 "
+      "--intrinsics lens.json --out cam.json");
   s->callback([so] { run_solve(*so); });
 
   auto* c = app.add_subcommand("calibrate", "A lens (intrinsics, distortion) from several photographs of a board");
@@ -285,6 +287,8 @@ void setup(CLI::App& app) {
   c->add_option("photos", co->photos, "three or more photographs of the board, one camera and zoom")->required();
   add_board_options(c, co->board, true);
   c->add_option("-o,--out", co->out, "the camera file to write: the lens and the first photograph's pose")->required();
+  c->footer(
+      "Example:\n  iblkit camera calibrate b1.jpg b2.jpg b3.jpg b4.jpg --board checker:9x6:0.025 --out lens.json");
   c->callback([co] { run_calibrate(*co); });
 
   auto* k = app.add_subcommand("check", "The reprojection error of points through a camera file");
@@ -292,6 +296,7 @@ void setup(CLI::App& app) {
   k->add_option("photo", ko->photo, "the photograph (its size)")->required();
   k->add_option("--camera", ko->camera, "iblkit.camera/1")->required();
   k->add_option("--points", ko->points, "iblkit.points/1")->required();
+  k->footer("Example:\n  iblkit camera check photo.jpg --camera cam.json --points pts.json");
   k->callback([ko] { run_check(*ko); });
 }
 
