@@ -48,6 +48,8 @@ constexpr Subcommand kSubcommands[] = {
     {"render", "Render an object lit by a probe, SH, an SH grid, lights or a luminaire (CPU reference or OpenGL)",
      "geometry"},
     {"composite", "Composite a virtual object into a photograph with its shadows (differential rendering)", "geometry"},
+    {"camera", "The camera of a photograph: pose and lens from points or a chessboard (OpenCV), calibration, checks",
+     "geometry"},
 #endif
 #if defined(IBLKIT_HAVE_GL) && defined(IBLKIT_HAVE_GLFW)
     {"view", "Interactive viewer (GLFW window): orbit, move the object, switch lightings", "view"},

@@ -76,6 +76,17 @@ CompositeRun run_composite(const Image& photo, const geometry::Camera& cam, cons
                            const CompositeScene& scene) {
   CompositeRun run;
   run.backend = job.backend;
+  if (cam.distorted()) {
+    // The GL compositor rasterises through Camera::projection(), which cannot bend lines; the CPU casts
+    // each pixel's ray (Camera::ray_direction), distortion and all.
+    if (run.backend == Backend::Gl)
+      fail(ErrorKind::Unsupported,
+           "--backend gl cannot render through the camera's lens distortion (k1 k2 p1 p2 k3); use --backend cpu");
+    if (run.backend == Backend::Auto) {
+      run.backend = Backend::Cpu;
+      run.notes.push_back("backend auto: the camera has lens distortion, which only the CPU composites");
+    }
+  }
   if (run.backend == Backend::Auto) {
     std::string why;
     run.backend = gl_backend_available(&why) ? Backend::Gl : Backend::Cpu;

@@ -59,5 +59,78 @@ TEST(GeometryCameraIo, HugeWidthIsRefusedNotNarrowed) {
   EXPECT_THROW(camera_from_json(j, "cam.json"), Error);
 }
 
+TEST(GeometryCameraIo, IntrinsicsAndDistortionRoundTrip) {
+  Camera c = looking_down();
+  c.width = 640;
+  c.height = 480;
+  c.intrinsics = Intrinsics{501.25, 499.5, 322.125, 238.75};
+  c.distortion = {-0.21, 0.043, 0.0011, -0.0007, -0.0032};
+  const auto path = (std::filesystem::temp_directory_path() / "geometry_test_camera_lens.json").string();
+  write_camera(path, c, false);  // with intrinsics the size is written anyway
+  const Camera r = read_camera(path);
+  std::filesystem::remove(path);
+  ASSERT_TRUE(r.intrinsics);
+  EXPECT_EQ(r.width, 640);
+  EXPECT_EQ(r.height, 480);
+  EXPECT_EQ(r.intrinsics->fx, 501.25);
+  EXPECT_EQ(r.intrinsics->fy, 499.5);
+  EXPECT_EQ(r.intrinsics->cx, 322.125);
+  EXPECT_EQ(r.intrinsics->cy, 238.75);
+  EXPECT_EQ(r.distortion.k1, -0.21);
+  EXPECT_EQ(r.distortion.k2, 0.043);
+  EXPECT_EQ(r.distortion.p1, 0.0011);
+  EXPECT_EQ(r.distortion.p2, -0.0007);
+  EXPECT_EQ(r.distortion.k3, -0.0032);
+  for (double px : {0.5, 320.0, 639.5}) EXPECT_LT(length(r.ray_direction(px, 17) - c.ray_direction(px, 17)), 1e-15);
+  // An old file (no lens) reads as the pinhole, and writes no lens back.
+  const Camera old = camera_from_json(camera_to_json(looking_down()), "old");
+  EXPECT_FALSE(old.intrinsics);
+  EXPECT_FALSE(camera_to_json(old).contains("intrinsics"));
+  EXPECT_FALSE(camera_to_json(old).contains("distortion"));
+  // fov_y_deg may be left out when the intrinsics give it.
+  nlohmann::json j = camera_to_json(c);
+  j.erase("fov_y_deg");
+  EXPECT_NEAR(camera_from_json(j, "t").fov_y_deg, 2 * std::atan(240 / 499.5) * 180 / kPi, 1e-12);
+}
+
+TEST(GeometryCameraIo, BadLensesAreRefusedNamingTheField) {
+  Camera c = looking_down();
+  c.intrinsics = Intrinsics{50, 50, 32, 24};
+  c.distortion = {-0.2, 0, 0, 0, 0};
+  auto refused = [](nlohmann::json j, const char* word) {
+    try {
+      camera_from_json(j, "cam.json");
+      ADD_FAILURE() << "accepted " << j.dump();
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(word), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("cam.json"), std::string::npos) << e.what();
+    }
+  };
+  nlohmann::json j = camera_to_json(c);
+  j["intrinsics"]["fx"] = -50;
+  refused(j, "focal");
+  j = camera_to_json(c);
+  j["intrinsics"].erase("cy");
+  refused(j, "cy");
+  j = camera_to_json(c);
+  j["intrinsics"]["cx"] = 1e9;
+  refused(j, "principal point");
+  j = camera_to_json(c);
+  j["distortion"] = {0.1, 0.2};
+  refused(j, "distortion");
+  j = camera_to_json(c);
+  j["distortion"][0] = 1e5;
+  refused(j, "distortion");
+  j = camera_to_json(c);
+  j["distortion"][1] = "x";
+  refused(j, "distortion");
+  j = camera_to_json(c);
+  j.erase("intrinsics");
+  refused(j, "intrinsics");
+  j = camera_to_json(c);
+  j.erase("width");
+  refused(j, "width");
+}
+
 }  // namespace
 }  // namespace ibl::geometry

@@ -148,6 +148,10 @@ RenderResult render_cpu(const FrameDesc& d, const ProgressFn& progress) {
   const int W = cam.width, H = cam.height;
   if (W <= 0 || H <= 0) fail(ErrorKind::Value, "frame size {}x{} is invalid", W, H);
   check_objects(d);
+  if (cam.distorted())
+    fail(ErrorKind::Unsupported,
+         "render: the rasteriser cannot draw through lens distortion (k1 k2 p1 p2 k3); composite --backend cpu "
+         "casts rays through it");
   geometry::Mat4f vp = geometry::mul(cam.projection(), cam.view());
   std::vector<Hit> hits(static_cast<size_t>(W) * H);
   // Rasterise in horizontal bands, one task each: every band tests every triangle's bounds.

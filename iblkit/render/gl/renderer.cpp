@@ -511,10 +511,17 @@ void Renderer::Impl::plan_uniforms(const FrameDesc& d, FramePlan& p) {
   if (p.deferred) {
     // Camera rays: dir(x, y) ∝ f + r·sx + u·sy with sx, sy linear in the pixel position.
     Vec3 f = normalize(cam.target - cam.eye), r = normalize(cross(f, cam.up)), u = cross(r, f);
-    double t = std::tan(cam.fov_y_deg * kPi / 360.0), aspect = static_cast<double>(p.W) / p.H;
-    set_vec3(prog, "u_ray00", f - r * (t * aspect) + u * t);
-    set_vec3(prog, "u_ray_dx", r * (2 * t * aspect / p.W));
-    set_vec3(prog, "u_ray_dy", u * (-2 * t / p.H));
+    if (cam.intrinsics) {  // a photograph's focal lengths and principal point (undistorted: checked above)
+      const geometry::Intrinsics& k = *cam.intrinsics;
+      set_vec3(prog, "u_ray00", f - r * (k.cx / k.fx) + u * (k.cy / k.fy));
+      set_vec3(prog, "u_ray_dx", r * (1 / k.fx));
+      set_vec3(prog, "u_ray_dy", u * (-1 / k.fy));
+    } else {
+      double t = std::tan(cam.fov_y_deg * kPi / 360.0), aspect = static_cast<double>(p.W) / p.H;
+      set_vec3(prog, "u_ray00", f - r * (t * aspect) + u * t);
+      set_vec3(prog, "u_ray_dx", r * (2 * t * aspect / p.W));
+      set_vec3(prog, "u_ray_dy", u * (-2 * t / p.H));
+    }
   }
   glProgramUniform1i(prog, glGetUniformLocation(prog, "u_light_count"), static_cast<GLint>(L.lights.size()));
   glProgramUniform1i(prog, glGetUniformLocation(prog, "u_point_light_count"),
@@ -692,6 +699,9 @@ void read_frame(const FramePlan& p, RenderResult& out) {
 }  // namespace
 
 RenderResult Renderer::render(const FrameDesc& d, int frames, GpuTiming* timing, bool read_back) {
+  if (d.camera.distorted())
+    fail(ErrorKind::Unsupported,
+         "the GL backend cannot render through lens distortion (k1 k2 p1 p2 k3); use --backend cpu");
   Impl& r = *impl_;
   FramePlan p;
   r.plan_programs(d, p);

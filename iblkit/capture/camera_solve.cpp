@@ -1,0 +1,200 @@
+#include "iblkit/capture/camera_solve.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "iblkit/core/check.h"
+#include "iblkit/core/error.h"
+#include "iblkit/core/json_file.h"
+
+namespace ibl::capture {
+
+namespace detail {
+constinit plugin::Provided<CvSolver> cv_solver{"cv", "OpenCV camera solver"};
+}  // namespace detail
+
+std::vector<Correspondence> points_from_json(const nlohmann::json& j, const std::string& what) {
+  require_format(j, what, "iblkit.points/1");
+  if (!j.contains("points") || !j["points"].is_array())
+    fail(ErrorKind::Format, "{}: \"points\" (an array of {{\"pixel\": [u, v], \"world\": [x, y, z]}}) is missing",
+         what);
+  std::vector<Correspondence> out;
+  for (size_t i = 0; i < j["points"].size(); ++i) {
+    const auto& p = j["points"][i];
+    auto numbers = [&](const char* key, size_t n) {
+      if (!p.is_object() || !p.contains(key) || !p[key].is_array() || p[key].size() != n)
+        fail(ErrorKind::Format, "{}: points[{}].{} must be an array of {} numbers", what, i, key, n);
+      std::vector<double> v;
+      for (const auto& x : p[key]) {
+        if (!x.is_number())
+          fail(ErrorKind::Format, "{}: points[{}].{} must be an array of {} numbers", what, i, key, n);
+        v.push_back(x.get<double>());
+      }
+      return v;
+    };
+    auto px = numbers("pixel", 2);
+    auto w = numbers("world", 3);
+    Correspondence c{{px[0], px[1]}, {w[0], w[1], w[2]}};
+    if (!std::isfinite(c.pixel.x) || !std::isfinite(c.pixel.y) || std::abs(c.pixel.x) > 1e6 ||
+        std::abs(c.pixel.y) > 1e6)
+      fail(ErrorKind::Value, "{}: points[{}].pixel ({}, {}) is not a finite pixel position", what, i, c.pixel.x,
+           c.pixel.y);
+    require_point(fmt::format("{}: points[{}].world", what, i), c.world);
+    out.push_back(c);
+  }
+  if (out.size() < static_cast<size_t>(kMinCorrespondences))
+    fail(ErrorKind::Value, "{}: {} points; a camera needs at least {} pixel ↔ world pairs", what, out.size(),
+         kMinCorrespondences);
+  return out;
+}
+
+std::vector<Correspondence> read_points(const std::string& path) {
+  return points_from_json(read_json_file(path), path);
+}
+
+nlohmann::json points_to_json(const std::vector<Correspondence>& pts) {
+  nlohmann::json a = nlohmann::json::array();
+  for (const auto& p : pts)
+    a.push_back({{"pixel", {p.pixel.x, p.pixel.y}}, {"world", {p.world.x, p.world.y, p.world.z}}});
+  return {{"format", "iblkit.points/1"}, {"points", a}};
+}
+
+std::vector<Vec3> Board::corners() const {
+  std::vector<Vec3> c;
+  for (int b = 0; b < rows; ++b)
+    for (int a = 0; a < cols; ++a) c.push_back(corner(a, b));
+  return c;
+}
+
+Board parse_board(const std::string& spec, const std::string& option) {
+  Board b;
+  int n = 0;
+  char tail = 0;
+  if (std::sscanf(spec.c_str(), "checker:%dx%d:%lf%n%c", &b.cols, &b.rows, &b.square, &n, &tail) != 3 ||
+      n != static_cast<int>(spec.size()))
+    fail(ErrorKind::Value, "{} {}: expected checker:COLSxROWS:SQUARE_M (inner corners, metres), e.g. checker:9x6:0.05",
+         option, spec);
+  if (b.cols < 3 || b.rows < 3 || b.cols > 100 || b.rows > 100)
+    fail(ErrorKind::Value, "{} {}: {}x{} inner corners; each count must lie in 3..100", option, spec, b.cols, b.rows);
+  if (b.cols == b.rows || (b.cols + b.rows) % 2 == 0)
+    fail(ErrorKind::Value,
+         "{} {}: a {}x{} board looks the same turned around; use one odd and one even count of inner corners "
+         "(9x6, 7x4)",
+         option, spec, b.cols, b.rows);
+  if (!(b.square > 0 && b.square <= 10))
+    fail(ErrorKind::Value, "{} {}: square size {} m must lie in (0, 10]", option, spec, b.square);
+  return b;
+}
+
+void place_board(Board& b, Vec3 origin, Vec3 u, Vec3 v, const std::string& option) {
+  require_point(option + " origin", origin);
+  Vec3 un = require_direction(option + " u axis", u), vn = require_direction(option + " v axis", v);
+  Vec3 vo = vn - un * dot(un, vn);
+  if (length(vo) < 1e-6) fail(ErrorKind::Value, "{}: the u and v axes are parallel", option);
+  b.origin = origin;
+  b.u = un;
+  b.v = normalize(vo);
+}
+
+Reprojection reprojection(const geometry::Camera& cam, const std::vector<Correspondence>& pts) {
+  Reprojection r;
+  double sum = 0;
+  int n = 0;
+  for (size_t i = 0; i < pts.size(); ++i) {
+    auto q = cam.project(pts[i].world);
+    if (!q) {
+      ++r.behind;
+      continue;
+    }
+    double e = std::hypot(q->x - pts[i].pixel.x, q->y - pts[i].pixel.y);
+    sum += e * e;
+    ++n;
+    if (e > r.max_px || r.worst < 0) r.max_px = e, r.worst = static_cast<int>(i);
+  }
+  r.rms_px = n ? std::sqrt(sum / n) : 0;
+  return r;
+}
+
+Solved solve_camera(const std::vector<Correspondence>& pts, const geometry::Camera& lens, LensMode mode) {
+  if (pts.size() < static_cast<size_t>(kMinCorrespondences))
+    fail(ErrorKind::Value, "{} points; a camera needs at least {} pixel ↔ world pairs", pts.size(),
+         kMinCorrespondences);
+  for (const auto& p : pts) {
+    require_point("world point", p.world);
+    if (!std::isfinite(p.pixel.x) || !std::isfinite(p.pixel.y))
+      fail(ErrorKind::Value, "pixel ({}, {}) is not finite", p.pixel.x, p.pixel.y);
+  }
+  if (lens.width < 1 || lens.height < 1) fail(ErrorKind::Value, "camera solve: the frame size is unknown");
+  Solved s = detail::cv_solver.get().solve(pts, lens, mode);
+  s.error = reprojection(s.camera, pts);
+  if (s.error.behind)
+    fail(ErrorKind::Value, "camera solve: {} of the {} points come out behind the solved camera", s.error.behind,
+         pts.size());
+  return s;
+}
+
+namespace {
+
+// Mean grey over the middle of the quadrilateral of four image points.
+double cell_grey(const Image& grey, Vec2 a, Vec2 b, Vec2 c, Vec2 d) {
+  double sum = 0;
+  int n = 0;
+  for (double s : {0.3, 0.5, 0.7})
+    for (double t : {0.3, 0.5, 0.7}) {
+      Vec2 p = (a * ((1 - s) * (1 - t)) + b * (s * (1 - t)) + c * ((1 - s) * t) + d * (s * t));
+      int x = static_cast<int>(std::floor(p.x)), y = static_cast<int>(std::floor(p.y));
+      if (x < 0 || y < 0 || x >= grey.width() || y >= grey.height()) continue;
+      sum += grey.at(x, y, 0);
+      ++n;
+    }
+  return n ? sum / n : 0;
+}
+
+}  // namespace
+
+std::optional<std::vector<Correspondence>> find_board(const Image& photo, const Board& board) {
+  Image grey(photo.width(), photo.height(), 1);
+  for (int y = 0; y < photo.height(); ++y)
+    for (int x = 0; x < photo.width(); ++x) {
+      const float* p = photo.pixel(x, y);
+      grey.at(x, y, 0) = photo.channels() >= 3 ? 0.2126f * p[0] + 0.7152f * p[1] + 0.0722f * p[2] : p[0];
+    }
+  auto found = detail::cv_solver.get().find_chessboard(grey, board.cols, board.rows);
+  if (!found) return std::nullopt;
+  const int C = board.cols, R = board.rows;
+  std::vector<Vec2>& c = *found;  // OpenCV's order: row b, column a at b·C + a; pixels in continuous coordinates
+  auto at = [&](int a, int b) { return c[static_cast<size_t>(b) * C + a]; };
+  // Relabel (a, b) so that the board's axes have the handedness of a face seen from the front (u × v towards
+  // the camera: in the image, x right and y down, the cross product of the u and v directions is negative)…
+  Vec2 du = at(C - 1, 0) - at(0, 0), dv = at(0, R - 1) - at(0, 0);
+  bool mirror = du.x * dv.y - du.y * dv.x > 0;
+  std::vector<Vec2> m(c.size());
+  for (int b = 0; b < R; ++b)
+    for (int a = 0; a < C; ++a) m[static_cast<size_t>(b) * C + a] = at(mirror ? C - 1 - a : a, b);
+  // …and so that the square between the first four corners is the dark one (COLS + ROWS is odd, so the
+  // board turned by 180° puts a light square there).
+  auto mt = [&](int a, int b) { return m[static_cast<size_t>(b) * C + a]; };
+  double first = cell_grey(grey, mt(0, 0), mt(1, 0), mt(0, 1), mt(1, 1));
+  double next = cell_grey(grey, mt(1, 0), mt(2, 0), mt(1, 1), mt(2, 1));
+  bool turn = first > next;
+  std::vector<Correspondence> out;
+  for (int b = 0; b < R; ++b)
+    for (int a = 0; a < C; ++a) {
+      Vec2 px = turn ? mt(C - 1 - a, R - 1 - b) : mt(a, b);
+      out.push_back({px, board.corner(a, b)});
+    }
+  return out;
+}
+
+Calibrated calibrate_camera(const std::vector<std::vector<Correspondence>>& views, int width, int height) {
+  if (views.size() < 3)
+    fail(ErrorKind::Value, "camera calibrate: {} photographs; a lens needs at least 3", views.size());
+  if (width < 1 || height < 1 || width > 16384 || height > 16384)
+    fail(ErrorKind::Value, "camera calibrate: frame size {}x{} outside 1..16384", width, height);
+  Calibrated c = detail::cv_solver.get().calibrate(views, width, height);
+  geometry::require_lens(c.camera, "camera calibrate");
+  return c;
+}
+
+}  // namespace ibl::capture

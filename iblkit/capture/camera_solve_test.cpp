@@ -1,0 +1,83 @@
+#include "iblkit/capture/camera_solve.h"
+
+#include <gtest/gtest.h>
+
+#include "iblkit/core/error.h"
+
+using namespace ibl;
+using namespace ibl::capture;
+
+namespace {
+
+nlohmann::json six_points() {
+  std::vector<Correspondence> p;
+  for (int i = 0; i < 6; ++i) p.push_back({{10.5 + i, 20.25 * i}, {0.1 * i, 0, -0.2 * (i % 3)}});
+  return points_to_json(p);
+}
+
+void refused(const nlohmann::json& j, const char* word) {
+  try {
+    points_from_json(j, "pts.json");
+    ADD_FAILURE() << "accepted " << j.dump();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(word), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("pts.json"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+
+TEST(CameraSolve, PointsFilesRoundTripAndAreChecked) {
+  auto pts = points_from_json(six_points(), "pts.json");
+  ASSERT_EQ(pts.size(), 6u);
+  EXPECT_EQ(pts[3].pixel.x, 13.5);
+  EXPECT_EQ(pts[3].pixel.y, 60.75);
+  EXPECT_EQ(pts[2].world.z, -0.4);
+  auto j = six_points();
+  j["points"].erase(0);
+  refused(j, "at least 6");
+  j = six_points();
+  j["points"][1]["pixel"] = {1.0};
+  refused(j, "points[1].pixel");
+  j = six_points();
+  j["points"][2]["world"][1] = std::nan("");  // nlohmann writes NaN as null: not a number
+  refused(j, "points[2].world");
+  j = six_points();
+  j["points"][2]["world"][1] = 1e9;
+  refused(j, "points[2].world");
+  j = six_points();
+  j["format"] = "iblkit.camera/1";
+  refused(j, "iblkit.points/1");
+}
+
+TEST(CameraSolve, BoardsAreParsedPlacedAndChecked) {
+  Board b = parse_board("checker:9x6:0.05", "--board");
+  EXPECT_EQ(b.cols, 9);
+  EXPECT_EQ(b.rows, 6);
+  EXPECT_EQ(b.square, 0.05);
+  place_board(b, {1, 0, 2}, {2, 0, 0}, {0.1, 0, -1}, "--board-axes");
+  Vec3 c = b.corner(2, 1);
+  EXPECT_NEAR(c.x, 1.1, 1e-12);
+  EXPECT_NEAR(c.z, 1.95, 1e-12);
+  EXPECT_EQ(b.corners().size(), 54u);
+  EXPECT_NEAR(dot(b.u, b.v), 0, 1e-15);
+  for (const char* bad : {"checker:9x6", "checker:6x6:0.05", "checker:9x7:0.05", "checker:2x5:0.05", "checker:9x6:0",
+                          "charuco:9x6:0.05", "checker:9x6:0.05x"})
+    EXPECT_THROW(parse_board(bad, "--board"), Error) << bad;
+  EXPECT_THROW(place_board(b, {0, 0, 0}, {1, 0, 0}, {2, 0, 0}, "--board-axes"), Error);
+}
+
+TEST(CameraSolve, ReprojectionCountsPointsBehindTheCamera) {
+  geometry::Camera c;
+  c.width = 64;
+  c.height = 48;
+  std::vector<Correspondence> pts;
+  for (Vec3 w : {Vec3{0, 0, 0}, Vec3{0.1, 0.2, 0}, Vec3{0, 0.3, 5}}) {
+    auto q = c.project(w);
+    pts.push_back({q ? *q + Vec2{0.3, 0.4} : Vec2{0, 0}, w});
+  }
+  Reprojection r = reprojection(c, pts);
+  EXPECT_EQ(r.behind, 1);  // (0, 0.3, 5) is behind the default eye at z = 1.2
+  EXPECT_NEAR(r.rms_px, 0.5, 1e-9);
+  EXPECT_NEAR(r.max_px, 0.5, 1e-9);
+}
