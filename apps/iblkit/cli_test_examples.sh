@@ -6,7 +6,8 @@
 # lat-longs of Blender's forest; path.json; cam.json; room.obj and floor.obj: a box room and a floor at
 # y = 0; grid.shgrid: an SH grid of low-scene2 over x, z in [-1, 1], y in [0.1, 1.5]; fusion/: a
 # low-scene2 probe set at (0.1, 0.3, 0.1), what composite's examples composite into; ball/ and brackets/: lab
-# shoot's chrome-ball photographs) and ../shared is
+# shoot's chrome-ball photographs; photo.jpg, pts.json, b1..b4.jpg, lens.json: chessboards for camera's)
+# and ../shared is
 # the shared data. A failing example fails the test with its command and message. Skipped, with a message:
 # `view` without --frames (an interactive window), examples that need OpenGL where it is absent, and
 # those that read ../shared where it is absent. Each example may take IBLKIT_EXAMPLE_TIMEOUT seconds
@@ -42,6 +43,26 @@ printf 'v -2 0 -2\nv 2 0 -2\nv 2 0 2\nv -2 0 2\nf 1 3 2\nf 1 4 3\n' > floor.obj
 "$BIN" --quiet lab shoot low-scene1 --at 0,1,0 --distance-radii 8 --out ball >/dev/null || echo "FAIL setup: ball/"
 "$BIN" --quiet lab shoot low-scene2 --two-sides --distance 2 --bracket 5 --ev-step 2 --noise --quality 95 --out brackets \
   >/dev/null || echo "FAIL setup: brackets/"
+# photo.jpg, pts.json, b1..b4.jpg (= board1..4.jpg) and lens.json: chessboards on the floor photographed by OpenCV
+# (camera_test_tool.py, the peer of cli_camera) for `camera`'s examples; without python3-opencv they are skipped.
+have_cv=no
+if /usr/bin/python3 -c "import cv2, numpy" >/dev/null 2>&1; then
+  have_cv=yes
+  tool="$SRC/apps/iblkit/camera_test_tool.py"
+  i=0
+  for eye in "0,0.9,0.7" "0.4,0.8,0.6" "-0.4,0.9,0.5" "0.2,0.6,0.8" "-0.2,1.0,0.4"; do
+    echo "{\"format\":\"iblkit.camera/1\",\"eye\":[$eye],\"target\":[0.1,0,-0.1],\"up\":[0,1,0],\"fov_y_deg\":40,\"width\":640,\"height\":480}" >"$T/c$i.json"
+    i=$((i+1))
+  done
+  /usr/bin/python3 "$tool" board "$T/c0.json" photo.jpg 9 6 0.05 0,0,0 1,0,0 0,0,-1 &&
+    /usr/bin/python3 "$tool" points "$T/c0.json" pts.json depth || echo "FAIL setup: photo.jpg, pts.json"
+  for i in 1 2 3 4; do
+    /usr/bin/python3 "$tool" board "$T/c$i.json" "b$i.jpg" 9 6 0.025 0,0,0 1,0,0 0,0,-1 && cp "b$i.jpg" "board$i.jpg" ||
+      echo "FAIL setup: b$i.jpg"
+  done
+  "$BIN" --quiet camera calibrate b1.jpg b2.jpg b3.jpg b4.jpg --board checker:9x6:0.025 --out lens.json >/dev/null ||
+    echo "FAIL setup: lens.json"
+fi
 have_gl=yes
 "$BIN" --quiet render blob --light probe.exr --backend gl --size 16x16 --out "$T/gl.png" >/dev/null 2>&1 || have_gl=no
 
@@ -58,6 +79,7 @@ run_example() {
     *" view "*)
       if [[ "$cmd" != *--frames* ]]; then echo "skip ($where, interactive window): $line"; skip=$((skip+1)); return; fi ;;
   esac
+  if [[ "$cmd" == *" camera "* && $have_cv = no ]]; then echo "skip ($where, no python3-opencv for its boards): $line"; skip=$((skip+1)); return; fi
   if [[ "$cmd" == *"--backend gl"* && $have_gl = no ]]; then echo "skip ($where, no OpenGL here): $line"; skip=$((skip+1)); return; fi
   if [[ "$cmd" == *"../shared/"* && ! -d "$T/shared" ]]; then echo "skip ($where, no $SHARED): $line"; skip=$((skip+1)); return; fi
   if [[ "$cmd" == xvfb-run* ]]; then
