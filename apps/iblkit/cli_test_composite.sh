@@ -16,6 +16,7 @@ check truth ok "the object covers" -- "$BIN" lab photograph low-scene2 "${CAM[@]
 "$BIN" lab capture low-scene2 --fusion --probe 0,0.5,0 --size 16 --out "$T/fus" --quiet >/dev/null 2>&1
 check composite ok "against .*object .* shadow .* unchanged" -- "$BIN" composite "$T/photo.exr" "${CAM[@]}" --probes "$T/fus/probes.json" \
   "${OBJ[@]}" --samples 16 --object-samples 32 --out "$T/comp.exr" --layers "$T/layers" --truth "$T/truth.exr"
+if [ -f "$T/layers/proxy_overlay.png" ]; then pass=$((pass+1)); else echo "FAIL layers: no proxy_overlay.png"; fail=$((fail+1)); fi
 for f in mask difference albedo render_with render_without; do
   if [ -f "$T/layers/$f.exr" ]; then pass=$((pass+1)); else echo "FAIL layers: no $f.exr"; fail=$((fail+1)); fi
 done

@@ -10,6 +10,7 @@
 #include "cli.h"
 #include "iblkit/augment/composite.h"
 #include "iblkit/augment/measure.h"
+#include "iblkit/augment/overlay.h"
 #include "iblkit/augment/run_composite.h"
 #include "iblkit/capture/backplate.h"
 #include "iblkit/core/atomic_file.h"
@@ -95,6 +96,9 @@ void run(const Opts& o, const ibl::io::EnvReadDesc& read) {
     write_layer(dir, "albedo", r.albedo);
     write_layer(dir, "render_with", r.render_with);
     write_layer(dir, "render_without", r.render_without);
+    // The proxy's edges over the photograph, through the camera: does the camera agree with the proxy?
+    ibl::io::write_image((dir / "proxy_overlay.png").string(),
+                         ibl::augment::proxy_overlay(ibl::io::tonemap(photo), cam, run.proxy));
   }
   const auto& s = r.stats;
   nlohmann::json j = {{"out", o.out},
@@ -151,7 +155,8 @@ void run(const Opts& o, const ibl::io::EnvReadDesc& read) {
     fmt::print("  {} object pixels, {} proxy pixels changed by its shadow and light\n", s.object_pixels,
                s.changed_pixels);
     if (!o.layers.empty())
-      fmt::print("  layers: {}/mask, difference, albedo, render_with, render_without (.exr)\n", o.layers);
+      fmt::print("  layers: {}/mask, difference, albedo, render_with, render_without (.exr), proxy_overlay.png\n",
+                 o.layers);
     if (!o.truth.empty())
       fmt::print(
           "  against {}: object {:.1f} % ({} px), shadow {:.1f} % of the shadow signal ({} px, {:.0f} % darker), "
@@ -256,7 +261,9 @@ void setup(CLI::App& app) {
                  "the composite: .exr linear; for an 8/16-bit photograph .jpg/.png/.tif back through --response in its "
                  "bit depth and metadata (unchanged pixels keep their codes); for an HDR one .png tone mapped")
       ->capture_default_str();
-  app.add_option("--layers", o->layers, "folder for mask, difference, albedo, render_with, render_without (.exr)");
+  app.add_option("--layers", o->layers,
+                 "folder for mask, difference, albedo, render_with, render_without (.exr) and proxy_overlay.png (the "
+                 "proxy's edges over the photograph)");
   iblcli::outputs(app, {"--layers"});  // besides --out (cli.h)
   app.add_option(
       "--truth", o->truth,

@@ -12,6 +12,7 @@
 #include "iblkit/augment/light.h"
 #include "iblkit/augment/match.h"
 #include "iblkit/augment/measure.h"
+#include "iblkit/augment/overlay.h"
 #include "iblkit/augment/testing.h"
 #include "iblkit/core/error.h"
 #include "iblkit/render/objects.h"
@@ -388,6 +389,27 @@ TEST(AugmentMatch, TheGainsAreWhatThePhotographAndTheProbeSeeOfTheSameFloor) {
   under.centre = {0, -0.5, 0};  // below the floor: the floor hides every point from it
   EXPECT_FALSE(estimate_match(photo, top_camera(), floor_mesh(), under).valid);
   EXPECT_THROW(estimate_match(Image(4, 4, 3), top_camera(), floor_mesh(), probe), Error);
+}
+
+TEST(AugmentOverlay, TheProxysOutlineIsDrawnWhereTheCameraSeesItAndItsDiagonalsAreNot) {
+  // A 6 m floor from 3 m above with a 60° view: its edges fall outside the frame; a 1 m square tile of two
+  // triangles in the middle (0.01 m up) shows its outline, not its diagonal; a box in front hides what is behind.
+  geometry::TriMesh tile = geometry::make_quad({0, 0.01, 0}, {0, 1, 0}, {0, 0, -1}, 1, 1);
+  const Image black(kW, kH, 3);
+  const Image o = proxy_overlay(black, top_camera(), tile);
+  auto lit = [&](double x, double z) {  // the tile's point (x, z) seen at a green pixel?
+    auto [px, py] = pixel_of(x, z);
+    double g = 0;
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx)
+        g = std::max<double>(g, o.at(std::clamp(px + dx, 0, kW - 1), std::clamp(py + dy, 0, kH - 1), 1));
+    return g > 0.3;
+  };
+  EXPECT_TRUE(lit(0.5, 0.0));     // its right edge
+  EXPECT_TRUE(lit(0.0, -0.5));    // its far edge
+  EXPECT_FALSE(lit(0.2, 0.2));    // on its diagonal (x = z): not a feature edge
+  EXPECT_FALSE(lit(0.25, -0.1));  // inside
+  EXPECT_THROW(proxy_overlay(Image(3, 3, 3), top_camera(), tile), Error);
 }
 
 TEST(AugmentMeasure, PerfectCompositeHasNoErrorAndShadowErrorIsRelative) {

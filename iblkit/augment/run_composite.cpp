@@ -99,6 +99,7 @@ CompositeRun run_composite(const Image& photo, const geometry::Camera& cam, cons
                    : composite(photo, cam, L.proxy, L.light, scene.object, job.material, job.desc);
   run.result.warnings.insert(run.result.warnings.begin(), L.warnings.begin(), L.warnings.end());
   run.light_source = L.light.source;
+  run.proxy = L.proxy;
   run.match = scene.match;
   run.matched = scene.matched;
   run.notes.insert(run.notes.begin(), scene.notes.begin(), scene.notes.end());

@@ -64,6 +64,7 @@ struct CompositeRun {
   CompositeResult result;          // its warnings begin with the light's
   Backend backend = Backend::Cpu;  // the one that ran (Auto resolved)
   std::string light_source;        // LocalRadiance::source
+  geometry::TriMesh proxy;         // the local scene it composited on (for the overlay layer)
   std::vector<std::string> notes;  // what the caller may tell the user (the backend auto chose, the match)
   MatchResult match;               // the gains estimated (match.valid false: none)
   bool matched = false;            // the light was multiplied by match.gain
