@@ -44,6 +44,16 @@ if command -v oiiotool >/dev/null; then
   g2=$("$BIN" composite "$T/photo_x2.exr" "${CAM[@]}" --probes "$T/fus/probes.json" "${OBJ[@]}" --samples 4 --object-samples 4 \
     --out "$T/c_x2.exr" --json 2>/dev/null | python3 -c 'import json,sys; print(json.load(sys.stdin)["match"]["gain"][1])')
   check match-one-stop ok "" -- python3 -c "import sys; r = $g2 / $g1; print(r); sys.exit(0 if abs(r - 2) < 0.02 else 1)"
+  # A grey card: the match from the pixels of one patch of floor (rows 28-33 of the 48x36 photograph).
+  g3=$("$BIN" composite "$T/photo_x2.exr" "${CAM[@]}" --probes "$T/fus/probes.json" "${OBJ[@]}" --samples 4 --object-samples 4 \
+    --grey-card 14,28,20,6 --out "$T/c_card.exr" --json 2>/dev/null | python3 -c 'import json,sys; print(json.load(sys.stdin)["match"]["gain"][1])')
+  g0=$("$BIN" composite "$T/photo.exr" "${CAM[@]}" --probes "$T/fus/probes.json" "${OBJ[@]}" --samples 4 --object-samples 4 \
+    --grey-card 14,28,20,6 --out "$T/c_card0.exr" --json 2>/dev/null | python3 -c 'import json,sys; print(json.load(sys.stdin)["match"]["gain"][1])')
+  check match-grey-card ok "" -- python3 -c "import sys; r = $g3 / $g0; print(r); sys.exit(0 if abs(r - 2) < 0.02 else 1)"
+  check match-grey-card-off-frame fail "must lie inside" -- "$BIN" composite "$T/photo_x2.exr" "${CAM[@]}" \
+    --probes "$T/fus/probes.json" "${OBJ[@]}" --grey-card 40,30,20,20 --out "$T/c_card2.exr"
+  check match-grey-card-no-rect fail "give the card" -- "$BIN" composite "$T/photo_x2.exr" "${CAM[@]}" \
+    --probes "$T/fus/probes.json" "${OBJ[@]}" --match grey-card --out "$T/c_card3.exr"
   check match-off ok "composited" -- "$BIN" composite "$T/photo_x2.exr" "${CAM[@]}" --probes "$T/fus/probes.json" "${OBJ[@]}" \
     --samples 4 --object-samples 4 --match off --out "$T/c_x2off.exr"
   check ldr-bad-response fail "no-such.json" -- "$BIN" composite "$T/photo.jpg" "${CAM[@]}" --probes "$T/fus/probes.json" \

@@ -2,6 +2,7 @@
 // shadows and interreflection (differential rendering, augment/composite.h; docs/augment.md).
 #ifdef IBLKIT_HAVE_GEOMETRY
 #include <cctype>
+#include <cstdio>
 #include <filesystem>
 
 #include <fmt/format.h>
@@ -26,7 +27,7 @@ using ibl::Vec3;
 
 struct Opts {
   std::string photo, probe_depth, object, at, albedo = "0.7,0.7,0.7", out = "composite.exr", layers, backend = "cpu",
-                                              response, match = "auto";
+                                              response, match = "auto", grey_card;
   int quality = 0;
   iblcli::PhotoSceneOptions scene;
   std::vector<std::string> light, truth;
@@ -59,6 +60,16 @@ void run(const Opts& o, const ibl::io::EnvReadDesc& read) {
   job.light.read = read;
   job.material = iblcli::object_material(o.albedo, o.gloss, o.exponent, o.lobe, o.texture);
   job.match = o.match == "off" ? ibl::augment::Match::Off : ibl::augment::Match::Auto;
+  if (!o.grey_card.empty()) {  // the card's rectangle: the match from its pixels alone
+    int v[4];
+    char tail = 0;
+    if (std::sscanf(o.grey_card.c_str(), "%d,%d,%d,%d%c", &v[0], &v[1], &v[2], &v[3], &tail) != 4)
+      ibl::fail(ibl::ErrorKind::Value, "--grey-card {}: expected x,y,w,h in pixels", o.grey_card);
+    job.grey_card = {v[0], v[1], v[2], v[3]};
+    job.match = ibl::augment::Match::GreyCard;
+  } else if (o.match == "grey-card") {
+    ibl::fail(ibl::ErrorKind::Value, "--match grey-card: give the card's pixels with --grey-card x,y,w,h");
+  }
   if (plate.encoded) {  // the photograph's top code, linear: saturated pixels say nothing of the light's scale
     job.saturated = 1e30;
     for (int c = 0; c < 3; ++c) job.saturated = std::min(job.saturated, plate.response.invert(1.0, c) * (1 - 1e-6));
@@ -180,9 +191,14 @@ void setup(CLI::App& app) {
                  "default for float files), camera, or an iblkit.response/1 file (docs/formats.md)");
   app.add_option("--match", o->match,
                  "auto: the light's scale and per-channel gains estimated from the proxy points the photograph and the "
-                 "probe both see, and applied (a probe's map; not an SH grid); off: the light as captured")
-      ->check(CLI::IsMember({"auto", "off"}))
+                 "probe both see, and applied (a probe's map; not an SH grid); grey-card: from --grey-card's pixels "
+                 "alone; off: the light as captured")
+      ->check(CLI::IsMember({"auto", "off", "grey-card"}))
       ->capture_default_str();
+  app.add_option(
+      "--grey-card", o->grey_card,
+      "x,y,w,h: pixels of a matte card (or any matte patch of the proxy) that the probe also sees: the match "
+      "from them alone (--match grey-card)");
   app.add_option("--quality", o->quality,
                  "JPEG quality of a .jpg --out (default: the input JPEG's own, estimated from its tables; else 95)")
       ->check(CLI::Range(1, 100));

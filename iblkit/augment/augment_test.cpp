@@ -381,6 +381,13 @@ TEST(AugmentMatch, TheGainsAreWhatThePhotographAndTheProbeSeeOfTheSameFloor) {
   EXPECT_NEAR(m.gain.y, 1.8, 1e-6);
   EXPECT_NEAR(m.gain.z, 1.2, 1e-6);
   EXPECT_NEAR(m.spread, 0, 1e-9);
+  const PixelRect card{10, 12, 8, 5};  // a grey card: its pixels alone
+  const MatchResult mc = estimate_match(photo, top_camera(), floor_mesh(), probe, 0, 40000, &card);
+  ASSERT_TRUE(mc.valid);
+  EXPECT_EQ(mc.points, 8 * 5);
+  EXPECT_NEAR(mc.gain.y, 1.8, 1e-6);
+  const PixelRect outside{60, 40, 10, 10};
+  EXPECT_THROW(estimate_match(photo, top_camera(), floor_mesh(), probe, 0, 40000, &outside), Error);
   const LocalRadiance matched = scaled(probe, m.gain);
   EXPECT_NEAR(matched.map.image.at(3, 20, 1), 0.45, 1e-6);
   // Saturated pixels are left out, and a probe that sees none of the points gives no gain.

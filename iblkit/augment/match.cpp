@@ -32,7 +32,7 @@ double median_of_image(const Image& img) {
 }  // namespace
 
 MatchResult estimate_match(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy,
-                           const LocalRadiance& light, double saturated, int64_t max_points) {
+                           const LocalRadiance& light, double saturated, int64_t max_points, const PixelRect* region) {
   if (photo.channels() < 3 || photo.width() != cam.width || photo.height() != cam.height)
     fail(ErrorKind::Value, "match: the photograph ({}x{}) and the camera's frame ({}x{}) must agree", photo.width(),
          photo.height(), cam.width, cam.height);
@@ -43,11 +43,17 @@ MatchResult estimate_match(const Image& photo, const geometry::Camera& cam, cons
   const double photo_floor = 0.01 * median_of_image(photo), light_floor = 0.01 * median_of_image(light.map.image);
   const bool have_depth = !light.depth.empty();
   const int64_t pixels = static_cast<int64_t>(photo.width()) * photo.height();
-  const int64_t stride = std::max<int64_t>(1, pixels / std::max<int64_t>(1, max_points));
+  if (region && (region->w < 1 || region->h < 1 || region->x < 0 || region->y < 0 ||
+                 region->x + region->w > photo.width() || region->y + region->h > photo.height()))
+    fail(ErrorKind::Value, "grey card {},{},{},{} must lie inside the {}x{} photograph", region->x, region->y,
+         region->w, region->h, photo.width(), photo.height());
+  const int64_t stride = region ? 1 : std::max<int64_t>(1, pixels / std::max<int64_t>(1, max_points));
   std::array<std::vector<double>, 3> ratio;
   std::vector<double> log_ratio;
   for (int64_t i = 0; i < pixels; i += stride) {
     const int x = static_cast<int>(i % photo.width()), y = static_cast<int>(i / photo.width());
+    if (region && (x < region->x || x >= region->x + region->w || y < region->y || y >= region->y + region->h))
+      continue;
     const Vec3 d = cam.pixel_direction(x, y);
     const geometry::Hit h = rt.intersect(cam.eye, d);
     if (!h.hit) continue;
@@ -78,7 +84,7 @@ MatchResult estimate_match(const Image& photo, const geometry::Camera& cam, cons
   }
   MatchResult r;
   r.points = static_cast<int64_t>(log_ratio.size());
-  if (r.points < kMinMatchPoints) return r;
+  if (r.points < (region ? kMinCardPoints : kMinMatchPoints)) return r;
   for (int c = 0; c < 3; ++c) r.gain[c] = median(ratio[c]);
   const double m = median(log_ratio);
   for (double& v : log_ratio) v = std::abs(v - m);

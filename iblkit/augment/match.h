@@ -29,12 +29,18 @@ struct MatchResult {
   double spread = 0;   // median absolute deviation of log2(ratio), stops (luminance)
   bool valid = false;  // enough points (≥ kMinMatchPoints) for a gain
 };
-inline constexpr int64_t kMinMatchPoints = 64;
+inline constexpr int64_t kMinMatchPoints = 64;  // over the whole photograph
+inline constexpr int64_t kMinCardPoints = 16;   // inside a grey card's rectangle
 
 // saturated: a photograph value at or above this (in any channel) is left out (the photograph's top code
-// linearised; 0: none is). At most max_points pixels, evenly spread, are used.
+// linearised; 0: none is). At most max_points pixels, evenly spread, are used. region (x, y, w, h in pixels):
+// only the pixels inside it — a grey card (or any matte patch) both see — every one of them.
+struct PixelRect {
+  int x = 0, y = 0, w = 0, h = 0;
+};
 MatchResult estimate_match(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy,
-                           const LocalRadiance& light, double saturated = 0, int64_t max_points = 40000);
+                           const LocalRadiance& light, double saturated = 0, int64_t max_points = 40000,
+                           const PixelRect* region = nullptr);
 
 // The light times the gains (its map; the depth stays).
 LocalRadiance scaled(const LocalRadiance& light, Vec3 gain);

@@ -28,8 +28,16 @@ Backend parse_backend(const std::string& name) {
 }
 
 void match_light(CompositeScene& s, const Image& photo, const geometry::Camera& cam, const CompositeJob& job) {
-  if (job.match == Match::Off || s.light.light.source == "SH grid") return;  // a grid's map is band-limited
-  s.match = estimate_match(photo, cam, s.light.proxy, s.light.light, job.saturated);
+  if (job.match == Match::Off) return;
+  if (job.match == Match::Auto && s.light.light.source == "SH grid") return;  // a grid's map is band-limited
+  const bool card = job.match == Match::GreyCard;
+  s.match =
+      estimate_match(photo, cam, s.light.proxy, s.light.light, job.saturated, 40000, card ? &job.grey_card : nullptr);
+  if (card && !s.match.valid)
+    fail(ErrorKind::Value,
+         "--grey-card {},{},{},{}: only {} of its pixels show a proxy point the light also sees (at least {}): put the "
+         "rectangle on the card as the photograph shows it, on the proxy",
+         job.grey_card.x, job.grey_card.y, job.grey_card.w, job.grey_card.h, s.match.points, kMinCardPoints);
   if (!s.match.valid) {
     s.notes.push_back(fmt::format(
         "match: the photograph and the light see only {} proxy points in common (< {}): the light is used as "

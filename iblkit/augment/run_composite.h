@@ -31,8 +31,9 @@ inline render::ObjectDesc inserted_object_defaults() { return {"blob", 0.3, 2000
 
 // The radiometric match of the light to the photograph (match.h): Auto estimates the gains whenever the
 // light is a probe's map (one probe, fused probes, a probe image: maps that see the proxy; not an SH grid's,
-// which is band-limited) and multiplies the light by them; Off leaves the light as captured.
-enum class Match { Auto, Off };
+// which is band-limited) and multiplies the light by them; GreyCard does the same from the pixels of
+// grey_card alone (a matte card both see: any light, an SH grid's too); Off leaves the light as captured.
+enum class Match { Auto, Off, GreyCard };
 
 struct CompositeJob {
   render::ObjectDesc object = inserted_object_defaults();  // made by render::make_object
@@ -41,6 +42,7 @@ struct CompositeJob {
   int median_cut = 0;         // > 0: the baseline of this many median-cut lights (cut after the match)
   Match match = Match::Auto;  // the light put in the photograph's units (match.h)
   double saturated = 0;       // linear value at which the photograph saturates (0: never), left out of the match
+  PixelRect grey_card;        // Match::GreyCard: the card's pixels in the photograph
   Backend backend = Backend::Cpu;
   CompositeDesc desc;  // sampling, seed, shadows, the GL options, progress
 };
