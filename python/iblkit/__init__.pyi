@@ -154,6 +154,9 @@ class Camera:
     def save(self, path: str) -> None: ...
     @staticmethod
     def load(path: str) -> Camera: ...
+    intrinsics: Optional[Tuple[float, float, float, float]]
+    distortion: Tuple[float, float, float, float, float]
+    def project(self, point: ArrayLike) -> Optional[Tuple[float, float]]: ...
 
 # ---- fusion -------------------------------------------------------------------------------------
 class ProbeSet:

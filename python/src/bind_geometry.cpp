@@ -196,6 +196,47 @@ row 0 at the top.)doc")
       .def_readwrite("fov_y_deg", &Camera::fov_y_deg, "Vertical field of view, degrees.")
       .def_readwrite("width", &Camera::width, "Frame width, pixels.")
       .def_readwrite("height", &Camera::height, "Frame height, pixels.")
+      .def_property(
+          "intrinsics",
+          [](const Camera& c) -> py::object {
+            if (!c.intrinsics) return py::none();
+            return py::make_tuple(c.intrinsics->fx, c.intrinsics->fy, c.intrinsics->cx, c.intrinsics->cy);
+          },
+          [](Camera& c, py::object v) {
+            if (v.is_none()) {
+              c.intrinsics.reset();
+              return;
+            }
+            auto t = v.cast<std::vector<double>>();
+            if (t.size() != 4) throw py::value_error("Camera.intrinsics: (fx, fy, cx, cy) in pixels, or None");
+            c.intrinsics = ibl::geometry::Intrinsics{t[0], t[1], t[2], t[3]};
+            ibl::geometry::require_lens(c, "Camera.intrinsics");
+          },
+          "(fx, fy, cx, cy) in pixels (continuous coordinates: pixel i's centre at i + ½), or None: the pinhole of "
+          "fov_y_deg with the principal point at the centre (docs/conventions.md, Camera).")
+      .def_property(
+          "distortion",
+          [](const Camera& c) {
+            const auto& d = c.distortion;
+            return py::make_tuple(d.k1, d.k2, d.p1, d.p2, d.k3);
+          },
+          [](Camera& c, py::handle v) {
+            auto t = v.cast<std::vector<double>>();
+            if (t.size() != 5) throw py::value_error("Camera.distortion: (k1, k2, p1, p2, k3), OpenCV's model");
+            c.distortion = ibl::geometry::Distortion{t[0], t[1], t[2], t[3], t[4]};
+            ibl::geometry::require_lens(c, "Camera.distortion");
+          },
+          "Brown–Conrady (k1, k2, p1, p2, k3) with OpenCV's signs; needs intrinsics.")
+      .def(
+          "project",
+          [](const Camera& c, py::handle point) -> py::object {
+            ibl::geometry::require_camera(c);
+            const auto p = c.project(to_vec3(point, "Camera.project: point"));
+            if (!p) return py::none();
+            return py::make_tuple(p->x, p->y);
+          },
+          py::arg("point"),
+          "The continuous pixel position (x, y) where a world point appears, through the lens; None behind the eye.")
       .def(
           "ray_directions",
           [](const Camera& c) {

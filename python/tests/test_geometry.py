@@ -166,3 +166,36 @@ def test_photograph_and_composite_match_cli(tmp_path, probe_set, scene):
     assert np.array_equal(g1.composite, iblkit.read_image(str(tmp_path / "g.exr"))[..., :3])
     with pytest.raises(iblkit.Error, match="expected cpu, gl or auto"):
         iblkit.composite(photo, cam, obj, probes=str(probe_set), backend="vulkan")
+
+
+def test_camera_lens_round_trip_and_opencv():
+    cam = iblkit.Camera(eye=(0.2, 1.1, 2.0), target=(0, 0.4, 0), width=64, height=48)
+    assert cam.intrinsics is None and cam.distortion == (0, 0, 0, 0, 0)
+    cam.intrinsics = (60.0, 61.0, 32.5, 23.5)
+    cam.distortion = (-0.3, 0.1, 0.001, -0.002, 0.0)
+    d = cam.ray_directions()
+    eye = np.array(cam.eye)
+    for (y, x) in [(0, 0), (10, 50), (47, 63), (24, 32)]:
+        px = cam.project(tuple(eye + 2.0 * d[y, x]))
+        assert abs(px[0] - (x + 0.5)) < 1e-6 and abs(px[1] - (y + 0.5)) < 1e-6
+    assert cam.project(tuple(eye - 2.0 * d[5, 5])) is None  # behind the eye
+    with pytest.raises(ValueError):
+        cam.distortion = (1, 2)
+    try:
+        import cv2
+    except ImportError:
+        pytest.skip("python3-opencv not installed: the OpenCV comparison skipped")
+    # OpenCV's projectPoints on the same lens and pose: pixels = OpenCV's + 0.5 (docs/conventions.md).
+    f = np.array(cam.target) - eye
+    f /= np.linalg.norm(f)
+    r = np.cross(f, cam.up)
+    r /= np.linalg.norm(r)
+    u = np.cross(r, f)
+    R = np.stack([r, -u, f])  # world -> OpenCV camera axes (x right, y down, z forward)
+    K = np.array([[60.0, 0, 32.0], [0, 61.0, 23.0], [0, 0, 1]])
+    rvec, _ = cv2.Rodrigues(R)
+    pts = np.array([[0.3, 0.2, -0.4], [-0.5, 0.8, 0.1]])
+    proj, _ = cv2.projectPoints(pts, rvec, -R @ eye, K, np.array(cam.distortion))
+    for p, q in zip(pts, proj.reshape(-1, 2)):
+        ours = cam.project(tuple(p))
+        assert abs(ours[0] - (q[0] + 0.5)) < 1e-6 and abs(ours[1] - (q[1] + 0.5)) < 1e-6
