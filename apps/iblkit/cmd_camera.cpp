@@ -206,7 +206,10 @@ void run_calibrate(const CalibrateOpts& o) {
                       {"photographs", o.photos.size()},
                       {"intrinsics", lens_json(c.camera)},
                       {"reprojection_rms_px", c.rms_px},
-                      {"per_photograph_rms_px", c.per_view_rms_px}};
+                      {"per_photograph_rms_px", c.per_view_rms_px},
+                      {"std_dev", c.std_dev},
+                      {"warnings", c.warnings}};
+  for (const auto& w : c.warnings) iblcli::info("warning: " + w);
   iblcli::emit(j, [&] {
     fmt::print("calibrated {} photographs of a {}x{} board\n", o.photos.size(), board.cols, board.rows);
     print_camera(c.camera);

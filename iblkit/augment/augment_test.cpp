@@ -417,6 +417,13 @@ TEST(AugmentOverlay, TheProxysOutlineIsDrawnWhereTheCameraSeesItAndItsDiagonalsA
   EXPECT_FALSE(lit(0.2, 0.2));    // on its diagonal (x = z): not a feature edge
   EXPECT_FALSE(lit(0.25, -0.1));  // inside
   EXPECT_THROW(proxy_overlay(Image(3, 3, 3), top_camera(), tile), Error);
+  // Through a strong lens, edges far outside the frame project where the polynomial folds back (10⁶ px away):
+  // they are not drawn (drawing them once took minutes) and what is in the frame still is.
+  geometry::Camera lens = top_camera();
+  lens.intrinsics = geometry::Intrinsics{40, 40, kW / 2.0, kH / 2.0};
+  lens.distortion = {-0.45, 0.1, 0, 0, 0};
+  const Image wide = proxy_overlay(black, lens, geometry::make_box({-50, -1, -50}, {50, 0.01, 50}));
+  EXPECT_EQ(wide.width(), kW);
 }
 
 TEST(AugmentMeasure, PerfectCompositeHasNoErrorAndShadowErrorIsRelative) {

@@ -59,15 +59,20 @@ Image proxy_overlay(const Image& picture, const geometry::Camera& cam, const geo
     if (!feature) continue;
     const Vec3 a = welded[static_cast<size_t>(e.first)], b = welded[static_cast<size_t>(e.second)];
     const auto pa = cam.project(a), pb = cam.project(b);
-    // About one sample per pixel of the projected edge (a part behind the eye: 256 samples).
-    const double px_len = pa && pb ? std::hypot(pb->x - pa->x, pb->y - pa->y) : 256.0;
+    // About one sample per pixel of the projected edge (a part behind the eye, or off the frame: 1024 samples).
+    const bool in_frame = pa && pb && std::abs(pa->x) < 4 * cam.width && std::abs(pb->x) < 4 * cam.width &&
+                          std::abs(pa->y) < 4 * cam.height && std::abs(pb->y) < 4 * cam.height;
+    const double px_len = in_frame ? std::hypot(pb->x - pa->x, pb->y - pa->y) : 1024.0;
     const int n = std::clamp(static_cast<int>(std::ceil(px_len)), 1, 4096);
     std::optional<Vec2> prev;
     for (int i = 0; i <= n; ++i) {
       const Vec3 q = a + (b - a) * (static_cast<double>(i) / n);
-      const auto p = cam.project(q);
+      auto p = cam.project(q);
+      // Only inside the frame: beyond it a strong lens's polynomial folds back and throws points far away.
+      if (p && !(p->x > -2 && p->x < cam.width + 2 && p->y > -2 && p->y < cam.height + 2)) p.reset();
       const bool seen = p && visible(q);
-      if (seen && prev) ibl::io::draw_line(out, prev->x, prev->y, p->x, p->y, rgb, 1.5);
+      if (seen && prev && std::hypot(p->x - prev->x, p->y - prev->y) < 8)  // samples ~1 px apart; a jump: a fold
+        ibl::io::draw_line(out, prev->x, prev->y, p->x, p->y, rgb, 1.5);
       prev = seen ? p : std::nullopt;
     }
   }

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include <fmt/format.h>
 #include <Eigen/Dense>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
@@ -249,6 +250,7 @@ Calibrated cv_calibrate(const std::vector<std::vector<Correspondence>>& views, i
     c.rms_px = cv::calibrateCamera(obj, img, cv::Size(width, height), k, d, rvecs, tvecs, sd_in, sd_ex, per, 0,
                                    cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 200, 1e-12));
     for (int i = 0; i < per.rows; ++i) c.per_view_rms_px.push_back(per.at<double>(i));
+    for (int i = 0; i < std::min(9, sd_in.rows); ++i) c.std_dev[static_cast<size_t>(i)] = sd_in.at<double>(i);
   } catch (const cv::Exception& e) {
     fail(ErrorKind::Value, "camera calibrate: OpenCV: {}", e.what());
   }
@@ -259,6 +261,20 @@ Calibrated cv_calibrate(const std::vector<std::vector<Correspondence>>& views, i
       geometry::Intrinsics{k.at<double>(0, 0), k.at<double>(1, 1), k.at<double>(0, 2) + 0.5, k.at<double>(1, 2) + 0.5};
   lens.distortion = {d.at<double>(0), d.at<double>(1), d.at<double>(2), d.at<double>(3), d.at<double>(4)};
   lens.fov_y_deg = 2 * std::atan(height / (2 * lens.intrinsics->fy)) * 180 / kPi;
+  {  // Parameters the photographs leave loose (calibrateCamera's own standard deviations).
+    static const char* names[9] = {"fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2", "k3"};
+    const double value[9] = {k.at<double>(0, 0),       k.at<double>(1, 1), k.at<double>(0, 2) + 0.5,
+                             k.at<double>(1, 2) + 0.5, d.at<double>(0),    d.at<double>(1),
+                             d.at<double>(2),          d.at<double>(3),    d.at<double>(4)};
+    const double f = k.at<double>(0, 0);
+    const double limit[9] = {0.01 * f, 0.01 * f, 0.01 * f, 0.01 * f, 0.05, 0.05, 0.005, 0.005, 0.05};
+    for (int i = 0; i < 9; ++i)
+      if (c.std_dev[static_cast<size_t>(i)] > limit[i])
+        c.warnings.push_back(
+            fmt::format("{} = {:.4g} ± {:.3g}: the photographs do not pin it down (tilt the board, "
+                        "fill the corners of the frame, or take more photographs)",
+                        names[i], value[i], c.std_dev[static_cast<size_t>(i)]));
+  }
   // The first view's pose, back in world coordinates: X_cam = R B (X − c) + t.
   cv::Mat rm;
   cv::Rodrigues(rvecs[0], rm);

@@ -5,6 +5,7 @@
 // capture/camera_cv.cpp), loaded the first time one of these needs it. Everything else here (files,
 // boards, checks, the reprojection error, which is measured with geometry::Camera::project) is OpenCV-free.
 #pragma once
+#include <array>
 #include <optional>
 #include <string>
 #include <vector>
@@ -87,6 +88,12 @@ struct Calibrated {
   geometry::Camera camera;  // intrinsics and distortion; the pose of the first photograph's board
   double rms_px = 0;        // calibrateCamera's RMS reprojection error over all photographs
   std::vector<double> per_view_rms_px;
+  // calibrateCamera's standard deviations of fx, fy, cx, cy, k1, k2, p1, p2, k3: how well the photographs pin
+  // the lens down (views alike, or the board always in the middle, leave the distortion free to wander).
+  std::array<double, 9> std_dev{};
+  // What the standard deviations say, in words: "k2 = −6.2 ± 3.1 (the photographs do not constrain it) …";
+  // empty when every parameter is known to 1 % of the focal length, 0.05 in k1/k2/k3 and 0.005 in p1/p2.
+  std::vector<std::string> warnings;
 };
 // A lens (fx, fy, cx, cy, k1 k2 p1 p2 k3) from the board's corners in several photographs of one size
 // (each a list from find_board); at least 3.
