@@ -136,6 +136,25 @@ ibl::Vec3 parse_vec3(const std::string& s, const std::string& what) {
   return v;
 }
 
+std::vector<double> parse_double_list(const std::string& s, const std::string& what) {
+  std::vector<double> v;
+  std::stringstream ss(s);
+  std::string part;
+  while (std::getline(ss, part, ',')) {
+    size_t used = 0;
+    double x = 0;
+    try {
+      x = std::stod(part, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != part.size() || !std::isfinite(x))
+      ibl::fail(ibl::ErrorKind::Value, "{}: \"{}\" is not a list of numbers", what, s);
+    v.push_back(x);
+  }
+  return v;
+}
+
 std::vector<int> parse_int_list(const std::string& s, const std::string& what) {
   std::vector<int> out;
   std::stringstream ss(s);

@@ -92,6 +92,8 @@ void info(const std::string& msg);
 // Parsers for option values.
 ibl::Vec3 parse_vec3(const std::string& s, const std::string& what);             // "x,y,z"
 std::vector<int> parse_int_list(const std::string& s, const std::string& what);  // "1,2,4"
+// "0.5,90,1e-3": finite numbers separated by commas (an empty string gives none).
+std::vector<double> parse_double_list(const std::string& s, const std::string& what);
 // Adds --mapping, --dead-angle, --sanitize to an app and returns the read settings they fill.
 ibl::io::EnvReadDesc& add_probe_read_options(CLI::App& app);
 

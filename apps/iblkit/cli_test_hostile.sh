@@ -122,10 +122,15 @@ check shgrid-trailing-setup ok "" -- cp "$T/g.shgrid" "$T/g2.shgrid"
 printf 'junk' >> "$T/g2.shgrid"
 check shgrid-trailing fail "bytes after the data" -- "$BIN" ilf info "$T/g2.shgrid"
 
-# §6: an allocation that fails names what and which option to lower.
+# §6: an allocation that fails names what and which option to lower. AddressSanitizer reserves terabytes of
+# address space at start-up, so under `make test-sanitize` no address-space limit can be set: skipped there.
+if ldd "$BIN" 2>/dev/null | grep -q libasan; then
+  echo "skip out-of-memory: an AddressSanitizer build cannot run under ulimit -v"
+else
 out=$(bash -c 'ulimit -v 2000000; exec "$0" convert "$1" "$2" --mapping latlong --size 16384' "$BIN" "$PROBE" "$T/big.exr" 2>&1); rc=$?
 if [ $rc -ne 0 ] && [ $rc -lt 128 ] && [ "$(wc -l <<<"$out")" = 1 ] && grep -q "out of memory" <<<"$out" && grep -q -- "--size 16384" <<<"$out"; then
   pass=$((pass+1)); else echo "FAIL out-of-memory: exit $rc: $out"; fail=$((fail+1)); fi
+fi
 # Progress in a log (stderr not a terminal): a line every few seconds (IBLKIT_PROGRESS_EVERY shortens it).
 out=$(IBLKIT_PROGRESS_EVERY=0.01 "$BIN" convert "$PROBE" "$T/p2.exr" --mapping mirrorball --size 512 2>&1 >/dev/null)
 grep -q "^iblkit: resample [0-9]*% " <<<"$out" && pass=$((pass+1)) || { echo "FAIL progress in a log: $out"; fail=$((fail+1)); }

@@ -1,6 +1,7 @@
 // iblkit camera solve | calibrate | check: the camera of a photograph (docs/camera.md). Parses and calls
 // capture/camera_solve.h; OpenCV sits in the cv plugin, loaded by the library when a solve needs it.
 #include <cmath>
+#include <optional>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -12,6 +13,7 @@
 #include "iblkit/core/json_file.h"
 #include "iblkit/geometry/camera_io.h"
 #include "iblkit/io/image_io.h"
+#include "iblkit/io/photo.h"
 
 namespace {
 
@@ -103,6 +105,7 @@ struct SolveOpts {
   BoardOpts board;
   double fov = 0;
   double max_error = 5;
+  bool no_exif = false;
 };
 
 void run_solve(const SolveOpts& o) {
@@ -115,9 +118,27 @@ void run_solve(const SolveOpts& o) {
   lens.width = spec.width;
   lens.height = spec.height;
   ibl::capture::LensMode mode = ibl::capture::LensMode::SolveFocal;
+  // The photograph's Exif focal length: the lens when nothing else gives one, and a check of --fov.
+  std::optional<ibl::capture::ExifLens> exif;
+  if (!o.no_exif && o.intrinsics.empty()) {
+    try {
+      exif = ibl::capture::lens_from_exif(ibl::io::read_photo(o.photo).meta, spec.width, spec.height);
+    } catch (const ibl::Error& e) {
+      if (e.kind() != ErrorKind::Format) throw;  // a float image: no Exif to read
+    }
+  }
+  std::string lens_source = "focal length solved";
   if (o.fov != 0) {
     lens.fov_y_deg = ibl::require_number("--fov", o.fov, 1e-3, 179);
+    if (exif && std::abs(exif->fov_y_deg - lens.fov_y_deg) > 1)
+      fail(ErrorKind::Value, "--fov {}: {}'s {} gives {:.2f}°; drop --fov, or give --no-exif to overrule the file",
+           o.fov, o.photo, exif->source, exif->fov_y_deg);
     mode = ibl::capture::LensMode::Fixed;
+    lens_source = "--fov";
+  } else if (exif) {
+    lens.fov_y_deg = exif->fov_y_deg;
+    mode = ibl::capture::LensMode::Fixed;
+    lens_source = exif->source;
   } else if (!o.intrinsics.empty()) {
     Camera k = ibl::geometry::read_camera(o.intrinsics);
     if (!k.intrinsics) fail(ErrorKind::Value, "--intrinsics {}: the file has no \"intrinsics\"", o.intrinsics);
@@ -128,6 +149,7 @@ void run_solve(const SolveOpts& o) {
     lens.distortion = k.distortion;
     lens.fov_y_deg = k.fov_y_deg;
     mode = ibl::capture::LensMode::Fixed;
+    lens_source = "--intrinsics " + o.intrinsics;
   }
   std::vector<Correspondence> pts;
   Board board;
@@ -165,6 +187,7 @@ void run_solve(const SolveOpts& o) {
                       {"points", pts.size()},
                       {"coplanar", s.coplanar},
                       {"lens", mode == ibl::capture::LensMode::Fixed ? "fixed" : "focal solved"},
+                      {"lens_source", lens_source},
                       {"eye", vec(s.camera.eye)},
                       {"target", vec(s.camera.target)},
                       {"up", vec(s.camera.up)},
@@ -174,7 +197,7 @@ void run_solve(const SolveOpts& o) {
   iblcli::emit(j, [&] {
     fmt::print("solved    {} {} points{} ({}), lens {}\n", pts.size(), o.points.empty() ? "board" : "user",
                s.coplanar ? ", coplanar" : "", s.coplanar ? "IPPE" : "EPnP + iterative",
-               mode == ibl::capture::LensMode::Fixed ? "fixed" : "focal length solved");
+               mode == ibl::capture::LensMode::Fixed ? "fixed (" + lens_source + ")" : lens_source);
     print_camera(s.camera);
     fmt::print("reprojection error {:.4g} px RMS, {:.4g} px max\n", s.error.rms_px, s.error.max_px);
     fmt::print("wrote     {}\n", o.out);
@@ -273,13 +296,17 @@ void setup(CLI::App& app) {
   s->add_option("--points", so->points, "iblkit.points/1: at least 6 pixel ↔ world pairs (docs/formats.md)");
   add_board_options(s, so->board, false);
   s->add_option("--fov", so->fov, "fix the lens: an undistorted pinhole of this vertical field of view (degrees)");
+  s->add_flag("--no-exif", so->no_exif,
+              "do not take the lens from the photograph's Exif (FocalLength with the focal plane's resolution, or "
+              "FocalLengthIn35mmFilm)");
   s->add_option("--intrinsics", so->intrinsics,
                 "fix the lens: an iblkit.camera/1 file with intrinsics and distortion (camera calibrate's)");
   s->add_option("--max-error", so->max_error, "refuse a solve whose RMS reprojection error exceeds this (px)")
       ->capture_default_str();
   s->add_option("-o,--out", so->out, "the camera file to write (iblkit.camera/1)")->required();
   s->footer(
-      "Without --fov or --intrinsics one focal length is solved with the pose (centred principal point, no "
+      "Without --fov, --intrinsics or an Exif focal length one focal length is solved with the pose (centred principal "
+      "point, no "
       "distortion).\nExamples:\n  iblkit camera solve photo.jpg --points pts.json --fov 40 --out cam.json\n"
       "  iblkit camera solve photo.jpg --board checker:9x6:0.05 --board-origin 0,0,0 --board-axes 1,0,0,0,0,-1 "
       "--intrinsics lens.json --out cam.json");

@@ -16,6 +16,7 @@
 #include "cli.h"
 #include "iblkit/capture/ball.h"
 #include "iblkit/capture/merge.h"
+#include "iblkit/capture/probe_eval.h"
 #include "iblkit/core/atomic_file.h"
 #include "iblkit/core/parallel.h"
 #include "iblkit/io/draw.h"
@@ -40,27 +41,6 @@ constexpr double kEvStep = 2;  // stops between them
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
-// Irradiance at each normal from a lat-long map (RGBA: alpha weights the texel).
-std::vector<Vec3> irradiance(const ibl::sphere::EnvMap& map, const std::vector<Vec3>& normals) {
-  std::vector<Vec3> dirs, vals;
-  for (int y = 0; y < map.image.height(); ++y)
-    for (int x = 0; x < map.image.width(); ++x) {
-      Vec3 d;
-      const double s = map.mapping.solid_angle(x, y);
-      if (s <= 0 || !map.mapping.to_direction(x + 0.5, y + 0.5, &d)) continue;
-      const double a = map.image.channels() > 3 ? map.image.at(x, y, 3) : 1.0;
-      dirs.push_back(d);
-      vals.push_back(map.image.rgb(x, y) * (a * s));
-    }
-  std::vector<Vec3> e(normals.size());
-  ibl::parallel_for(0, static_cast<int64_t>(normals.size()), [&](int64_t i) {
-    Vec3 sum;
-    for (size_t p = 0; p < dirs.size(); ++p) sum += vals[p] * std::max(0.0, dot(normals[i], dirs[p]));
-    e[i] = sum;
-  });
-  return e;
 }
 
 // The recovered curve (green) over the true one (grey), exposure on a log axis against code value.
@@ -168,11 +148,8 @@ void capture_step(iblcli::DemoContext& ctx) {
   const ibl::lab::Truth truth = ibl::lab::ground_truth(truth_scene, sd.ball_center, td);
   ibl::io::write_image((dir / "truth.exr").string(), truth.radiance.image);
   const auto normals = ibl::sphere::fibonacci_sphere(20480);
-  const auto e_probe = irradiance(probe.probe, normals), e_truth = irradiance(truth.radiance, normals);
-  double err = 0;
-  for (size_t i = 0; i < normals.size(); ++i)
-    err += std::abs(ibl::luminance(e_probe[i]) - ibl::luminance(e_truth[i])) / ibl::luminance(e_truth[i]);
-  err /= static_cast<double>(normals.size());
+  const double err = ibl::capture::mean_relative_luminance_error(
+      ibl::capture::probe_irradiance(probe.probe, normals), ibl::capture::probe_irradiance(truth.radiance, normals));
 
   // Pictures: view 0's bracket, the curve, the two balls, the weights, the probe beside the truth.
   pictures.push_back({"recovered curve (green) / sRGB (grey)", curve_picture(bd.sensor.response, recovered)});

@@ -9,6 +9,7 @@
 #include <fmt/ranges.h>
 
 #include "cli.h"
+#include "iblkit/augment/capture_chain.h"
 #include "iblkit/augment/composite.h"
 #include "iblkit/augment/measure.h"
 #include "iblkit/augment/overlay.h"
@@ -16,6 +17,8 @@
 #include "iblkit/capture/backplate.h"
 #include "iblkit/core/atomic_file.h"
 #include "iblkit/core/error.h"
+#include "iblkit/geometry/camera_io.h"
+#include "iblkit/geometry/mesh_io.h"
 #include "iblkit/io/image_io.h"
 #include "iblkit/io/tonemap.h"
 #include "render_setup.h"
@@ -27,8 +30,9 @@ using ibl::Vec3;
 
 struct Opts {
   std::string photo, probe_depth, object, at, albedo = "0.7,0.7,0.7", out = "composite.exr", layers, backend = "cpu",
-                                              response, match = "auto", grey_card;
+                                              response, match = "auto", grey_card, capture;
   int quality = 0;
+  bool recover_response = false;
   iblcli::PhotoSceneOptions scene;
   std::vector<std::string> light, truth;
   std::string lobe = "phong", texture;
@@ -44,6 +48,19 @@ struct Opts {
 void write_layer(const fs::path& dir, const std::string& name, const ibl::Image& img) {
   ibl::io::write_image((dir / (name + ".exr")).string(), img);
 }
+
+nlohmann::json errors_json(const ibl::augment::CompositeErrors& e) {
+  return {{"object", e.object},
+          {"shadow", e.shadow},
+          {"unchanged", e.unchanged},
+          {"object_pixels", e.object_pixels},
+          {"shadow_pixels", e.shadow_pixels},
+          {"unchanged_pixels", e.unchanged_pixels},
+          {"brightened_pixels", e.brightened_pixels},
+          {"shadow_signal", e.shadow_signal}};
+}
+
+nlohmann::json vec_json(Vec3 v) { return nlohmann::json::array({v.x, v.y, v.z}); }
 
 void run(const Opts& o, const ibl::io::EnvReadDesc& read) {
   if (o.light.size() > 1) ibl::fail(ibl::ErrorKind::Value, "--light: give one light file");
@@ -146,14 +163,7 @@ void run(const Opts& o, const ibl::io::EnvReadDesc& read) {
     e = te.errors;
     noise = te.noise;
     if (!o.layers.empty()) write_layer(o.layers, "truth_error", ibl::augment::error_picture(r.composite, te.mean));
-    j["errors"] = {{"object", e.object},
-                   {"shadow", e.shadow},
-                   {"unchanged", e.unchanged},
-                   {"object_pixels", e.object_pixels},
-                   {"shadow_pixels", e.shadow_pixels},
-                   {"unchanged_pixels", e.unchanged_pixels},
-                   {"brightened_pixels", e.brightened_pixels},
-                   {"shadow_signal", e.shadow_signal}};
+    j["errors"] = errors_json(e);
     if (o.truth.size() > 1)
       j["truth_noise"] = {{"object", noise.object},
                           {"shadow", noise.shadow},
@@ -181,11 +191,146 @@ void run(const Opts& o, const ibl::io::EnvReadDesc& read) {
   });
 }
 
+// composite --capture DIR: the chain from a capture folder (augment/capture_chain.h), and with the lab's truth in
+// the folder, its errors.
+void run_capture(const Opts& o) {
+  ibl::augment::ChainDesc cd;
+  cd.job = o.job;
+  cd.job.backend = ibl::augment::parse_backend(o.backend);
+  cd.job.match = o.match == "off" ? ibl::augment::Match::Off : ibl::augment::Match::Auto;
+  if (o.match == "grey-card" || !o.grey_card.empty())
+    ibl::fail(ibl::ErrorKind::Value, "--capture: the match is from the proxy (--match auto) or off");
+  cd.job.material = iblcli::object_material(o.albedo, o.gloss, o.exponent, o.lobe, o.texture);
+  cd.job.desc.progress = iblcli::progress_bar();
+  cd.recover_response = o.recover_response;
+  const ibl::capture::CaptureFolder folder = ibl::capture::read_capture(o.capture);
+  const ibl::augment::ChainResult c = ibl::augment::run_capture(folder, cd);
+  iblcli::progress_done();
+  for (const auto& n : c.run.notes) iblcli::info(n);
+  for (const auto& w : c.run.result.warnings) iblcli::info("warning: " + w);
+  const ibl::augment::CompositeResult& r = c.run.result;
+  const ibl::geometry::Camera& cam = c.camera.camera;
+  const bool photo_out = c.plate.encoded && ibl::capture::is_photo_extension(o.out);
+  if (photo_out)
+    ibl::capture::write_like(o.out, c.plate, c.codes, 0, o.quality);
+  else
+    ibl::io::write_image(o.out, r.composite);
+  if (!o.layers.empty()) {
+    ibl::make_output_folders(fs::path(o.layers).string());
+    fs::path dir(o.layers);
+    ibl::io::write_image((dir / "probe.exr").string(), c.probe.probe.image);
+    ibl::io::write_image((dir / "probe.png").string(), ibl::io::tonemap(c.probe.probe.image.with_channels(3)));
+    ibl::io::write_image((dir / "probe_weights.exr").string(), c.probe.weights);
+    // What another renderer needs to do the same composite: the light in the photograph's units (the match's gains
+    // applied), the object's mesh, the proxy, the solved camera.
+    ibl::io::write_image((dir / "probe_matched.exr").string(), c.light.map.image);
+    ibl::geometry::write_obj((dir / "object.obj").string(), c.object, "composite --capture: the inserted object");
+    ibl::geometry::write_obj((dir / "proxy.obj").string(), c.run.proxy, "composite --capture: the proxy");
+    ibl::geometry::write_camera((dir / "camera.json").string(), cam, true);
+    write_layer(dir, "mask", r.mask);
+    write_layer(dir, "difference", r.difference);
+    ibl::io::write_image((dir / "proxy_overlay.png").string(),
+                         ibl::augment::proxy_overlay(ibl::io::tonemap(c.plate.linear), cam, c.run.proxy));
+  }
+  nlohmann::json merges = nlohmann::json::array();
+  for (size_t k = 0; k < c.merges.size(); ++k)
+    merges.push_back({{"dynamic_range_stops", c.merges[k].dynamic_range_stops},
+                      {"saturated_everywhere", c.merges[k].saturated_everywhere},
+                      {"ball", {c.circles[k].cx, c.circles[k].cy, c.circles[k].r}},
+                      {"circle_residual_px", c.circle_residual_px[k]}});
+  nlohmann::json j = {{"out", o.out},
+                      {"capture", o.capture},
+                      {"response", c.response_source},
+                      {"views", merges},
+                      {"probe_invalid_pixels", c.probe.invalid_pixels},
+                      {"camera",
+                       {{"eye", vec_json(cam.eye)},
+                        {"target", vec_json(cam.target)},
+                        {"fov_y_deg", cam.fov_y_deg},
+                        {"lens", c.lens_source},
+                        {"board_corners", c.board_corners},
+                        {"reprojection_rms_px", c.camera.error.rms_px},
+                        {"reprojection_max_px", c.camera.error.max_px}}},
+                      {"backend", ibl::augment::backend_name(c.run.backend)},
+                      {"seconds", r.stats.seconds},
+                      {"object_pixels", r.stats.object_pixels},
+                      {"changed_pixels", r.stats.changed_pixels},
+                      {"kept_pixels", c.report.kept},
+                      {"encoded_pixels", c.report.encoded},
+                      {"saturated_darkened", c.report.saturated_darkened},
+                      {"warnings", r.warnings}};
+  if (c.run.match.points > 0)
+    j["match"] = {{"gain", vec_json(c.run.match.gain)},
+                  {"stops", std::log2(ibl::luminance(c.run.match.gain))},
+                  {"points", c.run.match.points},
+                  {"spread_stops", c.run.match.spread},
+                  {"applied", c.run.matched}};
+  // The lab's answers: the composite as written, in linear light, against the truth photographed through the same
+  // camera; the camera against the exact one.
+  ibl::augment::CompositeErrors e;
+  double eye_mm = 0, view_deg = 0;
+  const bool truth = !folder.truth.empty();
+  if (truth) {
+    const ibl::capture::Backplate t = ibl::capture::read_backplate(folder.at(folder.truth), c.plate.response);
+    ibl::Image comp = photo_out ? ibl::capture::read_backplate(o.out, c.plate.response).linear : r.composite;
+    ibl::Image mask = folder.truth_mask.empty() ? r.mask : ibl::io::read_image(folder.at(folder.truth_mask));
+    if (mask.channels() > 1) mask = mask.with_channels(1);
+    e = ibl::augment::measure(c.plate.linear, comp, t.linear, mask);
+    j["errors"] = errors_json(e);
+    if (!folder.truth_camera.empty()) {
+      const ibl::geometry::Camera tc = ibl::geometry::read_camera(folder.at(folder.truth_camera));
+      eye_mm = 1000 * ibl::length(cam.eye - tc.eye);
+      const double cosv = ibl::dot(ibl::normalize(cam.target - cam.eye), ibl::normalize(tc.target - tc.eye));
+      view_deg = std::acos(std::clamp(cosv, -1.0, 1.0)) * 180 / ibl::kPi;
+      j["camera"]["eye_error_mm"] = eye_mm;
+      j["camera"]["view_error_deg"] = view_deg;
+      j["camera"]["fov_error_deg"] = cam.fov_y_deg - tc.fov_y_deg;
+    }
+    if (!o.layers.empty()) write_layer(o.layers, "truth_error", ibl::augment::error_picture(comp, t.linear));
+  }
+  iblcli::emit(j, [&] {
+    fmt::print("composited the {} into {} ({}x{}) from {} in {:.2f} s: {}\n", folder.object,
+               folder.at(folder.backplate), cam.width, cam.height, o.capture, r.stats.seconds, o.out);
+    fmt::print("  response  {}\n", c.response_source);
+    for (size_t k = 0; k < c.merges.size(); ++k)
+      fmt::print("  view {}    {} frames, {:.1f} stops, ball {:.1f},{:.1f} r {:.1f} px{}\n", k,
+                 folder.views[k].frames.size(), c.merges[k].dynamic_range_stops, c.circles[k].cx, c.circles[k].cy,
+                 c.circles[k].r,
+                 c.circle_residual_px[k] > 0 ? fmt::format(" (fit residual {:.2f} px)", c.circle_residual_px[k])
+                                             : std::string());
+    fmt::print(
+        "  camera    eye {:.4f},{:.4f},{:.4f}, fov_y {:.3f}° ({}); {} board corners, reprojection {:.3f} px RMS\n",
+        cam.eye.x, cam.eye.y, cam.eye.z, cam.fov_y_deg, c.lens_source, c.board_corners, c.camera.error.rms_px);
+    if (c.run.match.points > 0)
+      fmt::print("  match     gain {:.4g},{:.4g},{:.4g} ({:+.2f} stops) from {} proxy points{}\n", c.run.match.gain.x,
+                 c.run.match.gain.y, c.run.match.gain.z, std::log2(ibl::luminance(c.run.match.gain)),
+                 c.run.match.points, c.run.matched ? "" : " (not applied)");
+    fmt::print("  {} object pixels, {} changed by its shadow and light, {} kept as photographed\n",
+               r.stats.object_pixels, r.stats.changed_pixels, c.report.kept);
+    if (truth) {
+      fmt::print(
+          "  against {}: object {:.1f} % ({} px), shadow {:.1f} % of the shadow signal ({} px, {:.0f} % darker), "
+          "unchanged {:.2f} %\n",
+          folder.truth, 100 * e.object, e.object_pixels, 100 * e.shadow, e.shadow_pixels, 100 * e.shadow_signal,
+          100 * e.unchanged);
+      if (!folder.truth_camera.empty())
+        fmt::print("  camera against {}: eye {:.2f} mm, view {:.3f}°\n", folder.truth_camera, eye_mm, view_deg);
+    }
+  });
+}
+
 void setup(CLI::App& app) {
   auto* o = iblcli::app_owned<Opts>();
-  app.add_option("photo", o->photo,
-                 "the background photograph: HDR (linear), or 8-bit JPEG/PNG, 16-bit TIFF/PNG code values (--response)")
-      ->required();
+  app.add_option(
+      "photo", o->photo,
+      "the background photograph: HDR (linear), or 8-bit JPEG/PNG, 16-bit TIFF/PNG code values (--response)");
+  app.add_option("--capture", o->capture,
+                 "a capture folder (iblkit.capture/1: backplate, the ball's brackets, the board, the proxy; `lab shoot "
+                 "--backplate` writes one): merge, probe from the ball, camera from the board, composite, in one go");
+  app.add_flag(
+      "--recover-response", o->recover_response,
+      "--capture: recover the curve from the ball's first bracket (Debevec & Malik) even where the folder names "
+      "one");
   app.add_option("--response", o->response,
                  "how the photograph's code values become linear: srgb (the default for 8/16-bit files), linear (the "
                  "default for float files), camera, or an iblkit.response/1 file (docs/formats.md)");
@@ -293,7 +438,16 @@ void setup(CLI::App& app) {
       "0,0.2,0\n"
       "  iblkit composite photo.exr --camera cam.json --light probe.exr --at-probe 0,0.5,0 --proxy floor.obj --at "
       "0,0.2,0");
-  app.callback([o, &rd] { run(*o, rd); });
+  app.callback([o, &rd] {
+    if (!o->capture.empty()) {
+      if (!o->photo.empty())
+        ibl::fail(ibl::ErrorKind::Value, "composite: give a photograph or --capture DIR, not both");
+      run_capture(*o);
+      return;
+    }
+    if (o->photo.empty()) ibl::fail(ibl::ErrorKind::Value, "composite: give the photograph (or --capture DIR)");
+    run(*o, rd);
+  });
 }
 
 iblcli::Command reg("composite", setup);

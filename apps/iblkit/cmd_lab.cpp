@@ -10,16 +10,21 @@
 #include <fmt/format.h>
 
 #include "cli.h"
+#include "iblkit/capture/camera_solve.h"
+#include "iblkit/capture/folder.h"
 #include "iblkit/capture/response.h"
 #include "iblkit/capture/sensor.h"
 #include "iblkit/core/atomic_file.h"
+#include "iblkit/core/check.h"
 #include "iblkit/core/error.h"
 #include "iblkit/core/json_file.h"
 #include "iblkit/geometry/camera_io.h"
+#include "iblkit/geometry/mesh_io.h"
 #include "iblkit/io/image_io.h"
 #include "iblkit/io/photo.h"
 #include "iblkit/io/tonemap.h"
 #include "iblkit/lab/capture.h"
+#include "iblkit/lab/plate.h"
 #include "iblkit/lab/scene_io.h"
 #include "iblkit/lab/sequence.h"
 #include "iblkit/lab/shoot.h"
@@ -269,26 +274,113 @@ struct ShootOpts {
   int width = 512, height = 512, samples = 2, truth_size = 128, bracket = 0, quality = 95, shift = 0, area_samples = 0,
       bounces = -1;
   uint64_t seed = 1;
-  bool two_sides = false, no_photographer = false, noise = false;
+  bool two_sides = false, no_photographer = false, noise = false, until_unsaturated = false;
+  // --backplate: the scene photographed with a board on the floor, the truth with the object, capture.json.
+  bool backplate = false;
+  std::string plate_eye = "0.3,1.4,2.2", plate_target = "0,0.2,0", plate_wb = "1,1,1", plate_exposure,
+              board = "7x4:0.1", board_at = "-0.4,0,0.9", object = "blob", object_at = "0,0.161,0",
+              albedo = "0.7,0.7,0.7";
+  double plate_fov = 50, plate_k1 = 0, object_size = 0.3;
+  int plate_width = 320, plate_height = 240, plate_samples = 8;
 };
 
-std::vector<double> parse_doubles(const std::string& s, const std::string& what) {
-  std::vector<double> v;
-  std::stringstream ss(s);
-  std::string part;
-  while (std::getline(ss, part, ',')) {
-    size_t used = 0;
-    double x = 0;
-    try {
-      x = std::stod(part, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used == 0 || used != part.size() || !std::isfinite(x))
-      ibl::fail(ibl::ErrorKind::Value, "{}: \"{}\" is not a list of numbers", what, s);
-    v.push_back(x);
+// lab shoot --backplate: the backplate (the scene with the board printed on the floor, no object), the truth (the
+// same photograph with the object), their camera, the proxy, and capture.json naming the views' brackets.
+nlohmann::json shoot_backplate(const ShootOpts& o, const ibl::lab::ShootDesc& d, const ibl::lab::BracketDesc& bd,
+                               const nlohmann::json& jviews, const fs::path& out) {
+  ibl::lab::Scene scene = ibl::lab::load_scene(o.scene, false);
+  const ibl::geometry::TriMesh proxy = scene.proxy_mesh();
+  ibl::capture::Board board = ibl::capture::parse_board("checker:" + o.board, "--board");
+  const Vec3 centre = iblcli::parse_vec3(o.board_at, "--board-at");
+  const Vec3 u{1, 0, 0}, v{0, 0, -1};  // on the floor, face up
+  const Vec3 origin = centre - (u * ((board.cols - 1) / 2.0) + v * ((board.rows - 1) / 2.0)) * board.square;
+  ibl::capture::place_board(board, origin, u, v, "--board-at");
+  ibl::lab::add_board(scene, board);
+  ibl::lab::PlateDesc pd;
+  ibl::geometry::Camera& cam = pd.camera;
+  cam.eye = iblcli::parse_vec3(o.plate_eye, "--plate-eye");
+  cam.target = iblcli::parse_vec3(o.plate_target, "--plate-target");
+  cam.fov_y_deg = ibl::require_number("--plate-fov", o.plate_fov, 1, 150);
+  cam.width = o.plate_width;
+  cam.height = o.plate_height;
+  if (o.plate_k1 != 0) {  // a lens with barrel (k1 < 0) or pincushion distortion
+    cam.intrinsics = cam.effective_intrinsics();
+    cam.distortion.k1 = ibl::require_number("--plate-k1", o.plate_k1, -1, 1);
   }
-  return v;
+  ibl::geometry::validate_camera(cam, "--plate-eye/--plate-target");
+  pd.samples = o.plate_samples;
+  pd.sensor = bd.sensor;
+  pd.sensor.wb_gains = iblcli::parse_vec3(o.plate_wb, "--plate-wb");
+  pd.sensor.exposure_s =
+      o.plate_exposure.empty() ? 0 : iblcli::parse_double_list(o.plate_exposure, "--plate-exposure").at(0);
+  pd.sensor.seed = o.seed + 5000;
+  const ibl::render::ObjectDesc od = iblcli::inserted_object(o.object, o.object_size, 20000, o.object_at);
+  const ibl::render::Material material = iblcli::object_material(o.albedo, 0, 20, "phong", "");
+  ibl::render::check_material(material, "--albedo");
+  pd.object = ibl::render::make_object(od);
+  pd.albedo = material.albedo;
+  // The room's light is the one the ball saw: the same bounces (a real room has them all; with B the object in the
+  // truth meets walls lit with B − 1, the B-th bounce is what the composite's probe has more).
+  pd.render = d.render;
+  ibl::lab::Plate plate = ibl::lab::shoot_plate(scene, pd, iblcli::progress_bar());
+  iblcli::progress_done();
+  ibl::io::PhotoMeta pm;
+  pm.exposure_time = plate.exposure_s;
+  pm.f_number = pd.sensor.f_number;
+  pm.iso = pd.sensor.iso;
+  pm.make = "iblkit";
+  pm.model = "lab shoot";
+  pm.attributes = ibl::capture::exif_lens_attributes(cam.fov_y_deg, cam.width, cam.height);
+  const std::string ext = o.format;
+  ibl::io::write_photo((out / ("backplate." + ext)).string(), plate.backplate, pd.sensor.bits, pm, o.quality);
+  ibl::io::write_photo((out / ("truth." + ext)).string(), plate.truth, pd.sensor.bits, pm, o.quality);
+  ibl::io::write_image((out / "truth_mask.png").string(), plate.truth_mask);
+  ibl::geometry::write_camera((out / "camera_truth.json").string(), cam, true);
+  ibl::geometry::write_obj((out / "proxy.obj").string(), proxy, "lab shoot --backplate: the proxy of " + scene.name);
+  ibl::capture::CaptureFolder f;
+  f.backplate = "backplate." + ext;
+  // The camera's curve, as a user who calibrated it once (hdr merge --response-out) names it; without "response"
+  // the chain recovers one from the ball's brackets (docs/capture.md measures both).
+  f.response = "response.json";
+  f.board_spec = "checker:" + o.board;
+  f.board = board;
+  if (cam.intrinsics) {  // the lens as `camera calibrate` would have found it beforehand
+    ibl::geometry::Camera lens = cam;
+    ibl::geometry::write_camera((out / "lens.json").string(), lens, true);
+    f.lens = "lens.json";
+  }
+  f.ball_center = d.ball_center;
+  f.ball_radius = d.ball_radius;
+  const double az = d.azimuth_deg * ibl::kPi / 180, el = d.elevation_deg * ibl::kPi / 180;
+  f.facing = {std::sin(az) * std::cos(el), std::sin(el), std::cos(az) * std::cos(el)};
+  f.fresnel = o.fresnel;
+  if (d.reflectance.r0) f.reflectance = d.reflectance.r0;
+  for (const auto& jv : jviews) {
+    ibl::capture::CaptureView cv;
+    for (const auto& fr : jv["frames"]) cv.frames.push_back(fr["file"].get<std::string>());
+    cv.angle_deg = jv["angle_deg"].get<double>();
+    cv.distance_radii = jv["distance_radii"].get<double>();
+    const auto& b = jv["ball"];  // the silhouette as the lab drew it (a user's folder may leave it to the fit)
+    cv.ball = ibl::capture::BallCircle{b[0].get<double>(), b[1].get<double>(), b[2].get<double>()};
+    f.views.push_back(cv);
+  }
+  f.proxy = "proxy.obj";
+  f.object = o.object;
+  f.object_size = o.object_size;
+  f.object_at = od.at;
+  f.albedo = material.albedo;
+  f.truth = "truth." + ext;
+  f.truth_mask = "truth_mask.png";
+  f.truth_camera = "camera_truth.json";
+  ibl::write_json_file((out / "capture.json").string(), ibl::capture::capture_to_json(f));
+  return {{"backplate", f.backplate},
+          {"truth", f.truth},
+          {"exposure_s", plate.exposure_s},
+          {"saturated_pixels", plate.saturated},
+          {"width", cam.width},
+          {"height", cam.height},
+          {"board", f.board_spec},
+          {"capture", "capture.json"}};
 }
 
 void run_shoot(const ShootOpts& o) {
@@ -299,7 +391,7 @@ void run_shoot(const ShootOpts& o) {
   d.distance = o.distance_radii > 0 ? o.distance_radii * o.ball_radius : o.distance;
   d.azimuth_deg = o.azimuth;
   d.elevation_deg = o.elevation;
-  d.views_deg = o.two_sides ? std::vector<double>{0, 90} : parse_doubles(o.views, "--views");
+  d.views_deg = o.two_sides ? std::vector<double>{0, 90} : iblcli::parse_double_list(o.views, "--views");
   d.width = o.width;
   d.height = o.height;
   d.fill = o.fill;
@@ -311,7 +403,7 @@ void run_shoot(const ShootOpts& o) {
   d.render.seed = o.seed;
   ibl::capture::parse_fresnel(o.fresnel, &d.reflectance);
   if (!o.reflectance.empty()) {
-    auto r = parse_doubles(o.reflectance, "--reflectance");
+    auto r = iblcli::parse_double_list(o.reflectance, "--reflectance");
     if (r.size() != 1 && r.size() != 3)
       ibl::fail(ibl::ErrorKind::Value, "--reflectance: expected r or r,g,b, got \"{}\"", o.reflectance);
     d.reflectance.r0 = r.size() == 1 ? Vec3{r[0], r[0], r[0]} : Vec3{r[0], r[1], r[2]};
@@ -349,8 +441,12 @@ void run_shoot(const ShootOpts& o) {
                          {"distance_radii", s.distance_radii}, {"camera", ibl::geometry::camera_to_json(s.camera)}};
     if (o.bracket > 0) {
       double middle = o.exposure.empty() ? ibl::lab::middle_grey_exposure(s.radiance, s.ball, bd.sensor)
-                                         : parse_doubles(o.exposure, "--exposure").at(0);
-      if (v == 0 || o.exposure.empty()) bd.exposures_s = ibl::lab::bracket_times(o.bracket, o.ev_step, middle);
+                                         : iblcli::parse_double_list(o.exposure, "--exposure").at(0);
+      if (o.until_unsaturated)  // one step over middle grey, then shorter until nothing saturates
+        bd.exposures_s = ibl::lab::bracket_until_unsaturated(s.radiance, bd.sensor, middle * std::exp2(o.ev_step),
+                                                             o.ev_step, o.bracket);
+      else if (v == 0 || o.exposure.empty())
+        bd.exposures_s = ibl::lab::bracket_times(o.bracket, o.ev_step, middle);
       ibl::capture::SensorDesc sd = bd.sensor;
       ibl::lab::BracketDesc b = bd;
       b.sensor.seed = bd.sensor.seed + 1000 * v;
@@ -376,6 +472,11 @@ void run_shoot(const ShootOpts& o) {
     jviews.push_back(jv);
   }
   if (o.bracket > 0) ibl::capture::write_response((out / "response.json").string(), bd.sensor.response);
+  nlohmann::json jplate;
+  if (o.backplate) {
+    if (o.bracket == 0) ibl::fail(ibl::ErrorKind::Value, "--backplate: the ball needs its brackets (--bracket N)");
+    jplate = shoot_backplate(o, d, bd, jviews, out);
+  }
   nlohmann::json j = {{"scene", scene.name},
                       {"ball_center", {d.ball_center.x, d.ball_center.y, d.ball_center.z}},
                       {"ball_radius", d.ball_radius},
@@ -402,11 +503,13 @@ void run_shoot(const ShootOpts& o) {
     td.size = o.truth_size;
     td.bands = 0;
     td.seed = o.seed;
+    ts.render.bounces = d.render.bounces;  // the light the ball saw
     auto t = ibl::lab::ground_truth(ts, d.ball_center, td, iblcli::progress_bar());
     iblcli::progress_done();
     ibl::io::write_image((out / "truth.exr").string(), t.radiance.image);
     j["truth"] = "truth.exr";
   }
+  if (o.backplate) j["backplate"] = jplate;
   j["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   ibl::write_json_file((out / "shoot.json").string(), j);
   j["out"] = o.out;
@@ -420,7 +523,11 @@ void run_shoot(const ShootOpts& o) {
     for (size_t v = 0; v < shots.size(); ++v)
       fmt::print("  view{}: {}°, ball {:.1f},{:.1f},{:.1f} px{}\n", v, shots[v].angle_deg, shots[v].ball.cx,
                  shots[v].ball.cy, shots[v].ball.r,
-                 o.bracket > 0 ? fmt::format(", {} {} frames", o.bracket, o.format) : std::string());
+                 o.bracket > 0 ? fmt::format(", {} {} frames", jviews[v]["frames"].size(), o.format) : std::string());
+    if (o.backplate)
+      fmt::print("  backplate {}x{} with a {} board, exposure {:.4g} s; the truth with the {} at {}: {}/capture.json\n",
+                 jplate["width"].get<int>(), jplate["height"].get<int>(), o.board, jplate["exposure_s"].get<double>(),
+                 o.object, o.object_at, o.out);
     fmt::print("  wrote {}/shoot.json{}\n", o.out, o.truth_size > 0 ? ", truth.exr (the lab's probe at the ball)" : "");
   });
 }
@@ -530,6 +637,8 @@ void setup(CLI::App& app) {
   sh->add_option("--bracket", so->bracket, "N exposures through the sensor model (0: linear radiance only)")
       ->capture_default_str();
   sh->add_option("--ev-step", so->ev_step, "stops between exposures")->capture_default_str();
+  sh->add_flag("--until-unsaturated", so->until_unsaturated,
+               "bracket from one step over middle grey down until no pixel saturates (--bracket N: at most N frames)");
   sh->add_option("--exposure", so->exposure,
                  "the middle exposure, seconds (default: the ball's median at middle grey)");
   sh->add_option("--fnumber", so->fnumber, "f-number (EXIF FNumber)")->capture_default_str();
@@ -546,11 +655,42 @@ void setup(CLI::App& app) {
   sh->add_option("--wb", so->wb, "white-balance gains r,g,b")->capture_default_str();
   sh->add_option("--shift", so->shift, "hand-held: frames move by up to this many pixels")->capture_default_str();
   sh->add_option("--seed", so->seed, "random seed")->capture_default_str();
+  sh->add_flag("--backplate", so->backplate,
+               "also the backplate (a board on the floor), the truth with the object, and capture.json for composite "
+               "--capture");
+  sh->add_option("--plate-eye", so->plate_eye, "the backplate's camera position")->capture_default_str();
+  sh->add_option("--plate-target", so->plate_target, "the point at the backplate's centre")->capture_default_str();
+  sh->add_option("--plate-fov", so->plate_fov, "its vertical field of view, degrees")->capture_default_str();
+  sh->add_option("--plate-k1", so->plate_k1, "its lens's radial distortion k1 (0: none; writes lens.json)")
+      ->capture_default_str();
+  sh->add_option("--plate-width", so->plate_width, "backplate width, pixels")
+      ->check(CLI::Range(16, 8192))
+      ->capture_default_str();
+  sh->add_option("--plate-height", so->plate_height, "backplate height, pixels")
+      ->check(CLI::Range(16, 8192))
+      ->capture_default_str();
+  sh->add_option("--plate-samples", so->plate_samples, "n×n rays per backplate pixel")
+      ->check(CLI::Range(1, 64))
+      ->capture_default_str();
+  sh->add_option("--plate-wb", so->plate_wb, "the backplate's white-balance gains r,g,b")->capture_default_str();
+  sh->add_option("--plate-exposure", so->plate_exposure,
+                 "the backplate's exposure, seconds (default: its median at middle grey, its highlights kept)");
+  sh->add_option("--board", so->board, "the board on the floor: COLSxROWS:SQUARE_M (inner corners)")
+      ->capture_default_str();
+  sh->add_option("--board-at", so->board_at, "the board's centre on the floor x,y,z")->capture_default_str();
+  sh->add_option("--object", so->object, "the object of the truth: blob, sphere or a mesh file")->capture_default_str();
+  sh->add_option("--object-at", so->object_at, "where its centre goes")->capture_default_str();
+  sh->add_option("--object-size", so->object_size, "its largest extent, metres")->capture_default_str();
+  sh->add_option("--albedo", so->albedo, "its Lambertian albedo r,g,b")->capture_default_str();
   sh->add_option("-o,--out", so->out, "output folder")->required();
   sh->footer(
       "Examples:\n  iblkit lab shoot low-scene1 --at 0,1,0 --distance-radii 8 --out ball\n"
       "  iblkit lab shoot low-scene2 --two-sides --distance 2 --bracket 5 --ev-step 2 --noise --quality 95 --out "
-      "brackets");
+      "brackets\n"
+      "  iblkit lab shoot low-scene2 --at 0,0.15,0 --two-sides --distance-radii 10 --width 384 --height 384 --samples "
+      "4 "
+      "--bracket 12 --until-unsaturated --ev-step 3 --bounces 1 --noise --wb 1.1,1,0.8 --backplate --out set\n"
+      "  iblkit composite --capture set --out set/composite.jpg --layers set/layers");
   sh->callback([so] { run_shoot(*so); });
 
   auto* ph = app.add_subcommand(

@@ -13,25 +13,6 @@
 
 namespace {
 
-std::vector<double> parse_numbers(const std::string& s, const std::string& what) {
-  std::vector<double> v;
-  std::stringstream ss(s);
-  std::string part;
-  while (std::getline(ss, part, ',')) {
-    size_t used = 0;
-    double x = 0;
-    try {
-      x = std::stod(part, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used == 0 || used != part.size() || !std::isfinite(x))
-      ibl::fail(ibl::ErrorKind::Value, "{}: \"{}\" is not a list of numbers", what, s);
-    v.push_back(x);
-  }
-  return v;
-}
-
 struct Opts {
   std::vector<std::string> photos, balls;
   std::string out, weights, mapping = "latlong", reflectance, fresnel = "chrome", angle = "90";
@@ -59,7 +40,7 @@ void run(const Opts& o) {
   d.rotation = ibl::Mat3::rotation({0, 1, 0}, o.rotate * ibl::kPi / 180);
   ibl::capture::parse_fresnel(o.fresnel, &d.reflectance);
   if (!o.reflectance.empty()) {
-    auto r = parse_numbers(o.reflectance, "--reflectance");
+    auto r = iblcli::parse_double_list(o.reflectance, "--reflectance");
     if (r.size() != 1 && r.size() != 3)
       ibl::fail(ibl::ErrorKind::Value, "--reflectance: expected r or r,g,b, got \"{}\"", o.reflectance);
     d.reflectance.r0 = r.size() == 1 ? ibl::Vec3{r[0], r[0], r[0]} : ibl::Vec3{r[0], r[1], r[2]};
@@ -73,7 +54,7 @@ void run(const Opts& o) {
     v.photo = ibl::io::read_image(o.photos[i]);
     nlohmann::json jv = {{"photo", o.photos[i]}, {"width", v.photo.width()}, {"height", v.photo.height()}};
     if (!o.balls.empty()) {
-      auto b = parse_numbers(o.balls[i], "--ball");
+      auto b = iblcli::parse_double_list(o.balls[i], "--ball");
       if (b.size() != 3) ibl::fail(ibl::ErrorKind::Value, "--ball: expected cx,cy,r (pixels), got \"{}\"", o.balls[i]);
       v.ball = {b[0], b[1], b[2]};
       jv["ball_from"] = "--ball";
@@ -106,7 +87,7 @@ void run(const Opts& o) {
       views[1].angle_deg = e.angle_deg;
       jangle = {{"estimated", true}, {"mean_abs_log_difference", e.residual}, {"directions", e.directions}};
     } else {
-      auto a = parse_numbers(o.angle, "--angle");
+      auto a = iblcli::parse_double_list(o.angle, "--angle");
       if (a.size() != 1) ibl::fail(ibl::ErrorKind::Value, "--angle: expected degrees or auto, got \"{}\"", o.angle);
       views[1].angle_deg = a[0];
       jangle = {{"estimated", false}};

@@ -34,17 +34,24 @@ Tracers::Tracers(const geometry::TriMesh& proxy_mesh, const geometry::TriMesh* o
   bound.r *= 1 + 1e-6;
 }
 
+namespace {
+
+// Light sample k of `count` (stratified) seen from x with normal n: its contribution over its probability, *w
+// its direction; zero where it lies behind the surface or `rt` occludes it.
+Vec3 light_sample(const Tracers& t, const geometry::RayTracer& rt, Vec3 x, Vec3 n, int k, int count, Rng& rng,
+                  bool shadowed, Vec3* w) {
+  double pmf, dist;
+  size_t i = t.light->sample((k + rng.uniform()) / count, &pmf);
+  Vec3 c = t.light->contribution(i, x, n, w, &dist, shadowed);
+  if (max_component(c) <= 0 || rt.occluded(x, *w, kRayEpsilon, patch_tfar(dist))) return {};
+  return c / pmf;
+}
+
+}  // namespace
+
 Vec3 irradiance(const Tracers& t, const geometry::RayTracer& rt, Vec3 x, Vec3 n, int count, Rng& rng, bool shadowed) {
-  Vec3 e;
-  for (int k = 0; k < count; ++k) {
-    double pmf;
-    size_t i = t.light->sample((k + rng.uniform()) / count, &pmf);
-    Vec3 w;
-    double dist;
-    Vec3 c = t.light->contribution(i, x, n, &w, &dist, shadowed);
-    if (max_component(c) <= 0 || rt.occluded(x, w, kRayEpsilon, patch_tfar(dist))) continue;
-    e += c / pmf;
-  }
+  Vec3 e, w;
+  for (int k = 0; k < count; ++k) e += light_sample(t, rt, x, n, k, count, rng, shadowed, &w);
   return e / count;
 }
 
@@ -54,13 +61,8 @@ Vec3 object_radiance(const Tracers& t, Vec3 z, Vec3 n, Vec3 v, Vec3 rho, const r
   const Vec3 r = normalize(n * (2 * dot(n, v)) - v);
   Vec3 e, g;
   for (int k = 0; k < count; ++k) {
-    double pmf;
-    size_t i = t.light->sample((k + rng.uniform()) / count, &pmf);
-    Vec3 w;
-    double dist;
-    Vec3 c = t.light->contribution(i, z, n, &w, &dist, true);
-    if (max_component(c) <= 0 || t.both_rt.occluded(z, w, kRayEpsilon, patch_tfar(dist))) continue;
-    c = c / pmf;
+    Vec3 w, c = light_sample(t, t.both_rt, z, n, k, count, rng, true, &w);
+    if (max_component(c) <= 0) continue;
     e += c;
     if (glossy)
       g += c * (render::glossy_lobe(m, n, v, r, w) / dot(n, w));  // c / cos: the irradiance at normal incidence

@@ -25,9 +25,11 @@ enum class Backend {
 const char* backend_name(Backend b);
 Backend parse_backend(const std::string& name);
 
-// The object a composite inserts when none is named: a 0.3 m blob of 20k triangles resting above a table
-// or floor at y = 0 (a hand-sized object; `iblkit render`'s 0.8 m, 100k-triangle blob is a showpiece).
-inline render::ObjectDesc inserted_object_defaults() { return {"blob", 0.3, 20000, {0, 0.15, 0}}; }
+// The object a composite inserts when none is named: a 0.3 m blob of 20k triangles resting on a table or floor
+// at y = 0 (its lowest point 0.1 mm above it; the blob's size scales its shape, which reaches 1.1 cm lower
+// than its centre minus half its size); a hand-sized object; `iblkit render`'s 0.8 m, 100k-triangle blob is a
+// showpiece.
+inline render::ObjectDesc inserted_object_defaults() { return {"blob", 0.3, 20000, {0, 0.161, 0}}; }
 
 // The radiometric match of the light to the photograph (match.h): Auto estimates the gains whenever the
 // light is a probe's map (one probe, fused probes, a probe image: maps that see the proxy; not an SH grid's,

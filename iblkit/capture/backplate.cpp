@@ -27,7 +27,11 @@ bool is_photo_extension(const std::string& path) {
   return e == ".jpg" || e == ".jpeg" || e == ".png" || e == ".tif" || e == ".tiff";
 }
 
-Backplate read_backplate(const std::string& path, const std::string& response) {
+namespace {
+
+// `pick(encoded)`: the response for an integer file (true) or a float one (false).
+template <typename Pick>
+Backplate read_with(const std::string& path, const Pick& pick) {
   Backplate b;
   b.path = path;
   if (is_photo_extension(path)) {
@@ -39,7 +43,7 @@ Backplate read_backplate(const std::string& path, const std::string& response) {
     }
   }
   if (!b.encoded) {
-    b.response = response_by_name(response.empty() ? "linear" : response);
+    b.response = pick(false);
     b.linear = io::read_image(path, {.max_channels = 3});
     if (b.linear.channels() < 3) b.linear = b.linear.with_channels(3);
     if (b.response.kind != "linear")  // a float file through a curve: its values are code values
@@ -50,13 +54,25 @@ Backplate read_backplate(const std::string& path, const std::string& response) {
         }
     return b;
   }
-  b.response = response_by_name(response.empty() ? "srgb" : response);
+  b.response = pick(true);
   const Image& codes = b.photo.codes;
   b.linear = Image(codes.width(), codes.height(), 3);
   for (size_t i = 0; i < codes.pixel_count(); ++i)
     for (int c = 0; c < 3; ++c)
       b.linear.data()[3 * i + c] = static_cast<float>(b.response.invert(codes.data()[3 * i + c], c));
   return b;
+}
+
+}  // namespace
+
+Backplate read_backplate(const std::string& path, const std::string& response) {
+  return read_with(path, [&](bool encoded) {
+    return response_by_name(response.empty() ? (encoded ? "srgb" : "linear") : response);
+  });
+}
+
+Backplate read_backplate(const std::string& path, const Response& response) {
+  return read_with(path, [&](bool) { return response; });
 }
 
 Image encode_like(const Backplate& b, const Image& composite, int bits, BackplateReport* report) {

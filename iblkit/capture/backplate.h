@@ -34,6 +34,8 @@ struct Backplate {
 // response: "" picks the default — "srgb" for integer files, "linear" for float ones — else "srgb",
 // "linear", "camera" or an iblkit.response/1 file. Throws ibl::Error naming the file.
 Backplate read_backplate(const std::string& path, const std::string& response = "");
+// The same through a curve in memory (one recovered from a bracket of the same camera).
+Backplate read_backplate(const std::string& path, const Response& response);
 
 struct BackplateReport {
   int64_t kept = 0;                // pixels whose original codes were kept (unchanged by the composite)

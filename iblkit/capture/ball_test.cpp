@@ -8,6 +8,7 @@
 #include <functional>
 #include <random>
 
+#include "iblkit/capture/probe_eval.h"
 #include "iblkit/core/error.h"
 #include "iblkit/core/parallel.h"
 #include "iblkit/ilf/ball.h"
@@ -56,33 +57,6 @@ Image photograph(const Env& env, int W, double r, double D, double angle_deg, co
   return img;
 }
 
-// Irradiance of a probe for each normal; pixels weighted by alpha when the probe has 4 channels.
-std::vector<Vec3> irradiance(const sphere::EnvMap& map, const std::vector<Vec3>& normals) {
-  std::vector<Vec3> E(normals.size());
-  const int W = map.image.width(), H = map.image.height();
-  std::vector<Vec3> dirs, vals;
-  std::vector<double> sa;
-  for (int y = 0; y < H; ++y)
-    for (int x = 0; x < W; ++x) {
-      Vec3 d;
-      double s = map.mapping.solid_angle(x, y);
-      if (s <= 0 || !map.mapping.to_direction(x + 0.5, y + 0.5, &d)) continue;
-      double a = map.image.channels() == 4 ? map.image.at(x, y, 3) : 1.0;
-      dirs.push_back(d);
-      vals.push_back(map.image.rgb(x, y) * a);
-      sa.push_back(s);
-    }
-  parallel_for(0, static_cast<int64_t>(normals.size()), [&](int64_t i) {
-    Vec3 e;
-    for (size_t p = 0; p < dirs.size(); ++p) {
-      double c = dot(normals[i], dirs[p]);
-      if (c > 0) e += vals[p] * (c * sa[p]);
-    }
-    E[i] = e;
-  });
-  return E;
-}
-
 // The exact lat-long map of env (n×n sub-samples per pixel), alpha-weighted like `like`: only the
 // sub-directions a probe with that validity sees.
 sphere::EnvMap truth_like(const Env& env, const sphere::EnvMap& like, const std::function<bool(Vec3)>& seen,
@@ -106,12 +80,6 @@ sphere::EnvMap truth_like(const Env& env, const sphere::EnvMap& like, const std:
     }
   });
   return {img, like.mapping};
-}
-
-double mean_relative(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
-  double s = 0;
-  for (size_t i = 0; i < a.size(); ++i) s += std::abs(luminance(a[i]) - luminance(b[i])) / luminance(b[i]);
-  return s / a.size();
 }
 
 TEST(CaptureBall, InverseOpticsRoundTrip) {
@@ -218,8 +186,9 @@ TEST(CaptureBall, OneViewPerspectiveIsExactOrthographicIsNot) {
   };
   sphere::EnvMap truth = truth_like(sky, persp.probe, seen);
   auto normals = sphere::fibonacci_sphere(20480);
-  auto Et = irradiance(truth, normals), Ep = irradiance(persp.probe, normals), Eo = irradiance(ortho.probe, normals);
-  double ep = mean_relative(Ep, Et), eo = mean_relative(Eo, Et);
+  auto Et = probe_irradiance(truth, normals), Ep = probe_irradiance(persp.probe, normals),
+       Eo = probe_irradiance(ortho.probe, normals);
+  double ep = mean_relative_luminance_error(Ep, Et), eo = mean_relative_luminance_error(Eo, Et);
   std::printf("one view at %.0f radii, 20480 normals: perspective %.3f %%, orthographic %.3f %% mean relative\n", D,
               100 * ep, 100 * eo);
   EXPECT_LT(ep, 0.01);
@@ -228,7 +197,7 @@ TEST(CaptureBall, OneViewPerspectiveIsExactOrthographicIsNot) {
   FromBallDesc flat = fd;
   flat.reflectance.fresnel = false;
   FromBallResult nofresnel = probe_from_ball({{photo, {256, 256, 250}, D, 0, "flat"}}, flat);
-  double en = mean_relative(irradiance(nofresnel.probe, normals), Et);
+  double en = mean_relative_luminance_error(probe_irradiance(nofresnel.probe, normals), Et);
   std::printf("  without the Fresnel rise: %.3f %%\n", 100 * en);
   EXPECT_GT(en, 2 * ep);
 }
@@ -243,7 +212,7 @@ TEST(CaptureBall, TwoViewsCoverTheSphere) {
   EXPECT_EQ(r.invalid_pixels, 0);
   sphere::EnvMap truth = truth_like(sky, r.probe, [](Vec3) { return true; });
   auto normals = sphere::fibonacci_sphere(4096);
-  double e = mean_relative(irradiance(r.probe, normals), irradiance(truth, normals));
+  double e = mean_relative_luminance_error(probe_irradiance(r.probe, normals), probe_irradiance(truth, normals));
   std::printf("two views 90° apart: %.3f %% mean relative irradiance\n", 100 * e);
   EXPECT_LT(e, 0.01);
   // The weights: view 0 owns view 1's axis (±X in view 0's frame), view 1 owns view 0's (±Z).
@@ -263,7 +232,8 @@ TEST(CaptureBall, TwoViewsCoverTheSphere) {
   EXPECT_NEAR(est.angle_deg, 90, 0.5);
   // A wrong angle shows: the views disagree.
   FromBallResult wrong = probe_from_ball({{a, {192, 192, 180}, D, 0, "a"}, {b, {192, 192, 180}, D, -90, "b"}}, fd);
-  EXPECT_GT(mean_relative(irradiance(wrong.probe, normals), irradiance(truth, normals)), 5 * e);
+  EXPECT_GT(mean_relative_luminance_error(probe_irradiance(wrong.probe, normals), probe_irradiance(truth, normals)),
+            5 * e);
 }
 
 TEST(CaptureBall, BadInput) {

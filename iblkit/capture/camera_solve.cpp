@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include <fmt/format.h>
+
 #include "iblkit/core/check.h"
 #include "iblkit/core/error.h"
 #include "iblkit/core/json_file.h"
@@ -195,6 +197,69 @@ Calibrated calibrate_camera(const std::vector<std::vector<Correspondence>>& view
   Calibrated c = detail::cv_solver.get().calibrate(views, width, height);
   geometry::require_lens(c.camera, "camera calibrate");
   return c;
+}
+
+namespace {
+
+// An Exif attribute's value as OpenImageIO writes it out ("24", "24.5", a rational "49/2"); 0 when absent or not a
+// positive finite number.
+double exif_number(const io::PhotoMeta& meta, const std::string& name) {
+  for (const io::PhotoAttribute& a : meta.attributes) {
+    if (a.name != name) continue;
+    double num = 0, den = 1;
+    char slash = 0, tail = 0;
+    const int n = std::sscanf(a.value.c_str(), "%lf%c%lf%c", &num, &slash, &den, &tail);
+    if (n == 1 || (n == 3 && slash == '/')) {
+      const double v = num / den;
+      return std::isfinite(v) && v > 0 ? v : 0;
+    }
+    return 0;
+  }
+  return 0;
+}
+
+}  // namespace
+
+std::optional<ExifLens> lens_from_exif(const io::PhotoMeta& meta, int width, int height) {
+  if (width <= 0 || height <= 0) return std::nullopt;
+  const double f = exif_number(meta, "Exif:FocalLength");
+  const double xres = exif_number(meta, "Exif:FocalPlaneXResolution"),
+               yres = exif_number(meta, "Exif:FocalPlaneYResolution");
+  const double unit_code = exif_number(meta, "Exif:FocalPlaneResolutionUnit");
+  const double unit_mm = unit_code == 3 ? 10.0 : unit_code == 4 ? 1.0 : unit_code == 2 || unit_code == 0 ? 25.4 : 0;
+  if (f > 0 && (yres > 0 || xres > 0) && unit_mm > 0) {
+    const double fy_px = f * (yres > 0 ? yres : xres) / unit_mm;  // pixels per mm of the sensor times mm
+    ExifLens l;
+    l.fov_y_deg = 2 * std::atan(height / (2 * fy_px)) * 180 / kPi;
+    l.source = fmt::format("Exif FocalLength {:g} mm, focal plane {:g} px per {}", f, yres > 0 ? yres : xres,
+                           unit_mm == 10  ? "cm"
+                           : unit_mm == 1 ? "mm"
+                                          : "inch");
+    if (l.fov_y_deg > 0 && l.fov_y_deg < 179) return l;
+  }
+  const double f35 = exif_number(meta, "Exif:FocalLengthIn35mmFilm");
+  if (f35 > 0) {
+    // The 35 mm equivalent matches the diagonal: the frame's half-diagonal in pixels over f_px is 21.63 / f35.
+    const double half_diag_px = std::hypot(width, height) / 2, fpx = half_diag_px * f35 / (std::hypot(36.0, 24.0) / 2);
+    ExifLens l;
+    l.fov_y_deg = 2 * std::atan(height / (2 * fpx)) * 180 / kPi;
+    l.source = fmt::format("Exif FocalLengthIn35mmFilm {:g} mm (whole millimetres: about ±{:.1f}° of field of view)",
+                           f35, l.fov_y_deg * 0.5 / f35);
+    if (l.fov_y_deg > 0 && l.fov_y_deg < 179) return l;
+  }
+  return std::nullopt;
+}
+
+std::vector<io::PhotoAttribute> exif_lens_attributes(double fov_y_deg, int width, int height, double sensor_width_mm) {
+  const double fy_px = height / (2 * std::tan(fov_y_deg * kPi / 360));
+  const double px_per_cm = width / (sensor_width_mm / 10);  // square pixels
+  const double f_mm = fy_px / px_per_cm * 10;
+  const double f35 = f_mm * std::hypot(36.0, 24.0) / (sensor_width_mm * std::hypot(width, height) / width);
+  return {{"Exif:FocalLength", "float", fmt::format("{:.9g}", f_mm)},
+          {"Exif:FocalPlaneXResolution", "float", fmt::format("{:.9g}", px_per_cm)},
+          {"Exif:FocalPlaneYResolution", "float", fmt::format("{:.9g}", px_per_cm)},
+          {"Exif:FocalPlaneResolutionUnit", "int", "3"},
+          {"Exif:FocalLengthIn35mmFilm", "int", fmt::format("{}", static_cast<int>(std::lround(f35)))}};
 }
 
 }  // namespace ibl::capture

@@ -16,6 +16,7 @@
 #include "iblkit/core/plugin.h"
 #include "iblkit/core/vec.h"
 #include "iblkit/geometry/camera.h"
+#include "iblkit/io/photo.h"
 
 namespace ibl::capture {
 
@@ -98,6 +99,21 @@ struct Calibrated {
 // A lens (fx, fy, cx, cy, k1 k2 p1 p2 k3) from the board's corners in several photographs of one size
 // (each a list from find_board); at least 3.
 Calibrated calibrate_camera(const std::vector<std::vector<Correspondence>>& views, int width, int height);
+
+// The lens a photograph's Exif states, as an undistorted pinhole with the principal point at the centre (a
+// prior: `camera solve` keeps it fixed while it solves the pose): the focal length FocalLength (mm) over the
+// sensor's pixel pitch (FocalPlaneXResolution / FocalPlaneYResolution per FocalPlaneResolutionUnit: inch, cm
+// or mm), else FocalLengthIn35mmFilm over the 36 × 24 mm frame's diagonal (whole millimetres: ±0.5 mm, a
+// percent or two of the field of view). Nothing when the file states neither.
+struct ExifLens {
+  double fov_y_deg = 0;
+  std::string source;  // in words: "Exif FocalLength 24 mm, focal plane 640 px / 3.6 cm"
+};
+std::optional<ExifLens> lens_from_exif(const io::PhotoMeta& meta, int width, int height);
+// The Exif attributes that state `fov_y_deg` for a width × height frame of a sensor `sensor_width_mm` wide (what
+// the lab writes; lens_from_exif reads them back).
+std::vector<io::PhotoAttribute> exif_lens_attributes(double fov_y_deg, int width, int height,
+                                                     double sensor_width_mm = 36);
 
 namespace detail {
 // What the "cv" plugin provides (capture/camera_cv.cpp).

@@ -1,8 +1,11 @@
 #include "iblkit/capture/camera_solve.h"
 
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 #include "iblkit/core/error.h"
+#include "iblkit/io/photo.h"
 
 using namespace ibl;
 using namespace ibl::capture;
@@ -80,4 +83,40 @@ TEST(CameraSolve, ReprojectionCountsPointsBehindTheCamera) {
   EXPECT_EQ(r.behind, 1);  // (0, 0.3, 5) is behind the default eye at z = 1.2
   EXPECT_NEAR(r.rms_px, 0.5, 1e-9);
   EXPECT_NEAR(r.max_px, 0.5, 1e-9);
+}
+
+TEST(CameraSolve, ExifLensRoundTripsThroughAJpeg) {
+  // The attributes the lab writes give the field of view back: exactly from FocalLength and the focal plane's
+  // resolution, to about a percent from the 35 mm equivalent alone.
+  for (double fov : {20.0, 50.0, 93.5}) {
+    io::PhotoMeta m;
+    m.attributes = exif_lens_attributes(fov, 320, 240);
+    auto l = lens_from_exif(m, 320, 240);
+    ASSERT_TRUE(l);
+    EXPECT_NEAR(l->fov_y_deg, fov, 1e-6) << l->source;
+    io::PhotoMeta m35;
+    for (const auto& a : m.attributes)
+      if (a.name == "Exif:FocalLengthIn35mmFilm") m35.attributes.push_back(a);
+    auto l35 = lens_from_exif(m35, 320, 240);
+    ASSERT_TRUE(l35);
+    EXPECT_NEAR(l35->fov_y_deg, fov, 0.02 * fov) << l35->source;
+  }
+  EXPECT_FALSE(lens_from_exif({}, 320, 240));
+  // Through OpenImageIO's JPEG writer and reader (the Exif block), as `lab shoot --backplate` writes it.
+  const std::string path = ::testing::TempDir() + "exif_lens.jpg";
+  io::PhotoMeta m;
+  m.exposure_time = 0.01;
+  m.attributes = exif_lens_attributes(50, 320, 240);
+  io::write_photo(path, Image(320, 240, 3), 8, m, 90);
+  auto back = lens_from_exif(io::read_photo(path).meta, 320, 240);
+  ASSERT_TRUE(back);
+  EXPECT_NEAR(back->fov_y_deg, 50, 1e-3) << back->source;
+  // A rational written out by OpenImageIO ("49/2") reads as its value.
+  io::PhotoMeta r;
+  r.attributes = {{"Exif:FocalLength", "rational", "49/2"},
+                  {"Exif:FocalPlaneXResolution", "rational", "1000/1"},
+                  {"Exif:FocalPlaneResolutionUnit", "int", "4"}};
+  auto lr = lens_from_exif(r, 320, 240);
+  ASSERT_TRUE(lr);
+  EXPECT_NEAR(lr->fov_y_deg, 2 * std::atan(120 / 24500.0) * 180 / kPi, 1e-9);
 }

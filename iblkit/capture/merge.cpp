@@ -523,8 +523,14 @@ Image merge_hdr(const std::vector<Frame>& frames, const MergeDesc& desc, MergeRe
       0, H,
       [&](int64_t y64) {
         const int y = static_cast<int>(y64);
+        std::vector<uint8_t> clipped(P);
         for (int x = 0; x < W; ++x) {
           uint8_t fl = 4;
+          // A frame in which any channel of the pixel is saturated says nothing of its other channels either: a
+          // camera clips them together (a JPEG's chroma and ringing pull a clipped highlight's other channels a few
+          // codes below the top, where the hat would trust them from an exposure hundreds of times too long).
+          for (int j = 0; j < P; ++j)
+            clipped[j] = std::max({fr[j].code(x, y, 0), fr[j].code(x, y, 1), fr[j].code(x, y, 2)}) >= kSaturatedCode;
           for (int c = 0; c < 3; ++c) {
             double num = 0, den = 0;
             int dark = -1, bright = -1, mid = -1;
@@ -532,7 +538,7 @@ Image merge_hdr(const std::vector<Frame>& frames, const MergeDesc& desc, MergeRe
             for (int j = 0; j < P; ++j) {
               const double z = fr[j].code(x, y, c);
               if (z < 0) continue;
-              const double t = frames[j].exposure, wt = hat_weight(z);
+              const double t = frames[j].exposure, wt = clipped[j] ? 0.0 : hat_weight(z);
               num += wt * R.invert(z, c);
               den += wt * t;
               if (dark < 0 || t < frames[dark].exposure) dark = j, zdark = z;
@@ -546,7 +552,7 @@ Image merge_hdr(const std::vector<Frame>& frames, const MergeDesc& desc, MergeRe
               fl &= ~4;
               if (dark < 0) {
                 E = 0;  // no frame covers the pixel (unreachable: the reference frame has shift 0)
-              } else if (zdark >= kSaturatedCode) {
+              } else if (zdark >= kSaturatedCode || clipped[dark]) {
                 E = R.invert(zdark, c) / frames[dark].exposure, fl |= 1;  // the darkest exposure's bound
               } else if (zbright <= kBlackCode) {
                 E = R.invert(zbright, c) / frames[bright].exposure, fl |= 2;  // the brightest exposure's bound

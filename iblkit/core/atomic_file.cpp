@@ -285,6 +285,14 @@ AtomicFile::~AtomicFile() {
   unregister_temp(slot_);
 }
 
+Error AtomicFile::naming_path(const Error& e) const {
+  std::string msg = e.what();
+  if (!temp_.empty() && temp_ != path_)
+    for (size_t at = 0; (at = msg.find(temp_, at)) != std::string::npos; at += path_.size())
+      msg.replace(at, temp_.size(), path_);
+  return Error(e.kind(), msg);
+}
+
 void AtomicFile::commit() {
   if (committed_) fail(ErrorKind::Internal, "{}: committed twice", path_);
   if (direct_) {

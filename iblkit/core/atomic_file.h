@@ -13,6 +13,8 @@
 
 namespace ibl {
 
+class Error;
+
 class AtomicFile {
  public:
   // Chooses temp_path() beside `path` as "<stem>.tmp-<pid>-<n><extension>": unique in the process
@@ -31,6 +33,9 @@ class AtomicFile {
   // Renames temp_path() onto path(); on failure removes temp_path() and throws ErrorKind::Io
   // "PATH: cannot write (reason)".
   void commit();
+  // `e` with every mention of temp_path() replaced by path(): a writer handed temp_path() names the
+  // temporary in its messages, the user named path(). `catch (const Error& e) { throw f.naming_path(e); }`
+  Error naming_path(const Error& e) const;
 
  private:
   std::string path_, target_, temp_;

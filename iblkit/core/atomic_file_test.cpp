@@ -52,6 +52,16 @@ TEST(AtomicFile, TempBesideTheOutputKeepsTheExtension) {
   fs::remove_all(d);
 }
 
+TEST(AtomicFile, MessagesNameTheOutputNotTheTemporary) {
+  auto d = fresh_dir("naming");
+  AtomicFile f((d / "probe.exr").string());
+  Error raw(ErrorKind::Io, f.temp_path() + ": cannot open; tried " + f.temp_path() + " twice");
+  Error named = f.naming_path(raw);
+  EXPECT_EQ(named.kind(), ErrorKind::Io);
+  EXPECT_EQ(std::string(named.what()), f.path() + ": cannot open; tried " + f.path() + " twice");
+  fs::remove_all(d);
+}
+
 TEST(AtomicFile, CommitReplacesAndAbandonLeavesThePreviousFile) {
   auto d = fresh_dir("commit");
   std::string out = (d / "a.json").string();

@@ -15,6 +15,7 @@
 #include "iblkit/core/atomic_file.h"
 #include "iblkit/core/error.h"
 #include "iblkit/core/input_file.h"
+#include "iblkit/core/vec.h"
 
 namespace ibl {
 
@@ -118,6 +119,18 @@ template <typename T>
 T req_field(const nlohmann::json& j, const std::string& where, const char* key) {
   if (j.is_object() && !j.contains(key)) fail(ErrorKind::Format, "{}: field \"{}\" is missing", where, key);
   return opt_field<T>(j, where, key, T{});
+}
+
+// Field `key` of the object j as a finite [x, y, z]: "WHERE: field \"key\" is missing" / "must be [x, y, z] (finite
+// numbers), got …" (ErrorKind::Format).
+inline Vec3 json_vec3(const nlohmann::json& j, const std::string& where, const char* key) {
+  if (!j.is_object() || !j.contains(key)) fail(ErrorKind::Format, "{}: field \"{}\" is missing", where, key);
+  const auto& a = j[key];
+  if (a.is_array() && a.size() == 3 && a[0].is_number() && a[1].is_number() && a[2].is_number()) {
+    Vec3 v{a[0].get<double>(), a[1].get<double>(), a[2].get<double>()};
+    if (std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z)) return v;
+  }
+  fail(ErrorKind::Format, "{}: field \"{}\" must be [x, y, z] (finite numbers), got {}", where, key, a.dump());
 }
 
 // Fails (ErrorKind::Format) unless j is an object whose "format" is `format`, e.g. "iblkit.probes/1".

@@ -190,10 +190,7 @@ void write_image(const std::string& path, const Image& img, const WriteDesc& des
     else
       write_encoded(file.temp_path(), ext, src, ldr, desc.half, desc.data);
   } catch (const Error& e) {
-    std::string msg = e.what();
-    for (size_t at; (at = msg.find(file.temp_path())) != std::string::npos;)
-      msg.replace(at, file.temp_path().size(), path);
-    throw Error(e.kind(), msg);
+    throw file.naming_path(e);
   }
   file.commit();
 }

@@ -36,10 +36,7 @@ void write_photo(const std::string& path, const Image& codes, int bits, const Ph
   try {
     detail::oiio_codec.get().write_photo(file.temp_path(), codes, bits, meta, quality);
   } catch (const Error& e) {
-    std::string msg = e.what();
-    for (size_t at; (at = msg.find(file.temp_path())) != std::string::npos;)
-      msg.replace(at, file.temp_path().size(), path);
-    throw Error(e.kind(), msg);
+    throw file.naming_path(e);
   }
   file.commit();
 }

@@ -1,5 +1,6 @@
 #include "iblkit/lab/shoot.h"
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 
@@ -118,6 +119,29 @@ std::vector<double> bracket_times(int n, double ev_step, double middle_s) {
   std::vector<double> t;
   for (int k = 0; k < n; ++k) t.push_back(middle_s * std::exp2(ev_step * (k - (n - 1) / 2.0)));
   return t;
+}
+
+std::vector<double> bracket_until_unsaturated(const Image& radiance, const capture::SensorDesc& s, double longest_s,
+                                              double ev_step, int max_frames) {
+  if (!(ev_step > 0 && ev_step <= 8)) fail(ErrorKind::Value, "EV step {} must lie in (0, 8] (--ev-step)", ev_step);
+  if (!(longest_s > 0 && std::isfinite(longest_s))) fail(ErrorKind::Value, "exposure {} s must be positive", longest_s);
+  if (max_frames < 2 || max_frames > 64)
+    fail(ErrorKind::Value, "bracket of at most {} frames is out of range [2, 64] (--bracket)", max_frames);
+  double peak = 0;
+  for (size_t i = 0; i < radiance.pixel_count(); ++i) {
+    const float* p = radiance.data() + i * radiance.channels();
+    peak = std::max({peak, p[0] * s.wb_gains.x, p[1] * s.wb_gains.y, p[2] * s.wb_gains.z});
+  }
+  const double per_second = (s.iso / 100.0) / (s.f_number * s.f_number);
+  std::vector<double> t;
+  for (int k = 0; k < max_frames; ++k) {
+    t.push_back(longest_s * std::exp2(-ev_step * k));
+    if (t.size() >= 2 && peak * t.back() * per_second < 0.9) return t;
+  }
+  fail(ErrorKind::Value,
+       "{} frames {} stops apart do not reach an exposure without saturated pixels (the brightest needs {:.3g} s): "
+       "allow more frames (--bracket) or a larger --ev-step",
+       max_frames, ev_step, 0.9 / (peak * per_second));
 }
 
 double middle_grey_exposure(const Image& radiance, const capture::BallCircle& ball, const capture::SensorDesc& s) {

@@ -70,6 +70,13 @@ std::vector<BracketFrame> bracket(const Image& radiance, const BracketDesc& desc
 // middle_s), shortest first.
 std::vector<double> bracket_times(int n, double ev_step, double middle_s);
 
+// As a photographer of a light probe brackets (Madsen & Laursen: "gradually lowering the exposure time until no
+// pixels in the image are saturated"): from `longest_s` down by `ev_step` stops until a frame leaves no pixel of
+// `radiance` above 90 % of saturation (before noise; its brightest channel times the white balance), at least two
+// frames and at most `max_frames`; longest first. Throws when max_frames do not reach it, naming --bracket.
+std::vector<double> bracket_until_unsaturated(const Image& radiance, const capture::SensorDesc& s, double longest_s,
+                                              double ev_step, int max_frames);
+
 // The exposure time that puts the median luminance of the ball's pixels (inside `ball`) at relative
 // exposure 0.18 (middle grey) for this sensor's f-number and ISO.
 double middle_grey_exposure(const Image& radiance, const capture::BallCircle& ball, const capture::SensorDesc& s);

@@ -8,6 +8,7 @@
 
 #include "iblkit/capture/ball.h"
 #include "iblkit/capture/merge.h"
+#include "iblkit/capture/probe_eval.h"
 #include "iblkit/capture/response.h"
 #include "iblkit/core/error.h"
 #include "iblkit/core/parallel.h"
@@ -29,39 +30,29 @@ Scene scene_without_projector() {
   return s;
 }
 
-std::vector<Vec3> irradiance_all(const sphere::EnvMap& map, const std::vector<Vec3>& normals, const Image* alpha) {
-  std::vector<Vec3> dirs, vals;
-  std::vector<double> sa;
-  for (int y = 0; y < map.image.height(); ++y)
-    for (int x = 0; x < map.image.width(); ++x) {
-      Vec3 d;
-      double s = map.mapping.solid_angle(x, y);
-      if (s <= 0 || !map.mapping.to_direction(x + 0.5, y + 0.5, &d)) continue;
-      double a = alpha ? alpha->at(x, y, 3) : 1.0;
-      dirs.push_back(d);
-      vals.push_back(map.image.rgb(x, y) * a);
-      sa.push_back(s);
-    }
-  std::vector<Vec3> E(normals.size());
-  parallel_for(0, static_cast<int64_t>(normals.size()), [&](int64_t i) {
-    Vec3 e;
-    for (size_t p = 0; p < dirs.size(); ++p) {
-      double c = dot(normals[i], dirs[p]);
-      if (c > 0) e += vals[p] * (c * sa[p]);
-    }
-    E[i] = e;
-  });
-  return E;
-}
-
-double mean_relative(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
-  double s = 0;
-  for (size_t i = 0; i < a.size(); ++i) s += std::abs(luminance(a[i]) - luminance(b[i])) / luminance(b[i]);
-  return s / a.size();
-}
-
 capture::BallView view_of(const Shot& s, std::string name, const Image* img = nullptr) {
   return {img ? *img : s.radiance, s.ball, s.distance_radii, s.angle_deg, std::move(name)};
+}
+
+// The normals every figure here is taken over, and the exact irradiance at them from the probe at the ball's
+// centre in the scene without its projector.
+const std::vector<Vec3>& test_normals() {
+  static const std::vector<Vec3> n = sphere::fibonacci_sphere(20480);
+  return n;
+}
+
+std::vector<Vec3> truth_irradiance(Vec3 ball_center) {
+  Scene truth_scene = scene_without_projector();
+  truth_scene.build();
+  TruthDesc td;
+  td.size = 64;
+  td.bands = 0;
+  return capture::probe_irradiance(ground_truth(truth_scene, ball_center, td).radiance, test_normals());
+}
+
+// The mean relative irradiance error of a probe against that truth.
+double error_against(const sphere::EnvMap& probe, const std::vector<Vec3>& truth) {
+  return capture::mean_relative_luminance_error(capture::probe_irradiance(probe, test_normals()), truth);
 }
 
 TEST(LabShoot, OneViewAgainstTheProbeAtTheBallsCentre) {
@@ -82,17 +73,10 @@ TEST(LabShoot, OneViewAgainstTheProbeAtTheBallsCentre) {
   fd.reflectance = d.reflectance;
   auto persp = capture::probe_from_ball({view_of(s, "persp")}, fd);
   auto ortho = capture::probe_from_ball({{s.radiance, s.ball, 0, 0, "ortho"}}, fd);
-  Scene truth_scene = scene_without_projector();
-  truth_scene.build();
-  TruthDesc td;
-  td.size = 64;
-  td.bands = 0;
-  Truth t = ground_truth(truth_scene, d.ball_center, td);
-  auto normals = sphere::fibonacci_sphere(20480);
   // The truth seen through the probe's validity (the blind cone behind the ball left out of both).
-  auto Et = irradiance_all(t.radiance, normals, &persp.probe.image);
-  double ep = mean_relative(irradiance_all(persp.probe, normals, &persp.probe.image), Et);
-  double eo = mean_relative(irradiance_all(ortho.probe, normals, &ortho.probe.image), Et);
+  auto Et = truth_irradiance(d.ball_center);
+  double ep = error_against(persp.probe, Et);
+  double eo = error_against(ortho.probe, Et);
   std::printf("lab, one view at 5 radii, 20480 normals: perspective %.2f %%, orthographic %.2f %%\n", 100 * ep,
               100 * eo);
   EXPECT_LT(ep, 0.03);
@@ -144,14 +128,8 @@ TEST(LabShoot, TwoViewsLeaveNoPixelOfThePhotographer) {
     for (int x = 0; x < single.probe.image.width(); ++x) one = std::max(one, single.probe.image.at(x, y, 0));
   EXPECT_GT(one, 0.5f);
   // Irradiance against the exact probe at the ball's centre (the scene without photographers).
-  Scene truth_scene = scene_without_projector();
-  truth_scene.build();
-  TruthDesc td;
-  td.size = 64;
-  td.bands = 0;
-  Truth t = ground_truth(truth_scene, d.ball_center, td);
-  auto normals = sphere::fibonacci_sphere(20480);
-  double e = mean_relative(irradiance_all(probe.probe, normals, nullptr), irradiance_all(t.radiance, normals, nullptr));
+  auto Et = truth_irradiance(d.ball_center);
+  double e = error_against(probe.probe, Et);
   std::printf("lab, two views at 40 radii, 20480 normals: %.2f %% mean relative irradiance\n", 100 * e);
   EXPECT_LT(e, 0.03);
   // The same with the balls found by the circle fit. A chrome ball's rim reflects what lies behind it,
@@ -171,8 +149,7 @@ TEST(LabShoot, TwoViewsLeaveNoPixelOfThePhotographer) {
   std::printf("  angle from the overlap: %.2f° (true 90°), mean |log difference| %.3f over %d directions\n",
               est.angle_deg, est.residual, est.directions);
   EXPECT_NEAR(est.angle_deg, 90, 3);  // noise and each side's photographer's shadows
-  double ef =
-      mean_relative(irradiance_all(fit_probe.probe, normals, nullptr), irradiance_all(t.radiance, normals, nullptr));
+  double ef = error_against(fit_probe.probe, Et);
   std::printf("  with the fitted circles: %.2f %% mean relative irradiance\n", 100 * ef);
   EXPECT_LT(ef, 0.03);
 }
@@ -297,22 +274,15 @@ TEST(LabShoot, ChainShootMergeFromBall) {
   capture::FromBallDesc fd;
   fd.size = 64;
   auto probe = capture::probe_from_ball(views, fd);
-  Scene truth_scene = scene_without_projector();
-  truth_scene.build();
-  TruthDesc td;
-  td.size = 64;
-  td.bands = 0;
-  Truth t = ground_truth(truth_scene, d.ball_center, td);
-  auto normals = sphere::fibonacci_sphere(20480);
-  double e = mean_relative(irradiance_all(probe.probe, normals, nullptr), irradiance_all(t.radiance, normals, nullptr));
+  auto Et = truth_irradiance(d.ball_center);
+  double e = error_against(probe.probe, Et);
   std::printf(
       "chain (two sides, 5 JPEG q95 frames 2 EV apart, noise, known sRGB curve): %.2f %% mean relative "
       "irradiance over 20480 normals\n",
       100 * e);
   EXPECT_LT(e, 0.03);
   auto rprobe = capture::probe_from_ball(recovered, fd);
-  double er =
-      mean_relative(irradiance_all(rprobe.probe, normals, nullptr), irradiance_all(t.radiance, normals, nullptr));
+  double er = error_against(rprobe.probe, Et);
   std::printf("  with the curve recovered by Debevec & Malik: %.2f %%\n", 100 * er);
 }
 

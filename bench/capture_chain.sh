@@ -1,0 +1,49 @@
+#!/usr/bin/env bash
+# The chain from a capture folder to the composite, measured against the lab's truth (docs/capture.md, "From the set
+# to the composite"; rows in bench/RESULTS.md): `lab shoot low-scene2 … --backplate` (the ball's brackets from two
+# sides, bracketed down until nothing saturates, a backplate with a board on the floor, the truth with the object;
+# JPEG q95 or 16-bit TIFF), then `composite --capture` with the camera's curve the folder names, with the curve
+# recovered from the ball's bracket (--recover-response), and for reference the same backplate composited with the
+# lab's exact probe at the ball's centre and the exact camera (what the chain would reach with a perfect probe).
+# Prints one line per case: camera error, reprojection, object / shadow / unchanged errors, wall time.
+#
+# Usage: bench/capture_chain.sh [BUILD/iblkit] [OUT]   (PLATE_SAMPLES=8: n×n rays per backplate pixel; TRUTH is
+# the same photograph with the object, so its noise is the backplate's, but its path-traced grain is its own)
+set -eu
+BIN=${1:-build/iblkit}
+OUT=${2:-/tmp/iblkit_capture_chain}
+PS=${PLATE_SAMPLES:-8}
+mkdir -p "$OUT"
+summary() {  # the chain's JSON -> one line
+  /usr/bin/python3 -c '
+import json, sys
+j = json.load(open(sys.argv[1])); e = j["errors"]; c = j.get("camera", {})
+cam = f"camera {c[\"eye_error_mm\"]:.2f} mm {c[\"view_error_deg\"]:.3f} deg {c[\"reprojection_rms_px\"]:.3f} px, " if "eye_error_mm" in c else ""
+print(f"{sys.argv[2]}: {cam}object {100*e[\"object\"]:.1f} %, shadow {100*e[\"shadow\"]:.1f} % of {100*e[\"shadow_signal\"]:.0f} % signal, unchanged {100*e[\"unchanged\"]:.2f} %, {sys.argv[3]} s")
+' "$1" "$2" "$3"
+}
+for fmt in jpg tif; do
+  set_dir="$OUT/set_$fmt"
+  rm -rf "$set_dir"
+  t0=$(date +%s.%N)
+  "$BIN" --quiet lab shoot low-scene2 --at 0,0.15,0 --two-sides --distance-radii 10 --width 384 --height 384 \
+    --samples 4 --bracket 12 --until-unsaturated --ev-step 3 --bounces 1 --noise --wb 1.1,1,0.8 --backplate \
+    --plate-samples "$PS" --format "$fmt" --out "$set_dir" > /dev/null
+  t1=$(date +%s.%N)
+  echo "shoot ($fmt): $(printf '%.1f' "$(echo "$t1 - $t0" | bc)") s"
+  for mode in curve recovered; do
+    extra=()
+    [ "$mode" = recovered ] && extra=(--recover-response)
+    t0=$(date +%s.%N)
+    "$BIN" --quiet --json composite --capture "$set_dir" --out "$set_dir/composite_$mode.$fmt" "${extra[@]}" \
+      > "$set_dir/chain_$mode.json"
+    t1=$(date +%s.%N)
+    summary "$set_dir/chain_$mode.json" "$fmt, $mode curve" "$(printf '%.1f' "$(echo "$t1 - $t0" | bc)")"
+  done
+  t0=$(date +%s.%N)
+  (cd "$set_dir" && "$BIN" --quiet --json composite "backplate.$fmt" --camera camera_truth.json --light truth.exr \
+    --at-probe 0,0.15,0 --proxy proxy.obj --at 0,0.161,0 --response response.json --truth "truth.$fmt" \
+    --out "exact.$fmt" > exact.json)
+  t1=$(date +%s.%N)
+  summary "$set_dir/exact.json" "$fmt, the lab's exact probe and camera" "$(printf '%.1f' "$(echo "$t1 - $t0" | bc)")"
+done
