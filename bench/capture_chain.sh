@@ -10,17 +10,22 @@
 # Usage: bench/capture_chain.sh [BUILD/iblkit] [OUT]   (PLATE_SAMPLES=8: n×n rays per backplate pixel; TRUTH is
 # the same photograph with the object, so its noise is the backplate's, but its path-traced grain is its own)
 set -eu
-BIN=${1:-build/iblkit}
+BIN=$(readlink -f "${1:-build/iblkit}")
 OUT=${2:-/tmp/iblkit_capture_chain}
 PS=${PLATE_SAMPLES:-8}
 mkdir -p "$OUT"
 summary() {  # the chain's JSON -> one line
-  /usr/bin/python3 -c '
+  /usr/bin/python3 - "$1" "$2" "$3" <<'PY'
 import json, sys
-j = json.load(open(sys.argv[1])); e = j["errors"]; c = j.get("camera", {})
-cam = f"camera {c[\"eye_error_mm\"]:.2f} mm {c[\"view_error_deg\"]:.3f} deg {c[\"reprojection_rms_px\"]:.3f} px, " if "eye_error_mm" in c else ""
-print(f"{sys.argv[2]}: {cam}object {100*e[\"object\"]:.1f} %, shadow {100*e[\"shadow\"]:.1f} % of {100*e[\"shadow_signal\"]:.0f} % signal, unchanged {100*e[\"unchanged\"]:.2f} %, {sys.argv[3]} s")
-' "$1" "$2" "$3"
+j = json.load(open(sys.argv[1]))
+e, c = j["errors"], j.get("camera", {})
+cam = ""
+if "eye_error_mm" in c:
+    cam = "camera %.2f mm %.3f deg %.3f px, " % (c["eye_error_mm"], c["view_error_deg"], c["reprojection_rms_px"])
+print("%s: %sobject %.1f %%, shadow %.1f %% of a %.0f %% signal, unchanged %.2f %%, %s s" % (
+    sys.argv[2], cam, 100 * e["object"], 100 * e["shadow"], 100 * e["shadow_signal"], 100 * e["unchanged"],
+    sys.argv[3]))
+PY
 }
 for fmt in jpg tif; do
   set_dir="$OUT/set_$fmt"
@@ -31,7 +36,7 @@ for fmt in jpg tif; do
     --plate-samples "$PS" --format "$fmt" --out "$set_dir" > /dev/null
   t1=$(date +%s.%N)
   echo "shoot ($fmt): $(printf '%.1f' "$(echo "$t1 - $t0" | bc)") s"
-  for mode in curve recovered; do
+  for mode in camera recovered; do
     extra=()
     [ "$mode" = recovered ] && extra=(--recover-response)
     t0=$(date +%s.%N)

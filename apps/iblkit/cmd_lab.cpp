@@ -268,7 +268,7 @@ void run_photograph(const PhotoOpts& o) {
 
 struct ShootOpts {
   std::string scene, out, at = "0,1,0", views = "0", reflectance, fresnel = "chrome", response = "srgb", format = "jpg",
-                          wb = "1,1,1", exposure;
+                          wb = "1,1,1", exposure, chroma;
   double ball_radius = 0.05, distance = 0.5, distance_radii = 0, azimuth = 0, elevation = 0, fill = 0.9, ev_step = 2,
          fnumber = 8, iso = 100, full_well = 0, read_noise = 0, vignetting = 0;
   int width = 512, height = 512, samples = 2, truth_size = 128, bracket = 0, quality = 95, shift = 0, area_samples = 0,
@@ -331,6 +331,7 @@ nlohmann::json shoot_backplate(const ShootOpts& o, const ibl::lab::ShootDesc& d,
   pm.make = "iblkit";
   pm.model = "lab shoot";
   pm.attributes = ibl::capture::exif_lens_attributes(cam.fov_y_deg, cam.width, cam.height);
+  if (!o.chroma.empty()) pm.attributes.push_back({"jpeg:subsampling", "string", o.chroma});
   const std::string ext = o.format;
   ibl::io::write_photo((out / ("backplate." + ext)).string(), plate.backplate, pd.sensor.bits, pm, o.quality);
   ibl::io::write_photo((out / ("truth." + ext)).string(), plate.truth, pd.sensor.bits, pm, o.quality);
@@ -460,6 +461,7 @@ void run_shoot(const ShootOpts& o) {
         pm.iso = sd.iso;
         pm.make = "iblkit";
         pm.model = "lab shoot";
+        if (!o.chroma.empty()) pm.attributes.push_back({"jpeg:subsampling", "string", o.chroma});
         ibl::io::write_photo((out / name).string(), frames[k].codes, sd.bits, pm, o.quality);
         jf.push_back({{"file", name},
                       {"exposure_s", frames[k].exposure_s},
@@ -647,6 +649,9 @@ void setup(CLI::App& app) {
       ->capture_default_str();
   sh->add_option("--format", so->format, "jpg (8-bit) or tif (16-bit)")->capture_default_str();
   sh->add_option("--quality", so->quality, "JPEG quality")->check(CLI::Range(1, 100))->capture_default_str();
+  sh->add_option("--chroma", so->chroma,
+                 "JPEG chroma subsampling: 4:2:0 (libjpeg's and many cameras' default), 4:2:2 or 4:4:4 (none)")
+      ->check(CLI::IsMember({"4:2:0", "4:2:2", "4:4:4"}));
   sh->add_flag("--noise", so->noise, "shot and read noise (full well 20000 e⁻ at ISO 100, read noise 0.001)");
   sh->add_option("--full-well", so->full_well, "photo-electrons at saturation at ISO 100 (shot noise)");
   sh->add_option("--read-noise", so->read_noise, "read noise σ in units of saturation");

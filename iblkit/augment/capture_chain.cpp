@@ -40,8 +40,8 @@ geometry::Camera chain_lens(const capture::CaptureFolder& f, const capture::Back
     const geometry::Camera k = geometry::read_camera(f.at(f.lens));
     if (!k.intrinsics) fail(ErrorKind::Value, "{}: the lens file has no \"intrinsics\"", f.at(f.lens));
     if (k.width != lens.width || k.height != lens.height)
-      fail(ErrorKind::Value, "{}: calibrated for {}x{}, but {} is {}x{}", f.at(f.lens), k.width, k.height,
-           plate.path, lens.width, lens.height);
+      fail(ErrorKind::Value, "{}: calibrated for {}x{}, but {} is {}x{}", f.at(f.lens), k.width, k.height, plate.path,
+           lens.width, lens.height);
     lens.intrinsics = k.intrinsics;
     lens.distortion = k.distortion;
     lens.fov_y_deg = k.fov_y_deg;
@@ -52,9 +52,8 @@ geometry::Camera chain_lens(const capture::CaptureFolder& f, const capture::Back
   if (exif && plate.encoded) e = capture::lens_from_exif(plate.photo.meta, lens.width, lens.height);
   if (f.fov_deg > 0) {
     if (e && std::abs(e->fov_y_deg - f.fov_deg) > 1)
-      fail(ErrorKind::Value,
-           "{}: \"fov_deg\" {}° contradicts the backplate's Exif ({}: {:.2f}°); drop one of them", f.at("capture.json"),
-           f.fov_deg, e->source, e->fov_y_deg);
+      fail(ErrorKind::Value, "{}: \"fov_deg\" {}° contradicts the backplate's Exif ({}: {:.2f}°); drop one of them",
+           f.at("capture.json"), f.fov_deg, e->source, e->fov_y_deg);
     lens.fov_y_deg = f.fov_deg;
     *source = fmt::format("fov_deg {}°", f.fov_deg);
     return lens;
@@ -65,8 +64,9 @@ geometry::Camera chain_lens(const capture::CaptureFolder& f, const capture::Back
     return lens;
   }
   *mode = capture::LensMode::SolveFocal;
-  *source = "focal length solved with the pose (one view of a planar board leaves it loose: give \"fov_deg\" or "
-            "\"lens\")";
+  *source =
+      "focal length solved with the pose (one view of a planar board leaves it loose: give \"fov_deg\" or "
+      "\"lens\")";
   return lens;
 }
 

@@ -25,13 +25,13 @@
 namespace ibl::augment {
 
 struct ChainDesc {
-  CompositeJob job;           // sampling, backend, match (the object, material and light come from the folder)
-  int probe_size = 128;       // lat-long height of the probe
-  int probe_samples = 6;      // n×n looks into the ball photograph per probe texel: a lamp a pixel wide in the
-                              // photograph is averaged into its texel, not hit or missed by 2×2 point samples
-  bool exif_lens = true;      // take the backplate's Exif focal length as its lens when the folder gives none
+  CompositeJob job;               // sampling, backend, match (the object, material and light come from the folder)
+  int probe_size = 128;           // lat-long height of the probe
+  int probe_samples = 6;          // n×n looks into the ball photograph per probe texel: a lamp a pixel wide in the
+                                  // photograph is averaged into its texel, not hit or missed by 2×2 point samples
+  bool exif_lens = true;          // take the backplate's Exif focal length as its lens when the folder gives none
   bool recover_response = false;  // recover the curve from view 0's bracket even when the folder names one
-  double max_error_px = 5;    // refuse a board whose reprojection error exceeds this (RMS)
+  double max_error_px = 5;        // refuse a board whose reprojection error exceeds this (RMS)
 };
 
 struct ChainResult {

@@ -41,9 +41,10 @@ CaptureFolder read_capture(const std::string& dir_or_manifest) {
   CaptureFolder c;
   std::error_code ec;
   if (!fs::exists(dir_or_manifest, ec))
-    fail(ErrorKind::Io, "{}: no such capture folder (a folder holding capture.json, iblkit.capture/1)", dir_or_manifest);
-  fs::path manifest = fs::is_directory(dir_or_manifest) ? fs::path(dir_or_manifest) / "capture.json"
-                                                        : fs::path(dir_or_manifest);
+    fail(ErrorKind::Io, "{}: no such capture folder (a folder holding capture.json, iblkit.capture/1)",
+         dir_or_manifest);
+  fs::path manifest =
+      fs::is_directory(dir_or_manifest) ? fs::path(dir_or_manifest) / "capture.json" : fs::path(dir_or_manifest);
   const std::string where = manifest.string();
   nlohmann::json j = read_json_file(where);
   require_format(j, where, "iblkit.capture/1");
@@ -51,7 +52,8 @@ CaptureFolder read_capture(const std::string& dir_or_manifest) {
   c.backplate = string_field(j, where, "backplate");
   c.response = opt_field(j, where, "response", "");
   // The backplate's camera.
-  if (!j.contains("board")) fail(ErrorKind::Format, "{}: field \"board\" is missing (the board seen in the backplate)", where);
+  if (!j.contains("board"))
+    fail(ErrorKind::Format, "{}: field \"board\" is missing (the board seen in the backplate)", where);
   const nlohmann::json& b = j["board"];
   const std::string bw = where + ": board";
   c.board_spec = string_field(b, bw, "spec");
@@ -71,7 +73,8 @@ CaptureFolder read_capture(const std::string& dir_or_manifest) {
   c.lens = opt_field(j, where, "lens", "");
   c.fov_deg = positive(j, where, "fov_deg", 0, 179);
   // The ball.
-  if (!j.contains("ball")) fail(ErrorKind::Format, "{}: field \"ball\" is missing (the chrome ball's photographs)", where);
+  if (!j.contains("ball"))
+    fail(ErrorKind::Format, "{}: field \"ball\" is missing (the chrome ball's photographs)", where);
   const nlohmann::json& jb = j["ball"];
   const std::string ww = where + ": ball";
   c.ball_center = json_vec3(jb, ww, "center");
@@ -108,8 +111,10 @@ CaptureFolder read_capture(const std::string& dir_or_manifest) {
     cv.focal_mm = positive(jv, vw, "focal_mm", 0, 1e4);
     cv.sensor_mm = positive(jv, vw, "sensor_mm", 0, 1e4);
     if (cv.distance_radii == 0 && (cv.focal_mm == 0 || cv.sensor_mm == 0))
-      fail(ErrorKind::Format, "{}: give \"distance_radii\" (camera to ball centre in ball radii) or \"focal_mm\" and "
-           "\"sensor_mm\"", vw);
+      fail(ErrorKind::Format,
+           "{}: give \"distance_radii\" (camera to ball centre in ball radii) or \"focal_mm\" and "
+           "\"sensor_mm\"",
+           vw);
     c.views.push_back(std::move(cv));
   }
   // The scene and the object.
@@ -144,8 +149,11 @@ nlohmann::json capture_to_json(const CaptureFolder& c) {
     if (v.sensor_mm > 0) jv["sensor_mm"] = v.sensor_mm;
     views.push_back(jv);
   }
-  nlohmann::json ball = {{"center", vec(c.ball_center)}, {"radius", c.ball_radius}, {"facing", vec(c.facing)},
-                         {"fresnel", c.fresnel},         {"views", views}};
+  nlohmann::json ball = {{"center", vec(c.ball_center)},
+                         {"radius", c.ball_radius},
+                         {"facing", vec(c.facing)},
+                         {"fresnel", c.fresnel},
+                         {"views", views}};
   if (c.reflectance) ball["reflectance"] = vec(*c.reflectance);
   nlohmann::json j = {
       {"format", "iblkit.capture/1"},

@@ -17,10 +17,10 @@
 namespace ibl::capture {
 
 struct CaptureView {
-  std::vector<std::string> frames;  // the bracket (paths as written in the manifest: relative to the folder)
-  double angle_deg = 0;             // where this view's camera stood about +Y from view 0's
-  std::optional<BallCircle> ball;   // the silhouette in pixels; absent: found (find_ball)
-  double distance_radii = 0;        // camera to ball centre in ball radii; 0: from the silhouette and the lens
+  std::vector<std::string> frames;     // the bracket (paths as written in the manifest: relative to the folder)
+  double angle_deg = 0;                // where this view's camera stood about +Y from view 0's
+  std::optional<BallCircle> ball;      // the silhouette in pixels; absent: found (find_ball)
+  double distance_radii = 0;           // camera to ball centre in ball radii; 0: from the silhouette and the lens
   double focal_mm = 0, sensor_mm = 0;  // the lens, for distance_from_lens when distance_radii is 0
 };
 
@@ -38,16 +38,16 @@ struct CaptureFolder {
   double fov_deg = 0;
   // The chrome ball: where it stood, its size, which way view 0's camera looked at it, its views.
   Vec3 ball_center;
-  double ball_radius = 0;     // metres
-  Vec3 facing{0, 0, 1};       // world direction from the ball to view 0's camera
+  double ball_radius = 0;  // metres
+  Vec3 facing{0, 0, 1};    // world direction from the ball to view 0's camera
   std::string fresnel = "chrome";
   std::optional<Vec3> reflectance;  // normal-incidence reflectance (default: the metal's)
   std::vector<CaptureView> views;
   // The local scene and what goes into it.
-  std::string proxy;                      // mesh file (world metres)
-  std::string object = "blob";            // blob, sphere, or a mesh file
-  double object_size = 0.3;               // largest extent, metres (0: a mesh file's own)
-  Vec3 object_at{0, 0.15, 0};             // where the object's centre goes
+  std::string proxy;            // mesh file (world metres)
+  std::string object = "blob";  // blob, sphere, or a mesh file
+  double object_size = 0.3;     // largest extent, metres (0: a mesh file's own)
+  Vec3 object_at{0, 0.15, 0};   // where the object's centre goes
   Vec3 albedo{0.7, 0.7, 0.7};
   // The lab's answers (absent in a user's folder): the backplate photographed with the object really there
   // (same camera, same exposure, same noise), its mask, and the exact camera.

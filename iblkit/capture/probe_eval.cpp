@@ -33,11 +33,13 @@ std::vector<Vec3> probe_irradiance(const sphere::EnvMap& probe, const std::vecto
 
 double mean_relative_luminance_error(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
   if (a.size() != b.size() || a.empty())
-    fail(ErrorKind::Value, "irradiance sets of {} and {} normals: they must be the same, non-empty", a.size(), b.size());
+    fail(ErrorKind::Value, "irradiance sets of {} and {} normals: they must be the same, non-empty", a.size(),
+         b.size());
   double s = 0;
   for (size_t i = 0; i < a.size(); ++i) {
     const double ref = luminance(b[i]);
-    if (!(ref > 0)) fail(ErrorKind::Value, "the reference irradiance at normal {} is {}: no light to compare with", i, ref);
+    if (!(ref > 0))
+      fail(ErrorKind::Value, "the reference irradiance at normal {} is {}: no light to compare with", i, ref);
     s += std::abs(luminance(a[i]) - ref) / ref;
   }
   return s / static_cast<double>(a.size());

@@ -93,7 +93,8 @@ Plate shoot_plate(const Scene& base, const PlateDesc& d, const ProgressFn& progr
   p.backplate = capture::expose(without.radiance, s);
   const float top = 1.0f - 0.5f / static_cast<float>((1 << s.bits) - 1);
   for (size_t i = 0; i < p.backplate.pixel_count(); ++i)
-    p.saturated += std::max({p.backplate.data()[3 * i], p.backplate.data()[3 * i + 1], p.backplate.data()[3 * i + 2]}) >= top;
+    p.saturated +=
+        std::max({p.backplate.data()[3 * i], p.backplate.data()[3 * i + 1], p.backplate.data()[3 * i + 2]}) >= top;
   if (!truth) return p;
   Scene with = base;
   const int object = add_object(with, "object", d.object, d.albedo);

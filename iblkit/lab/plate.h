@@ -25,19 +25,19 @@ void add_board(Scene& scene, const capture::Board& board);
 struct PlateDesc {
   geometry::Camera camera;     // pose, lens and frame size
   int samples = 8;             // n×n rays per pixel
-  capture::SensorDesc sensor;  // exposure_s ≤ 0 (not its default): metered, the median at middle grey (0.18), the 99.5th
-                               // percentile at most at 80 % of saturation
+  capture::SensorDesc sensor;  // exposure_s ≤ 0 (not its default): metered, the median at middle grey (0.18),
+                               // the 99.5th percentile at most at 80 % of saturation
   geometry::TriMesh object;    // the inserted object, for the truth (empty: no truth)
   Vec3 albedo{0.7, 0.7, 0.7};  // its Lambertian albedo
   RenderDesc render;           // light estimation (bounces: the scene's)
 };
 
 struct Plate {
-  Image backplate;         // code values in [0, 1], 3 channels, the scene without the object
-  Image truth;             // the same with the object (empty without one)
-  Image truth_mask;        // one channel: 1 where the pixel centre sees the object
-  double exposure_s = 0;   // the exposure used
-  int64_t saturated = 0;   // backplate pixels with a channel at the top code
+  Image backplate;        // code values in [0, 1], 3 channels, the scene without the object
+  Image truth;            // the same with the object (empty without one)
+  Image truth_mask;       // one channel: 1 where the pixel centre sees the object
+  double exposure_s = 0;  // the exposure used
+  int64_t saturated = 0;  // backplate pixels with a channel at the top code
 };
 
 // `scene` not built (the object is added to a copy). Board, if any, already added (add_board).

@@ -22,9 +22,7 @@ TEST(LabPlate, TheBoardIsPrintedAsItsConventionSays) {
   EXPECT_FALSE(print.proxy);
   // The square between the first four inner corners (square 1, 1 counted from the outer edge) is dark, its
   // neighbours along u and v white, and the print faces up (u × v), 1 mm above the floor.
-  auto albedo = [&](int i, int j) {
-    return print.albedo.eval({(i + 0.5) / (b.cols + 1), (j + 0.5) / (b.rows + 1)}).x;
-  };
+  auto albedo = [&](int i, int j) { return print.albedo.eval({(i + 0.5) / (b.cols + 1), (j + 0.5) / (b.rows + 1)}).x; };
   EXPECT_EQ(albedo(1, 1), kBoardDark);
   EXPECT_EQ(albedo(2, 1), kBoardWhite);
   EXPECT_EQ(albedo(1, 2), kBoardWhite);

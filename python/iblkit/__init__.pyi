@@ -43,6 +43,10 @@ def probe_from_ball(photos: Sequence[ArrayLike], balls: Optional[Sequence[Vec3]]
 # ---- capture ----------------------------------------------------------------------------------------
 def hdr_merge(images: Sequence[ArrayLike], exposures: Sequence[float], response: str = "", method: str = "debevec",
               align: bool = True) -> Tuple[np.ndarray, Dict[str, Any]]: ...
+def camera_solve(photo: Optional[ArrayLike] = None, *, points: Any = None, board: str = "",
+                 board_origin: ArrayLike = (0, 0, 0), board_axes: Sequence[float] = (1, 0, 0, 0, 0, -1),
+                 fov: float = 0.0, intrinsics: Optional["Camera"] = None, width: int = 0,
+                 height: int = 0) -> Tuple["Camera", Dict[str, Any]]: ...
 
 # ---- spherical harmonics ------------------------------------------------------------------------
 class SHCoeffs:

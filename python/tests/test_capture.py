@@ -41,3 +41,22 @@ def test_recovered_and_errors():
         iblkit.hdr_merge(imgs[:1], ex[:1])
     with pytest.raises(ValueError, match="outside"):
         iblkit.hdr_merge([i * 255 for i in imgs], ex)
+
+
+def test_camera_solve_from_points_gives_the_camera_back():
+    """Exact points projected through a known camera (Camera.project) give it back, in depth and on the floor."""
+    truth = iblkit.Camera(eye=(0.35, 1.15, 2.3), target=(0.05, 0.25, 0.1), fov_y_deg=42, width=320, height=240)
+    rng = np.random.default_rng(3)
+    for floor in (False, True):
+        world = rng.uniform((-1, 0, -1), (1, 0 if floor else 1.2, 1), size=(20, 3))
+        pts = [(truth.project(tuple(w)), tuple(w)) for w in world]
+        cam, rep = iblkit.camera_solve(points=pts, width=320, height=240, fov=42)
+        assert rep["coplanar"] == floor
+        assert rep["reprojection_rms_px"] < 1e-6
+        assert np.allclose(cam.eye, truth.eye, atol=1e-6)
+        solved, rep2 = iblkit.camera_solve(points=pts, width=320, height=240)  # the focal length too
+        assert rep2["lens"] == "focal solved" and abs(solved.fov_y_deg - 42) < 1e-4
+    with pytest.raises(ValueError, match="either points= or board="):
+        iblkit.camera_solve(width=320, height=240)
+    with pytest.raises(ValueError, match="at least 6"):
+        iblkit.camera_solve(points=pts[:5], width=320, height=240, fov=42)
