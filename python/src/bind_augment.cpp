@@ -2,6 +2,10 @@
 // `iblkit composite`; the captured light (LocalRadiance) from files, an SH grid or fused probes.
 #include "common.h"
 
+#include <algorithm>
+#include <cmath>
+#include <span>
+
 #include <fmt/format.h>
 
 #include "iblkit/augment/composite.h"
@@ -9,6 +13,7 @@
 #include "iblkit/augment/load.h"
 #include "iblkit/augment/measure.h"
 #include "iblkit/augment/run_composite.h"
+#include "iblkit/capture/backplate.h"
 #include "iblkit/core/check.h"
 #include "iblkit/fusion/probe_set.h"
 #include "iblkit/geometry/camera_io.h"
@@ -21,6 +26,42 @@ namespace iblpy {
 namespace {
 
 namespace ag = ibl::augment;
+
+// A photograph as composite() takes it: a uint8/uint16 array holds the camera's code values, linearised through
+// `response` ("" = srgb, as the CLI's default for 8/16-bit files); a float array is linear light (response "" or
+// "linear") or code values in [0, 1] through another curve.
+ibl::capture::Backplate photo_input(py::handle photo, const std::string& response, const char* what) {
+  ibl::capture::Backplate b;
+  b.path = what;
+  py::array a = py::array::ensure(photo);
+  const int bits = a && a.dtype().kind() == 'u' ? (a.itemsize() == 1 ? 8 : a.itemsize() == 2 ? 16 : 0) : 0;
+  if (a && a.dtype().kind() == 'u' && bits == 0)
+    ibl::fail(ibl::ErrorKind::Value, "{}: unsigned integers of {} bytes; a photograph is uint8 or uint16", what,
+              a.itemsize());
+  if (bits == 0) {
+    b.linear = to_checked_image(photo, what);
+    b.response = ibl::capture::response_by_name(response.empty() ? "linear" : response);
+    const int nc = b.linear.channels();
+    if (b.response.kind != "linear")  // code values in [0, 1] through the curve
+      for (size_t i = 0; i < b.linear.size(); ++i) {
+        float& v = b.linear.data()[i];
+        v = static_cast<float>(b.response.invert(std::clamp(static_cast<double>(v), 0.0, 1.0), std::min(2, int(i % nc))));
+      }
+    return b;
+  }
+  ibl::Image codes = to_image(py::array_t<float, py::array::forcecast>(a), what, 3);
+  const float levels = bits == 8 ? 255.0f : 65535.0f;
+  for (float& v : std::span(codes.data(), codes.size())) v /= levels;
+  b.encoded = true;
+  b.photo.codes = codes.with_channels(3);
+  b.photo.bits = bits;
+  b.response = ibl::capture::response_by_name(response.empty() ? "srgb" : response);
+  b.linear = ibl::Image(b.photo.codes.width(), b.photo.codes.height(), 3);
+  for (size_t i = 0; i < b.photo.codes.pixel_count(); ++i)
+    for (int c = 0; c < 3; ++c)
+      b.linear.data()[3 * i + c] = static_cast<float>(b.response.invert(b.photo.codes.data()[3 * i + c], c));
+  return b;
+}
 
 }  // namespace
 
@@ -105,8 +146,9 @@ void init_augment(py::module_& m) {
          py::object light, py::object proxy, py::object at_probe, const std::string& probe_depth, py::handle albedo,
          int median_cut, int light_samples, int object_samples, int bounce_samples, int triangle_samples,
          int pixel_samples, uint64_t seed, bool shadows, const std::string& backend, int gl_lights, double gl_threshold,
-         int gl_visibility, const std::string& match, py::object progress) {
-        ibl::Image ph = to_checked_image(photo, "composite: photo");
+         int gl_visibility, const std::string& match, const std::string& response, py::object progress) {
+        const ibl::capture::Backplate plate = photo_input(photo, response, "composite: photo");
+        const ibl::Image& ph = plate.linear;
         camera.width = ph.width();
         camera.height = ph.height();
         ibl::geometry::validate_camera(camera, "composite: camera");
@@ -172,7 +214,8 @@ void init_augment(py::module_& m) {
       py::arg("backend") = std::string(ag::backend_name(kJob.backend)),
       py::arg("gl_lights") = kDefaults.gl.split.lights, py::arg("gl_threshold") = kDefaults.gl.split.threshold,
       py::arg("gl_visibility") = kDefaults.gl.visibility_samples,
-      py::arg("match") = std::string(kJob.match == ag::Match::Auto ? "auto" : "off"), py::arg("progress") = py::none(),
+      py::arg("match") = std::string(kJob.match == ag::Match::Auto ? "auto" : "off"), py::arg("response") = "",
+      py::arg("progress") = py::none(),
       R"doc(Composites `object` (a TriMesh, e.g. TriMesh.object(at=…)) into the photograph (H, W, 3) seen by
 `camera` (its size becomes the photograph's), as `iblkit composite` (Debevec 1998): a CompositeResult
 with the composite, mask, difference, albedo and render layers.
@@ -184,8 +227,34 @@ object_samples, bounce_samples (0: no bounce), triangle_samples, pixel_samples, 
 pastes the object without its shadow. backend= "cpu" (the ray-traced reference), "gl" (OpenGL: shadow
 maps and the soft sphere term; gl_lights, gl_threshold, gl_visibility as --gl-lights, --gl-threshold,
 --gl-visibility) or "auto". match="auto" puts the light in the photograph's units (the gains from the
-proxy points both see; result.warnings says them), "off" keeps it as captured. Every default is the library's (augment::CompositeJob). Releases the GIL;
-progress(stage, fraction).)doc");
+proxy points both see; result.warnings says them), "off" keeps it as captured. A uint8/uint16 photo holds the
+camera's codes, made linear through response= ("" = "srgb", "linear", "camera" or an iblkit.response/1 file);
+result.composite is linear: encode_photo(result.composite, photo, response) writes it back into the photo's codes.
+Every default is the library's (augment::CompositeJob). Releases the GIL; progress(stage, fraction).)doc");
+
+  m.def(
+      "encode_photo",
+      [](py::handle composite, py::handle photo, const std::string& response) {
+        const ibl::capture::Backplate plate = photo_input(photo, response, "encode_photo: photo");
+        if (!plate.encoded)
+          ibl::fail(ibl::ErrorKind::Value, "encode_photo: photo must be the uint8/uint16 array composite() took");
+        const ibl::Image codes = ibl::capture::encode_like(plate, to_image(composite, "encode_photo: composite", 3));
+        const double levels = plate.photo.bits == 8 ? 255.0 : 65535.0;
+        const auto H = static_cast<py::ssize_t>(codes.height()), W = static_cast<py::ssize_t>(codes.width());
+        if (plate.photo.bits == 8) {
+          py::array_t<uint8_t> out({H, W, py::ssize_t(3)});
+          auto* p = out.mutable_data();
+          for (size_t i = 0; i < codes.size(); ++i) p[i] = static_cast<uint8_t>(std::lround(codes.data()[i] * levels));
+          return py::object(out);
+        }
+        py::array_t<uint16_t> out({H, W, py::ssize_t(3)});
+        auto* p = out.mutable_data();
+        for (size_t i = 0; i < codes.size(); ++i) p[i] = static_cast<uint16_t>(std::lround(codes.data()[i] * levels));
+        return py::object(out);
+      },
+      py::arg("composite"), py::arg("photo"), py::arg("response") = "",
+      "The linear composite back into the uint8/uint16 photo's codes through `response` (as composite() took it):\n"
+      "pixels the composite left exactly as they were keep their codes, the others are encoded and rounded.");
 
   m.def(
       "measure_composite",

@@ -154,6 +154,20 @@ def test_photograph_and_composite_match_cli(tmp_path, probe_set, scene):
     g = iblkit.ilf.SHGrid(np.zeros((2, 2, 2, 9, 3), np.float32) + 0.5, (-1, 0, -1), (1, 2, 1))
     assert iblkit.LocalRadiance.from_grid(g, (0, 0.3, 0), size=8).map.shape == (8, 16, 3)
     assert iblkit.LocalLight is iblkit.LocalRadiance  # the earlier name still works
+    # a photograph as the camera wrote it: uint8 codes in (through the sRGB curve), encode_photo back out
+    enc = np.where(photo <= 0.0031308, 12.92 * photo, 1.055 * np.power(np.maximum(photo, 0), 1 / 2.4) - 0.055)
+    codes = np.round(np.clip(enc, 0, 1) * 255).astype(np.uint8)
+    z = codes / 255.0
+    decoded = np.where(z <= 0.04045, z / 12.92, ((z + 0.055) / 1.055) ** 2.4).astype(np.float32)
+    r8 = iblkit.composite(codes, cam, obj, probes=str(probe_set), **args)
+    lin = iblkit.composite(decoded, cam, obj, probes=str(probe_set), **args)
+    assert np.allclose(r8.composite, lin.composite, rtol=1e-4, atol=1e-6)
+    back = iblkit.encode_photo(r8.composite, codes)
+    assert back.dtype == np.uint8 and back.shape == codes.shape
+    same = r8.difference.max(axis=2) == 0
+    assert same.any() and np.array_equal(back[same], codes[same])  # what the object left alone keeps its codes
+    with pytest.raises(ValueError, match="uint8 or uint16"):
+        iblkit.composite(codes.astype(np.uint32), cam, obj, probes=str(probe_set), **args)
     # the GL backend through the same entry point as the CLI's --backend gl: the same bytes
     gl_args = dict(light_samples=8, bounce_samples=2, gl_visibility=16)
     try:
