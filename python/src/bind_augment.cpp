@@ -45,7 +45,8 @@ ibl::capture::Backplate photo_input(py::handle photo, const std::string& respons
     if (b.response.kind != "linear")  // code values in [0, 1] through the curve
       for (size_t i = 0; i < b.linear.size(); ++i) {
         float& v = b.linear.data()[i];
-        v = static_cast<float>(b.response.invert(std::clamp(static_cast<double>(v), 0.0, 1.0), std::min(2, int(i % nc))));
+        v = static_cast<float>(
+            b.response.invert(std::clamp(static_cast<double>(v), 0.0, 1.0), std::min(2, int(i % nc))));
       }
     return b;
   }
