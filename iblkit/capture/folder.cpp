@@ -127,6 +127,14 @@ CaptureFolder read_capture(const std::string& dir_or_manifest) {
     if (o.contains("at")) c.object_at = json_vec3(o, ow, "at");
     if (o.contains("albedo")) c.albedo = json_vec3(o, ow, "albedo");
   }
+  // Points checked where they enter (docs/conventions.md, "Range of values"), naming the field.
+  for (const auto& [what, p] : {std::pair<const char*, Vec3>{"ball.center", c.ball_center}, {"object.at", c.object_at}}) {
+    try {
+      require_point(what, p);
+    } catch (const Error& e) {
+      fail(ErrorKind::Format, "{}: {}", where, e.what());
+    }
+  }
   if (j.contains("truth")) {
     const nlohmann::json& t = j["truth"];
     const std::string tw = where + ": truth";

@@ -109,4 +109,7 @@ TEST(CaptureFolder, BadManifestsNameTheFieldAndTheFile) {
   j = good;
   j["ball"]["facing"] = {0, 1, 0};
   refused(j, "facing", "facing");
+  j = good;
+  j["object"]["at"] = {1e30, 0, 0};
+  refused(j, "far", "object.at");
 }
