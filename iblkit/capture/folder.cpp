@@ -128,7 +128,8 @@ CaptureFolder read_capture(const std::string& dir_or_manifest) {
     if (o.contains("albedo")) c.albedo = json_vec3(o, ow, "albedo");
   }
   // Points checked where they enter (docs/conventions.md, "Range of values"), naming the field.
-  for (const auto& [what, p] : {std::pair<const char*, Vec3>{"ball.center", c.ball_center}, {"object.at", c.object_at}}) {
+  for (const auto& [what, p] :
+       {std::pair<const char*, Vec3>{"ball.center", c.ball_center}, {"object.at", c.object_at}}) {
     try {
       require_point(what, p);
     } catch (const Error& e) {
