@@ -46,6 +46,10 @@ check board-not-found fail "backplate.jpg: no 9x6-corner chessboard" -- \
   "$BIN" composite --capture "$T/bad" --out "$T/bad/x1.jpg"
 check no-manifest fail "nowhere: no such capture folder" -- "$BIN" composite --capture "$T/nowhere" --out "$T/x2.jpg"
 check both fail "not both" -- "$BIN" composite "$T/set/backplate.jpg" --capture "$T/set" --out "$T/x3.jpg"
+check backplate-no-bracket fail "--backplate: the ball needs its brackets" -- \
+  "$BIN" lab shoot low-scene2 --backplate --out "$T/x5"
+check backplate-symmetric-board fail "looks the same turned around" -- \
+  "$BIN" lab shoot low-scene2 --backplate --bracket 3 --board 8x6:0.1 --out "$T/x6"
 check nothing-written ok "^none$" -- sh -c "ls '$T' '$T/bad' | grep '^x[0-9]' || echo none"
 # camera solve takes the lens from the backplate's Exif, and refuses a --fov that contradicts it.
 O=$(/usr/bin/python3 -c "import json;print(','.join(map(str,json.load(open('$T/set/capture.json'))['board']['origin'])))")

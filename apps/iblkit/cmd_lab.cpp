@@ -385,6 +385,9 @@ nlohmann::json shoot_backplate(const ShootOpts& o, const ibl::lab::ShootDesc& d,
 }
 
 void run_shoot(const ShootOpts& o) {
+  if (o.backplate && o.bracket == 0)  // before anything is shot or written
+    ibl::fail(ibl::ErrorKind::Value, "--backplate: the ball needs its brackets (--bracket N)");
+  if (o.backplate) ibl::capture::parse_board("checker:" + o.board, "--board");
   ibl::lab::Scene scene = ibl::lab::load_scene(o.scene, false);
   ibl::lab::ShootDesc d;
   d.ball_center = iblcli::parse_vec3(o.at, "--at");
@@ -475,10 +478,7 @@ void run_shoot(const ShootOpts& o) {
   }
   if (o.bracket > 0) ibl::capture::write_response((out / "response.json").string(), bd.sensor.response);
   nlohmann::json jplate;
-  if (o.backplate) {
-    if (o.bracket == 0) ibl::fail(ibl::ErrorKind::Value, "--backplate: the ball needs its brackets (--bracket N)");
-    jplate = shoot_backplate(o, d, bd, jviews, out);
-  }
+  if (o.backplate) jplate = shoot_backplate(o, d, bd, jviews, out);
   nlohmann::json j = {{"scene", scene.name},
                       {"ball_center", {d.ball_center.x, d.ball_center.y, d.ball_center.z}},
                       {"ball_radius", d.ball_radius},
