@@ -198,7 +198,9 @@ big = os.path.join(site, "big.bin")
 with open(big, "wb") as f:
     f.truncate(64 << 20)
     f.write(b"head")
-srv = Server(site, limits=as_limit(3145728))
+# (--request-timeout is also the server's idle timeout: on a loaded machine a starved client thread that reads
+# nothing for 10 s is dropped, which this check is not about, so it gets 60 s.)
+srv = Server(site, limits=as_limit(3145728), extra=("--request-timeout", "60"))
 p = srv.port
 sizes = []
 
