@@ -64,7 +64,12 @@ Bracket read_bracket(const std::vector<std::string>& files, const BracketDesc& d
     if (i == 0) {
       b.bits = p.bits;
       b.camera = camera;
+      b.linear = p.linear;
+      b.raw = p.raw;
     } else {
+      if (p.linear != b.linear)
+        fail(ErrorKind::Value, "{}: {}, but {} is {}: merge raw files or developed photographs, not both", files[i],
+             p.linear ? "a raw file" : "a developed photograph", files[0], b.linear ? "a raw file" : "not");
       if (p.bits != b.bits)
         fail(ErrorKind::Value, "{}: {}-bit, but {} is {}-bit: every photograph of a bracket must come from one camera",
              files[i], p.bits, files[0], b.bits);

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "iblkit/capture/merge.h"
+#include "iblkit/io/photo.h"
 
 namespace ibl::capture {
 
@@ -24,11 +25,13 @@ struct Bracket {
   std::string camera;           // "Make Model" from Exif, or empty
   std::string exposure_source;  // "exif", "seconds" or "ev"
   bool iso_assumed = false;     // Exif had no ISO: ISO 100 assumed
+  bool linear = false;          // raw files (io/photo.h): linear codes, no response curve
+  io::RawLevels raw;            // the first raw file's levels and white balance
 };
 
-// Reads every file (8-bit JPEG/PNG, 16-bit TIFF/PNG); throws ibl::Error naming the file: unreadable,
-// other bit depth or camera than the first, no exposure time (naming --exposures), wrong count of
-// exposures.
+// Reads every file (8-bit JPEG/PNG, 16-bit TIFF/PNG, raw files); throws ibl::Error naming the file: unreadable,
+// other bit depth or camera than the first, raw and non-raw mixed, no exposure time (naming --exposures), wrong count
+// of exposures.
 Bracket read_bracket(const std::vector<std::string>& files, const BracketDesc& desc);
 
 // Parses "1/250,1/60,0.5" (seconds) or "ev:-2,0,2" (EV steps) for --exposures.

@@ -28,14 +28,17 @@ void validate(const SensorDesc& s) {
   s.response.validate("sensor response");
 }
 
-Image expose(const Image& radiance, const SensorDesc& s) {
+namespace {
+
+// Calls emit(x, y, c, X) with every pixel's and channel's noisy relative exposure X (not clamped), the
+// white-balance gains applied when `wb`.
+template <typename Emit>
+void sense(const Image& radiance, const SensorDesc& s, bool wb, Emit emit) {
   validate(s);
   if (radiance.empty()) fail(ErrorKind::Value, "sensor: the radiance image is empty");
   const int w = radiance.width(), h = radiance.height(), nc = radiance.channels();
-  Image out(w, h, 3);
   const double k = s.exposure_factor();
   const double electrons = s.full_well * 100.0 / s.iso;
-  const double levels = std::exp2(s.bits) - 1;
   const double cx = 0.5 * w, cy = 0.5 * h, r2max = cx * cx + cy * cy;
   const uint64_t seed_key = mix64(s.seed);
   parallel_for(
@@ -52,18 +55,57 @@ Image expose(const Image& radiance, const SensorDesc& s) {
             if (!(std::isfinite(L) && L >= 0))
               fail(ErrorKind::Value, "sensor: radiance at pixel ({}, {}) channel {} is {}: must be finite and >= 0", x,
                    y, c, L);
-            double X = L * k * s.wb_gains[c] * v;
+            double X = L * k * (wb ? s.wb_gains[c] : 1.0) * v;
             // Both normals are drawn for every pixel, so each pixel's noise is the same whatever the settings.
             const double n_shot = rng.normal(), n_read = rng.normal();
             if (electrons > 0) X += std::sqrt(std::min(X, 1.0) / electrons) * n_shot;
             X += s.read_noise * n_read;
-            const double z = s.response.apply(std::clamp(X, 0.0, 1.0), c);
-            out.pixel(x, static_cast<int>(y))[c] = static_cast<float>(std::round(z * levels) / levels);
+            emit(x, static_cast<int>(y), c, X);
           }
         }
       },
       4);
+}
+
+}  // namespace
+
+Image expose(const Image& radiance, const SensorDesc& s) {
+  Image out(radiance.width(), radiance.height(), 3);
+  const double levels = std::exp2(s.bits) - 1;
+  sense(radiance, s, true, [&](int x, int y, int c, double X) {
+    const double z = s.response.apply(std::clamp(X, 0.0, 1.0), c);
+    out.pixel(x, y)[c] = static_cast<float>(std::round(z * levels) / levels);
+  });
   return out;
+}
+
+std::vector<uint16_t> expose_raw(const Image& radiance, const SensorDesc& s, const RawSensor& r) {
+  if (!(r.black >= 0 && r.black < r.white && r.white <= 65535))
+    fail(ErrorKind::Value, "sensor: black level {} and white level {}: need 0 <= black < white <= 65535", r.black,
+         r.white);
+  const int w = radiance.width(), h = radiance.height();
+  if (w % 2 || h % 2) fail(ErrorKind::Value, "sensor: a raw mosaic needs an even size, not {}x{}", w, h);
+  std::vector<uint16_t> out(static_cast<size_t>(w) * h);
+  const double span = r.white - r.black;
+  sense(radiance, s, false, [&](int x, int y, int c, double X) {
+    const int site = (y & 1) + (x & 1);  // R G / G B: 0 red, 1 green, 2 blue
+    if (site == c)
+      out[static_cast<size_t>(y) * w + x] =
+          static_cast<uint16_t>(std::lround(r.black + std::clamp(X, 0.0, 1.0) * span));
+  });
+  return out;
+}
+
+io::DngDesc expose_dng(const Image& radiance, const SensorDesc& s, const RawSensor& r, const io::PhotoMeta& meta) {
+  io::DngDesc d;
+  d.cfa = expose_raw(radiance, s, r);
+  d.width = radiance.width(), d.height = radiance.height();
+  d.black = r.black, d.white = r.white;
+  for (int c = 0; c < 3; ++c) d.as_shot_neutral[c] = s.wb_gains[1] / s.wb_gains[c];
+  d.meta = meta;
+  d.meta.exposure_time = s.exposure_s, d.meta.f_number = s.f_number, d.meta.iso = s.iso;
+  d.meta.attributes.clear();
+  return d;
 }
 
 }  // namespace ibl::capture

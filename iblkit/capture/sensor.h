@@ -14,10 +14,12 @@
 // code = round(response.apply(X) · (2^bits − 1)) / (2^bits − 1).
 #pragma once
 #include <cstdint>
+#include <vector>
 
 #include "iblkit/capture/response.h"
 #include "iblkit/core/image.h"
 #include "iblkit/core/vec.h"
+#include "iblkit/io/dng.h"
 
 namespace ibl::capture {
 
@@ -40,6 +42,23 @@ struct SensorDesc {
 // Fails (ibl::Error) unless every field is in range (positive time, f-number, ISO, gains; bits 8 or
 // 16; vignetting in [0, 1); noise >= 0; a valid response).
 void validate(const SensorDesc& s);
+
+// A raw file's sensor: the black and white levels of its values (a 14-bit sensor by default).
+struct RawSensor {
+  int black = 512, white = 16383;
+};
+
+// What the sensor of a raw file records for `radiance`: the same X and the same noise as expose (the same
+// numbers drawn for each pixel and channel) but without the white-balance gains (a raw file records the
+// camera's white balance, it does not apply it: write AsShotNeutral = 1 / wb_gains) and without a response
+// curve: site value round(black + clamp(X, 0, 1) · (white − black)), one channel a site in the RGGB
+// pattern (red at (0, 0), blue at (1, 1)). Width and height must be even. Deterministic given s.seed.
+std::vector<uint16_t> expose_raw(const Image& radiance, const SensorDesc& s, const RawSensor& r);
+
+// The raw file of that exposure: expose_raw's mosaic with its levels, AsShotNeutral = 1 / wb_gains, the
+// default colour matrix (the lab's channels are linear sRGB's) and the exposure in `meta` (make, model
+// given; exposure time, f-number and ISO the sensor's).
+io::DngDesc expose_dng(const Image& radiance, const SensorDesc& s, const RawSensor& r, const io::PhotoMeta& meta);
 
 // The code values (in [0, 1], 3 channels; a grey radiance image is repeated) the sensor writes for
 // `radiance` (linear RGB, finite and non-negative). Deterministic given s.seed.

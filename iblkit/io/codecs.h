@@ -94,4 +94,11 @@ struct OiioCodec {
 };
 extern plugin::Provided<OiioCodec> oiio_codec;
 
+// Raw files through LibRaw (the "raw" plugin, libiblkit_raw.so; codec_raw.cpp): io/photo.h's read_photo
+// for a path dng.h's is_raw_path names.
+struct RawCodec {
+  Photo (*read_photo)(const std::string& path);
+};
+extern plugin::Provided<RawCodec> raw_codec;
+
 }  // namespace ibl::io::detail

@@ -64,6 +64,7 @@ int check_pixels(Image& img, const std::string& what, bool sanitize) {
 namespace detail {
 
 constinit plugin::Provided<OiioCodec> oiio_codec{"oiio", "OpenImageIO codec"};
+constinit plugin::Provided<RawCodec> raw_codec{"raw", "LibRaw raw decoder"};
 
 FileKind sniff(const std::string& path) {
   unsigned char b[4] = {};

@@ -7,12 +7,14 @@
 #include "iblkit/core/error.h"
 #include "iblkit/core/input_file.h"
 #include "iblkit/io/codecs.h"
+#include "iblkit/io/dng.h"
 #include "iblkit/io/jpeg_quality.h"
 
 namespace ibl::io {
 
 Photo read_photo(const std::string& path) {
   require_input_file(path, "photograph");
+  if (is_raw_path(path)) return detail::raw_codec.get().read_photo(path);
   Photo p = detail::oiio_codec.get().read_photo(path);
   if (p.format == "jpeg") p.meta.jpeg_quality = estimate_jpeg_quality(path);
   return p;

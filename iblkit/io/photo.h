@@ -4,6 +4,7 @@
 // for the lab's photographs (write_photo: 8-bit JPEG/PNG, 16-bit TIFF/PNG, Exif written where the
 // format holds it).
 #pragma once
+#include <array>
 #include <string>
 #include <vector>
 
@@ -29,14 +30,29 @@ struct PhotoMeta {
   int jpeg_quality = 0;  // a JPEG's quality estimated from its luminance quantisation table (jpeg_quality.h); 0: none
 };
 
+// What a raw file's decoding did (LibRaw; see read_photo).
+struct RawLevels {
+  double black = 0, white = 0;          // the sensor's black and white level, from the file
+  std::array<double, 3> multipliers{};  // the white-balance multipliers applied (as shot; the smallest is 1)
+  std::string pattern;                  // the colour filter array ("RGGB", "LinearRaw", …)
+};
+
 struct Photo {
   Image codes;  // 3 channels (grey repeated, alpha dropped), values code / (2^bits − 1)
   int bits = 8;
   PhotoMeta meta;
-  std::string format;  // OpenImageIO's name of the format
+  std::string format;  // OpenImageIO's name of the format, or "raw"
+  // A raw file (DNG, CR2, NEF, …, by extension: dng.h's is_raw_path), decoded by LibRaw (the "raw"
+  // plugin) as dcraw would with `-4 -W -w -H 0 -o 1`: codes linear in the light, (value − black) /
+  // (white − black) times the as-shot multipliers (so 1 is saturation in the channel with the smallest, and
+  // clipped sites read 1 in every channel), demosaiced (AHD), camera colour to linear sRGB by the file's
+  // matrix, 16-bit. No response curve applies.
+  bool linear = false;
+  RawLevels raw;
 };
 
-// Throws ibl::Error naming the file (missing, not an image, not 8/16-bit integer data).
+// Throws ibl::Error naming the file (missing, not an image, not 8/16-bit integer data, a raw file LibRaw
+// cannot open).
 Photo read_photo(const std::string& path);
 
 // Writes codes (values in [0, 1], 1 or 3 channels) as `bits`-bit integers (8: .jpg/.png/.tif; 16:
