@@ -41,8 +41,10 @@ def timed(cmd, reps=3, **kw):
 
 
 def error(merged, truth, mask):
+    # The scale: the median of truth / merged (robust: a raw mosaic's demosaiced noise floor reads 0 in places,
+    # where a geometric mean would be dominated by the zeros).
     r = truth[mask] / np.maximum(merged[mask], 1e-30)
-    s = np.exp(np.mean(np.log(np.clip(r, 1e-30, None))))
+    s = float(np.median(r))
     return float(np.median(np.abs(s * merged[mask] / truth[mask] - 1))), float(s)
 
 
@@ -50,13 +52,16 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("iblkit")
     ap.add_argument("--out", default=None)
-    ap.add_argument("--format", default="jpg", choices=["jpg", "png"], help="jpg: q95; png: lossless 8-bit")
+    ap.add_argument("--linear-raw", action="store_true", help="with --format dng: LinearRaw DNGs (no mosaic)")
+    ap.add_argument("--format", default="jpg", choices=["jpg", "png", "dng"],
+                    help="jpg: q95; png: lossless 8-bit; dng: 14-bit raw mosaics (iblkit only: OpenCV's calibration "
+                    "takes 8-bit images and neither peer reads DNG)")
     a = ap.parse_args()
     d = a.out or tempfile.mkdtemp(prefix="hdrbench-")
     os.makedirs(d, exist_ok=True)
     subprocess.run([a.iblkit, "hdr", "bracket", PROBE, "-o", f"{d}/b", "--response", "camera", "--full-well",
                     "30000", "--read-noise", "3e-4", "--quality", "95", "--format", a.format,
-                    "--exposures", ",".join(TIMES)],
+                    "--exposures", ",".join(TIMES)] + (["--linear-raw"] if a.linear_raw else []),
                    check=True, stdout=subprocess.DEVNULL)
     files = [f"{d}/b-{j}.{a.format}" for j in range(len(TIMES))]
     secs = [eval(t) for t in TIMES]  # noqa: S307 (our own constants)
@@ -67,7 +72,11 @@ def main():
     # iblkit
     t = timed([a.iblkit, "-q", "hdr", "merge", *files, "--out", f"{d}/iblkit.exr", "--float", "--exposures",
                ",".join(TIMES)])
-    rows.append(("iblkit hdr merge (Debevec)", *error(read_exr(f"{d}/iblkit.exr"), truth, mask), t))
+    rows.append((f"iblkit hdr merge ({'linear raw' if a.format == 'dng' else 'Debevec'})",
+                 *error(read_exr(f"{d}/iblkit.exr"), truth, mask), t))
+    if a.format == "dng":
+        report(rows, files, a.format, mask)
+        return
     # OpenCV
     ocv = f"""
 import os, sys, cv2, numpy as np
@@ -91,7 +100,12 @@ np.save("{d}/opencv.npy", hdr[:, :, ::-1])
         rows.append(("pfstools pfshdrcalibrate (Robertson)", *error(read_exr(f"{d}/pfs.exr"), truth, mask), t))
     else:
         print("SKIP pfstools: pfsinhdrgen/pfshdrcalibrate missing")
-    print(f"bracket: {len(files)} {'JPEG q95' if a.format == 'jpg' else 'PNG'} 1024x512, 2 EV apart; {int(mask.sum())} well-exposed channel values")
+    report(rows, files, a.format, mask)
+
+
+def report(rows, files, fmt, mask):
+    kind = {"jpg": "JPEG q95", "png": "PNG", "dng": "DNG (14-bit raw)"}[fmt]
+    print(f"bracket: {len(files)} {kind} 1024x512, 2 EV apart; {int(mask.sum())} well-exposed channel values")
     print(f"{'tool':40s} {'median rel. error':>18s} {'scale':>8s} {'time s':>8s}")
     for name, e, s, t in rows:
         print(f"{name:40s} {100 * e:17.2f}% {s:8.4f} {t:8.3f}")

@@ -20,6 +20,7 @@
 #include "iblkit/core/json_file.h"
 #include "iblkit/geometry/camera_io.h"
 #include "iblkit/geometry/mesh_io.h"
+#include "iblkit/io/dng.h"
 #include "iblkit/io/image_io.h"
 #include "iblkit/io/photo.h"
 #include "iblkit/io/tonemap.h"
@@ -333,8 +334,15 @@ nlohmann::json shoot_backplate(const ShootOpts& o, const ibl::lab::ShootDesc& d,
   pm.attributes = ibl::capture::exif_lens_attributes(cam.fov_y_deg, cam.width, cam.height);
   if (!o.chroma.empty()) pm.attributes.push_back({"jpeg:subsampling", "string", o.chroma});
   const std::string ext = o.format;
-  ibl::io::write_photo((out / ("backplate." + ext)).string(), plate.backplate, pd.sensor.bits, pm, o.quality);
-  ibl::io::write_photo((out / ("truth." + ext)).string(), plate.truth, pd.sensor.bits, pm, o.quality);
+  if (bd.raw) {  // raw files of the same shot: the same light and noise, no curve
+    ibl::io::write_dng((out / ("backplate." + ext)).string(),
+                       ibl::capture::expose_dng(plate.backplate_radiance, plate.sensor, *bd.raw, pm));
+    ibl::io::write_dng((out / ("truth." + ext)).string(),
+                       ibl::capture::expose_dng(plate.truth_radiance, plate.sensor, *bd.raw, pm));
+  } else {
+    ibl::io::write_photo((out / ("backplate." + ext)).string(), plate.backplate, pd.sensor.bits, pm, o.quality);
+    ibl::io::write_photo((out / ("truth." + ext)).string(), plate.truth, pd.sensor.bits, pm, o.quality);
+  }
   ibl::io::write_image((out / "truth_mask.png").string(), plate.truth_mask);
   ibl::geometry::write_camera((out / "camera_truth.json").string(), cam, true);
   ibl::geometry::write_obj((out / "proxy.obj").string(), proxy, "lab shoot --backplate: the proxy of " + scene.name);
@@ -342,7 +350,7 @@ nlohmann::json shoot_backplate(const ShootOpts& o, const ibl::lab::ShootDesc& d,
   f.backplate = "backplate." + ext;
   // The camera's curve, as a user who calibrated it once (hdr merge --response-out) names it; without "response"
   // the chain recovers one from the ball's brackets (docs/capture.md measures both).
-  f.response = "response.json";
+  f.response = bd.raw ? "linear" : "response.json";  // a raw file is linear
   f.board_spec = "checker:" + o.board;
   f.board = board;
   if (cam.intrinsics) {  // the lens as `camera calibrate` would have found it beforehand
@@ -418,8 +426,10 @@ void run_shoot(const ShootOpts& o) {
     bd.sensor.iso = o.iso;
     bd.sensor.response = ibl::capture::response_by_name(o.response);
     bd.sensor.bits = o.format == "jpg" ? 8 : 16;
-    if (o.format != "jpg" && o.format != "tif")
-      ibl::fail(ibl::ErrorKind::Value, "--format: expected jpg (8-bit) or tif (16-bit), got {}", o.format);
+    if (o.format != "jpg" && o.format != "tif" && o.format != "dng")
+      ibl::fail(ibl::ErrorKind::Value, "--format: expected jpg (8-bit), tif (16-bit) or dng (14-bit raw), got {}",
+                o.format);
+    if (o.format == "dng") bd.raw = ibl::capture::RawSensor{};
     bd.sensor.full_well = o.noise && o.full_well == 0 ? 20000 : o.full_well;
     bd.sensor.read_noise = o.noise && o.read_noise == 0 ? 0.001 : o.read_noise;
     bd.sensor.vignetting = o.vignetting;
@@ -446,10 +456,13 @@ void run_shoot(const ShootOpts& o) {
     if (o.bracket > 0) {
       double middle = o.exposure.empty() ? ibl::lab::middle_grey_exposure(s.radiance, s.ball, bd.sensor)
                                          : iblcli::parse_double_list(o.exposure, "--exposure").at(0);
-      if (o.until_unsaturated)  // one step over middle grey, then shorter until nothing saturates
-        bd.exposures_s = ibl::lab::bracket_until_unsaturated(s.radiance, bd.sensor, middle * std::exp2(o.ev_step),
-                                                             o.ev_step, o.bracket);
-      else if (v == 0 || o.exposure.empty())
+      if (o.until_unsaturated) {  // one step over middle grey, then shorter until nothing saturates
+        ibl::capture::SensorDesc meter = bd.sensor;
+        if (bd.raw)  // a raw file is decoded with the white balance's multipliers over the smallest: they clip at 1
+          meter.wb_gains = meter.wb_gains / std::min({meter.wb_gains.x, meter.wb_gains.y, meter.wb_gains.z});
+        bd.exposures_s =
+            ibl::lab::bracket_until_unsaturated(s.radiance, meter, middle * std::exp2(o.ev_step), o.ev_step, o.bracket);
+      } else if (v == 0 || o.exposure.empty())
         bd.exposures_s = ibl::lab::bracket_times(o.bracket, o.ev_step, middle);
       ibl::capture::SensorDesc sd = bd.sensor;
       ibl::lab::BracketDesc b = bd;
@@ -465,7 +478,12 @@ void run_shoot(const ShootOpts& o) {
         pm.make = "iblkit";
         pm.model = "lab shoot";
         if (!o.chroma.empty()) pm.attributes.push_back({"jpeg:subsampling", "string", o.chroma});
-        ibl::io::write_photo((out / name).string(), frames[k].codes, sd.bits, pm, o.quality);
+        if (b.raw) {
+          frames[k].raw.meta = pm;
+          ibl::io::write_dng((out / name).string(), frames[k].raw);
+        } else {
+          ibl::io::write_photo((out / name).string(), frames[k].codes, sd.bits, pm, o.quality);
+        }
         jf.push_back({{"file", name},
                       {"exposure_s", frames[k].exposure_s},
                       {"f_number", sd.f_number},

@@ -16,6 +16,10 @@ namespace {
 // The folder's response for the ball and the backplate: named, or recovered from view 0's bracket.
 capture::Response chain_response(const capture::CaptureFolder& f, const capture::Bracket& view0, bool recover,
                                  std::string* source) {
+  if (view0.linear) {  // raw files: linear, nothing to recover
+    *source = "linear (raw files)";
+    return capture::linear_response();
+  }
   if (!f.response.empty() && !recover) {
     const bool named = f.response == "srgb" || f.response == "linear" || f.response == "camera";
     *source = named ? f.response : f.at(f.response);

@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include "iblkit/core/error.h"
+#include "iblkit/io/dng.h"
 #include "iblkit/io/image_io.h"
 
 namespace ibl::capture {
@@ -34,6 +35,16 @@ template <typename Pick>
 Backplate read_with(const std::string& path, const Pick& pick) {
   Backplate b;
   b.path = path;
+  if (io::is_raw_path(path)) {  // linear already (LibRaw): no curve
+    b.photo = io::read_photo(path);
+    b.encoded = true;
+    b.response = pick(true);
+    if (b.response.kind != "linear")
+      fail(ErrorKind::Value, "{}: a raw file is linear (LibRaw decodes it): no response curve ({}) applies to it", path,
+           b.response.kind);
+    b.linear = b.photo.codes;
+    return b;
+  }
   if (is_photo_extension(path)) {
     try {
       b.photo = io::read_photo(path);
@@ -66,8 +77,9 @@ Backplate read_with(const std::string& path, const Pick& pick) {
 }  // namespace
 
 Backplate read_backplate(const std::string& path, const std::string& response) {
+  const bool raw = io::is_raw_path(path);
   return read_with(path, [&](bool encoded) {
-    return response_by_name(response.empty() ? (encoded ? "srgb" : "linear") : response);
+    return response_by_name(response.empty() ? (encoded && !raw ? "srgb" : "linear") : response);
   });
 }
 
@@ -83,6 +95,10 @@ Image encode_like(const Backplate& b, const Image& composite, int bits, Backplat
   if (bits == 0) bits = b.photo.bits;
   if (bits != 8 && bits != 16) fail(ErrorKind::Value, "bit depth {}: 8 or 16", bits);
   const bool same_depth = bits == b.photo.bits;
+  // A raw backplate's codes are linear: written at 16 bits they stay so (the unchanged pixels bit for bit), at 8
+  // bits through sRGB (a developed photograph; 8 linear bits would band the shadows).
+  const Response srgb = srgb_response();
+  const Response& curve = b.photo.linear && bits == 8 ? srgb : b.response;
   const double levels = levels_of(bits), in_levels = levels_of(b.photo.bits);
   BackplateReport r;
   Image out(composite.width(), composite.height(), 3);
@@ -106,7 +122,7 @@ Image encode_like(const Backplate& b, const Image& composite, int bits, Backplat
         continue;
       }
       for (int c = 0; c < 3; ++c) {
-        const double z = b.response.apply(std::max(0.0, static_cast<double>(comp[c])), c);
+        const double z = curve.apply(std::max(0.0, static_cast<double>(comp[c])), c);
         o[c] = static_cast<float>(std::lround(std::clamp(z, 0.0, 1.0) * levels) / levels);
       }
       ++r.encoded;
@@ -121,6 +137,11 @@ Image encode_like(const Backplate& b, const Image& composite, int bits, Backplat
 
 void write_like(const std::string& path, const Backplate& b, const Image& codes, int bits, int quality) {
   if (!b.encoded) fail(ErrorKind::Value, "{}: not a photograph of code values", b.path);
+  if (io::is_raw_path(path))
+    fail(ErrorKind::Value,
+         "{}: iblkit writes no raw files: write the composite as .tif (16-bit, linear like the raw), .jpg (sRGB) or "
+         ".exr",
+         path);
   if (bits == 0) bits = b.photo.bits;
   if (quality == 0) quality = b.photo.meta.jpeg_quality > 0 ? b.photo.meta.jpeg_quality : 95;
   io::write_photo(path, codes, bits, b.photo.meta, quality);

@@ -1,4 +1,5 @@
-// A backplate as the camera wrote it — 8-bit JPEG/PNG, 16-bit TIFF/PNG — taken into linear light for the
+// A backplate as the camera wrote it — 8-bit JPEG/PNG, 16-bit TIFF/PNG, a raw file (linear: no curve; written
+// back as a 16-bit linear TIFF or an 8-bit sRGB JPEG/PNG, iblkit writes no raw files) — taken into linear light for the
 // composite and written back the way it came: through the same response curve, in the same bit depth,
 // with the same metadata (docs/capture.md, "Backplates").
 //
@@ -31,7 +32,7 @@ struct Backplate {
   Image linear;          // RGB, what composite() takes
 };
 
-// response: "" picks the default — "srgb" for integer files, "linear" for float ones — else "srgb",
+// response: "" picks the default — "srgb" for integer files, "linear" for float and raw ones — else "srgb",
 // "linear", "camera" or an iblkit.response/1 file. Throws ibl::Error naming the file.
 Backplate read_backplate(const std::string& path, const std::string& response = "");
 // The same through a curve in memory (one recovered from a bracket of the same camera).

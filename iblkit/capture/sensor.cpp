@@ -79,19 +79,39 @@ Image expose(const Image& radiance, const SensorDesc& s) {
   return out;
 }
 
-std::vector<uint16_t> expose_raw(const Image& radiance, const SensorDesc& s, const RawSensor& r) {
+Image olpf_blur(const Image& radiance) {
+  const int w = radiance.width(), h = radiance.height(), nc = radiance.channels();
+  Image across(w, h, nc), out(w, h, nc);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < nc; ++c)
+        across.at(x, y, c) = 0.25f * radiance.at(std::max(x - 1, 0), y, c) + 0.5f * radiance.at(x, y, c) +
+                             0.25f * radiance.at(std::min(x + 1, w - 1), y, c);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < nc; ++c)
+        out.at(x, y, c) = 0.25f * across.at(x, std::max(y - 1, 0), c) + 0.5f * across.at(x, y, c) +
+                          0.25f * across.at(x, std::min(y + 1, h - 1), c);
+  return out;
+}
+
+std::vector<uint16_t> expose_raw(const Image& radiance_in, const SensorDesc& s, const RawSensor& r) {
+  const Image blurred = r.mosaic && r.olpf && !radiance_in.empty() ? olpf_blur(radiance_in) : Image();
+  const Image& radiance = blurred.empty() ? radiance_in : blurred;
   if (!(r.black >= 0 && r.black < r.white && r.white <= 65535))
     fail(ErrorKind::Value, "sensor: black level {} and white level {}: need 0 <= black < white <= 65535", r.black,
          r.white);
   const int w = radiance.width(), h = radiance.height();
   if (w % 2 || h % 2) fail(ErrorKind::Value, "sensor: a raw mosaic needs an even size, not {}x{}", w, h);
-  std::vector<uint16_t> out(static_cast<size_t>(w) * h);
+  std::vector<uint16_t> out(static_cast<size_t>(w) * h * (r.mosaic ? 1 : 3));
   const double span = r.white - r.black;
   sense(radiance, s, false, [&](int x, int y, int c, double X) {
-    const int site = (y & 1) + (x & 1);  // R G / G B: 0 red, 1 green, 2 blue
-    if (site == c)
-      out[static_cast<size_t>(y) * w + x] =
-          static_cast<uint16_t>(std::lround(r.black + std::clamp(X, 0.0, 1.0) * span));
+    const auto v = static_cast<uint16_t>(std::lround(r.black + std::clamp(X, 0.0, 1.0) * span));
+    const size_t pixel = static_cast<size_t>(y) * w + x;
+    if (!r.mosaic)
+      out[3 * pixel + c] = v;
+    else if ((y & 1) + (x & 1) == c)  // R G / G B: 0 red, 1 green, 2 blue
+      out[pixel] = v;
   });
   return out;
 }
@@ -101,10 +121,10 @@ io::DngDesc expose_dng(const Image& radiance, const SensorDesc& s, const RawSens
   d.cfa = expose_raw(radiance, s, r);
   d.width = radiance.width(), d.height = radiance.height();
   d.black = r.black, d.white = r.white;
+  d.mosaic = r.mosaic;
   for (int c = 0; c < 3; ++c) d.as_shot_neutral[c] = s.wb_gains[1] / s.wb_gains[c];
   d.meta = meta;
   d.meta.exposure_time = s.exposure_s, d.meta.f_number = s.f_number, d.meta.iso = s.iso;
-  d.meta.attributes.clear();
   return d;
 }
 

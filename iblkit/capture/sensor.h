@@ -46,13 +46,25 @@ void validate(const SensorDesc& s);
 // A raw file's sensor: the black and white levels of its values (a 14-bit sensor by default).
 struct RawSensor {
   int black = 512, white = 16383;
+  // true: a Bayer mosaic (RGGB), one channel a site, as nearly every camera; false: every channel at every
+  // pixel (a LinearRaw DNG, as a three-sensor or Foveon camera, or a raw file already demosaiced).
+  bool mosaic = true;
+  // The optical low-pass filter in front of a Bayer sensor (a birefringent plate splitting each ray into spots
+  // one pixel apart, both ways): the radiance is blurred by [1 2 1] / 4 across and down before the mosaic samples
+  // it. Without it a lamp a pixel wide lands on one colour's site and demosaics to any colour (measured: the lab's
+  // lamps in a ball came out at 0.2–3 % of their light). Applies to the mosaic only.
+  bool olpf = true;
 };
+
+// The radiance as an optical low-pass filter passes it: [1 2 1] / 4 across and down, edges clamped.
+Image olpf_blur(const Image& radiance);
 
 // What the sensor of a raw file records for `radiance`: the same X and the same noise as expose (the same
 // numbers drawn for each pixel and channel) but without the white-balance gains (a raw file records the
 // camera's white balance, it does not apply it: write AsShotNeutral = 1 / wb_gains) and without a response
-// curve: site value round(black + clamp(X, 0, 1) · (white − black)), one channel a site in the RGGB
-// pattern (red at (0, 0), blue at (1, 1)). Width and height must be even. Deterministic given s.seed.
+// curve: site value round(black + clamp(X, 0, 1) · (white − black)); with r.mosaic (after r.olpf) one channel a site in
+// the RGGB pattern (red at (0, 0), blue at (1, 1)), width × height values; else 3 a pixel (interleaved). Width and
+// height must be even. Deterministic given s.seed.
 std::vector<uint16_t> expose_raw(const Image& radiance, const SensorDesc& s, const RawSensor& r);
 
 // The raw file of that exposure: expose_raw's mosaic with its levels, AsShotNeutral = 1 / wb_gains, the

@@ -4,7 +4,10 @@
 #include <libraw/libraw.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <memory>
+
+#include <fmt/format.h>
 
 #include "iblkit/core/error.h"
 #include "iblkit/io/codecs.h"
@@ -26,15 +29,15 @@ std::string pattern_of(LibRaw& lr) {
 Photo raw_read_photo(const std::string& path) {
   auto lr = std::make_unique<LibRaw>();
   auto& P = lr->imgdata.params;
-  P.output_bps = 16;                      // -4: 16-bit linear
-  P.gamm[0] = 1, P.gamm[1] = 1;           //     no gamma
-  P.no_auto_bright = 1;                   // -W: no brightening to the histogram
-  P.use_camera_wb = 1;                    // -w: the as-shot white balance
-  P.use_camera_matrix = 1;                //     the file's colour matrix
-  P.output_color = 1;                     // -o 1: linear sRGB primaries
-  P.highlight = 0;                        // -H 0: clip (a clipped site reads 1 in every channel)
-  P.user_qual = 3;                        // -q 3: AHD demosaicing
-  P.adjust_maximum_thr = 0;               //     the white level is the file's, not the data's maximum
+  P.output_bps = 16;             // -4: 16-bit linear
+  P.gamm[0] = 1, P.gamm[1] = 1;  //     no gamma
+  P.no_auto_bright = 1;          // -W: no brightening to the histogram
+  P.use_camera_wb = 1;           // -w: the as-shot white balance
+  P.use_camera_matrix = 1;       //     the file's colour matrix
+  P.output_color = 1;            // -o 1: linear sRGB primaries
+  P.highlight = 0;               // -H 0: clip (a clipped site reads 1 in every channel)
+  P.user_qual = 3;               // -q 3: AHD demosaicing
+  P.adjust_maximum_thr = 0;      //     the white level is the file's, not the data's maximum
   // LibRaw reports data errors (a file cut short) through this callback and carries on with zeros; the
   // reader refuses the file instead of printing LibRaw's line and returning black rows.
   struct DataError {
@@ -48,6 +51,29 @@ Photo raw_read_photo(const std::string& path) {
         e->offset = offset;
       },
       &data_error);
+  // The focal plane's resolution (Exif 0xA20E, 0xA20F, 0xA210), which LibRaw parses past without keeping: with the
+  // focal length it gives the field of view exactly (capture::lens_from_exif).
+  struct FocalPlane {
+    double xres = 0, yres = 0;
+    int unit = 0;
+  } plane;
+  lr->set_exifparser_handler(
+      [](void* ctx, int tag, int type, int len, unsigned int ord, void* ifp, INT64) {
+        auto* fp = static_cast<FocalPlane*>(ctx);
+        auto* in = static_cast<LibRaw_abstract_datastream*>(ifp);
+        const int t = tag & 0xffff;
+        if (len != 1 || (t != 0xa20e && t != 0xa20f && t != 0xa210)) return;
+        auto u32 = [&](const uint8_t* b) {
+          return ord == 0x4949 ? uint32_t(b[0]) | uint32_t(b[1]) << 8 | uint32_t(b[2]) << 16 | uint32_t(b[3]) << 24
+                               : uint32_t(b[3]) | uint32_t(b[2]) << 8 | uint32_t(b[1]) << 16 | uint32_t(b[0]) << 24;
+        };
+        uint8_t b[8] = {};
+        if (t == 0xa210 && type == 3 && in->read(b, 1, 2) == 2)
+          fp->unit = ord == 0x4949 ? b[0] | b[1] << 8 : b[1] | b[0] << 8;
+        else if (type == 5 && in->read(b, 1, 8) == 8 && u32(b + 4) != 0)
+          (t == 0xa20e ? fp->xres : fp->yres) = double(u32(b)) / u32(b + 4);
+      },
+      &plane);
   int rc = lr->open_file(path.c_str());
   if (rc != LIBRAW_SUCCESS)
     fail(ErrorKind::Format, "{}: not a raw file LibRaw can read ({}): convert it to DNG, or pass a JPEG/TIFF", path,
@@ -88,11 +114,24 @@ Photo raw_read_photo(const std::string& path) {
   const auto* px = reinterpret_cast<const uint16_t*>(img->data);
   const int nc = img->colors;
   for (size_t i = 0; i < p.codes.pixel_count(); ++i)
-    for (int c = 0; c < 3; ++c) p.codes.data()[3 * i + c] = static_cast<float>(px[i * nc + (nc == 3 ? c : 0)] / 65535.0);
+    for (int c = 0; c < 3; ++c)
+      p.codes.data()[3 * i + c] = static_cast<float>(px[i * nc + (nc == 3 ? c : 0)] / 65535.0);
   const auto& o = lr->imgdata.other;
   p.meta.exposure_time = o.shutter > 0 ? o.shutter : 0;
   p.meta.f_number = o.aperture > 0 ? o.aperture : 0;
   p.meta.iso = o.iso_speed > 0 ? o.iso_speed : 0;
+  // The lens as LibRaw reads it (Exif FocalLength and FocalLengthIn35mmFilm), in OpenImageIO's names, for
+  // capture::lens_from_exif.
+  if (o.focal_len > 0) p.meta.attributes.push_back({"Exif:FocalLength", "float", fmt::format("{:.9g}", o.focal_len)});
+  if (plane.xres > 0)
+    p.meta.attributes.push_back({"Exif:FocalPlaneXResolution", "float", fmt::format("{:.9g}", plane.xres)});
+  if (plane.yres > 0)
+    p.meta.attributes.push_back({"Exif:FocalPlaneYResolution", "float", fmt::format("{:.9g}", plane.yres)});
+  if (plane.unit > 0)
+    p.meta.attributes.push_back({"Exif:FocalPlaneResolutionUnit", "int", fmt::format("{}", plane.unit)});
+  if (lr->imgdata.lens.FocalLengthIn35mmFormat > 0)
+    p.meta.attributes.push_back({"Exif:FocalLengthIn35mmFilm", "int",
+                                 fmt::format("{}", static_cast<int>(lr->imgdata.lens.FocalLengthIn35mmFormat))});
   p.meta.make = lr->imgdata.idata.make;
   p.meta.model = lr->imgdata.idata.model;
   return p;

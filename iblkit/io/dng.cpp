@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 
@@ -47,7 +48,8 @@ Entry ascii(uint16_t tag, const std::string& s) {
 }
 // v as num/den: 1/n exactly for shutter-like times, else to 10^-6.
 std::pair<uint32_t, uint32_t> rational(double v) {
-  if (v > 0 && v < 1 && std::abs(1 / v - std::round(1 / v)) < 1e-6 / v) return {1, static_cast<uint32_t>(std::lround(1 / v))};
+  if (v > 0 && v < 1 && std::abs(1 / v - std::round(1 / v)) < 1e-6 / v)
+    return {1, static_cast<uint32_t>(std::lround(1 / v))};
   if (v >= 1000) return {static_cast<uint32_t>(std::lround(v)), 1};
   return {static_cast<uint32_t>(std::lround(v * 1e6)), 1000000};
 }
@@ -73,52 +75,72 @@ void write_dng(const std::string& path, const DngDesc& d) {
   if (d.width < 2 || d.height < 2 || d.width % 2 || d.height % 2 || d.width > 65536 || d.height > 65536)
     fail(ErrorKind::Value, "{}: a DNG mosaic of {}x{}: width and height must be even, 2 to 65536", path, d.width,
          d.height);
-  if (d.cfa.size() != static_cast<size_t>(d.width) * d.height)
-    fail(ErrorKind::Value, "{}: {} sensor values for a {}x{} mosaic", path, d.cfa.size(), d.width, d.height);
+  const int spp = d.mosaic ? 1 : 3;
+  if (d.cfa.size() != static_cast<size_t>(d.width) * d.height * spp)
+    fail(ErrorKind::Value, "{}: {} sensor values for a {}x{} {}", path, d.cfa.size(), d.width, d.height,
+         d.mosaic ? "mosaic" : "LinearRaw image (3 a pixel)");
   if (!(d.black >= 0 && d.black < d.white && d.white <= 65535))
     fail(ErrorKind::Value, "{}: black level {} and white level {}: need 0 <= black < white <= 65535", path, d.black,
          d.white);
   for (double n : d.as_shot_neutral)
-    if (!(std::isfinite(n) && n > 0 && n <= 1e3)) fail(ErrorKind::Value, "{}: as-shot neutral {} not in (0, 1000]", path, n);
+    if (!(std::isfinite(n) && n > 0 && n <= 1e3))
+      fail(ErrorKind::Value, "{}: as-shot neutral {} not in (0, 1000]", path, n);
   for (double m : d.color_matrix)
     if (!(std::isfinite(m) && std::abs(m) < 1000)) fail(ErrorKind::Value, "{}: colour matrix entry {}", path, m);
   const auto above = std::find_if(d.cfa.begin(), d.cfa.end(), [&](uint16_t v) { return v > d.white; });
   if (above != d.cfa.end())
     fail(ErrorKind::Value, "{}: sensor value {} above the white level {}", path, *above, d.white);
 
+  if (d.cfa.size() * 2 > 0xffffffffu)
+    fail(ErrorKind::Value, "{}: {}x{} is too large for one TIFF strip", path, d.width, d.height);
   const uint32_t strip_bytes = static_cast<uint32_t>(d.cfa.size() * 2);
   std::vector<Entry> e;
   e.push_back(longs(254, {0}));  // NewSubFileType: the main image
   e.push_back(longs(256, {static_cast<uint32_t>(d.width)}));
   e.push_back(longs(257, {static_cast<uint32_t>(d.height)}));
-  e.push_back(shorts(258, {16}));     // BitsPerSample
-  e.push_back(shorts(259, {1}));      // Compression: none
-  e.push_back(shorts(262, {32803}));  // PhotometricInterpretation: CFA
+  e.push_back(d.mosaic ? shorts(258, {16}) : shorts(258, {16, 16, 16}));        // BitsPerSample
+  e.push_back(shorts(259, {1}));                                                // Compression: none
+  e.push_back(shorts(262, {static_cast<uint16_t>(d.mosaic ? 32803 : 34892)}));  // Photometric: CFA or LinearRaw
   if (!d.meta.make.empty()) e.push_back(ascii(271, d.meta.make));
   if (!d.meta.model.empty()) e.push_back(ascii(272, d.meta.model));
-  e.push_back(longs(273, {0}));  // StripOffsets: filled below
-  e.push_back(shorts(274, {1}));  // Orientation: top-left
-  e.push_back(shorts(277, {1}));  // SamplesPerPixel
+  e.push_back(longs(273, {0}));                                // StripOffsets: filled below
+  e.push_back(shorts(274, {1}));                               // Orientation: top-left
+  e.push_back(shorts(277, {static_cast<uint16_t>(spp)}));      // SamplesPerPixel
   e.push_back(longs(278, {static_cast<uint32_t>(d.height)}));  // RowsPerStrip: one strip
   e.push_back(longs(279, {strip_bytes}));
   e.push_back(shorts(284, {1}));  // PlanarConfiguration: chunky
   e.push_back(ascii(305, "iblkit lab"));
-  e.push_back(shorts(33421, {2, 2}));       // CFARepeatPatternDim
-  e.push_back(bytes(33422, {0, 1, 1, 2}));  // CFAPattern: R G / G B
+  if (d.mosaic) {
+    e.push_back(shorts(33421, {2, 2}));       // CFARepeatPatternDim
+    e.push_back(bytes(33422, {0, 1, 1, 2}));  // CFAPattern: R G / G B
+  }
   // The exposure in an Exif IFD, where cameras and Adobe's converter put it (LibRaw reads the ISO only there).
   std::vector<Entry> exif;
   if (d.meta.exposure_time > 0) exif.push_back(rationals(33434, {d.meta.exposure_time}));
   if (d.meta.f_number > 0) exif.push_back(rationals(33437, {d.meta.f_number}));
   if (d.meta.iso > 0)
     exif.push_back(shorts(34855, {static_cast<uint16_t>(std::clamp(std::lround(d.meta.iso), 1L, 65535L))}));
+  // The lens, where the photograph's attributes name it (capture::exif_lens_attributes): FocalLength,
+  // FocalPlaneX/YResolution and their unit, FocalLengthIn35mmFilm.
+  for (const PhotoAttribute& a : d.meta.attributes) {
+    char* end = nullptr;
+    const double v = std::strtod(a.value.c_str(), &end);
+    if (end == a.value.c_str() || !(std::isfinite(v) && v > 0 && v < 1e6)) continue;
+    if (a.name == "Exif:FocalLength") exif.push_back(rationals(37386, {v}));
+    if (a.name == "Exif:FocalPlaneXResolution") exif.push_back(rationals(41486, {v}));
+    if (a.name == "Exif:FocalPlaneYResolution") exif.push_back(rationals(41487, {v}));
+    if (a.name == "Exif:FocalPlaneResolutionUnit") exif.push_back(shorts(41488, {static_cast<uint16_t>(v)}));
+    if (a.name == "Exif:FocalLengthIn35mmFilm") exif.push_back(shorts(41989, {static_cast<uint16_t>(std::lround(v))}));
+  }
+  std::sort(exif.begin(), exif.end(), [](const Entry& a, const Entry& b) { return a.tag < b.tag; });
   if (!exif.empty()) e.push_back(longs(34665, {0}));  // ExifIFD: filled below
-  e.push_back(bytes(50706, {1, 4, 0, 0}));  // DNGVersion
-  e.push_back(bytes(50707, {1, 1, 0, 0}));  // DNGBackwardVersion
+  e.push_back(bytes(50706, {1, 4, 0, 0}));            // DNGVersion
+  e.push_back(bytes(50707, {1, 1, 0, 0}));            // DNGBackwardVersion
   const std::string camera = (d.meta.make + " " + d.meta.model);
   e.push_back(ascii(50708, camera == " " ? std::string("iblkit lab") : camera));  // UniqueCameraModel
-  e.push_back(longs(50714, {static_cast<uint32_t>(d.black)}));                   // BlackLevel
-  e.push_back(longs(50717, {static_cast<uint32_t>(d.white)}));                   // WhiteLevel
-  e.push_back(srationals(50721, d.color_matrix));                                // ColorMatrix1
+  e.push_back(longs(50714, {static_cast<uint32_t>(d.black)}));                    // BlackLevel
+  e.push_back(longs(50717, {static_cast<uint32_t>(d.white)}));                    // WhiteLevel
+  e.push_back(srationals(50721, d.color_matrix));                                 // ColorMatrix1
   e.push_back(rationals(50728, {d.as_shot_neutral[0], d.as_shot_neutral[1], d.as_shot_neutral[2]}));
   e.push_back(shorts(50778, {21}));  // CalibrationIlluminant1: D65
   std::sort(e.begin(), e.end(), [](const Entry& a, const Entry& b) { return a.tag < b.tag; });

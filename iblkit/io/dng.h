@@ -14,16 +14,21 @@
 namespace ibl::io {
 
 struct DngDesc {
-  int width = 0, height = 0;   // even, so that the 2×2 pattern tiles the image
-  std::vector<uint16_t> cfa;   // width × height sensor values, row-major; RGGB: (0,0) red, (1,0) and (0,1) green
-  int black = 0, white = 0;    // BlackLevel and WhiteLevel; 0 <= black < white <= 65535
+  int width = 0, height = 0;  // even, so that the 2×2 pattern tiles the image
+  // The sensor values, row-major: with `mosaic` width × height of an RGGB Bayer pattern ((0,0) red, (1,0) and
+  // (0,1) green); else LinearRaw, 3 a pixel (R, G, B interleaved).
+  std::vector<uint16_t> cfa;
+  bool mosaic = true;
+  int black = 0, white = 0;  // BlackLevel and WhiteLevel; 0 <= black < white <= 65535
   // AsShotNeutral: the camera's raw values of a neutral (white-balance multipliers are their inverses).
   std::array<double, 3> as_shot_neutral{1, 1, 1};
   // ColorMatrix1 (XYZ -> camera, row-major), under CalibrationIlluminant1 D65. Default: the inverse of
   // linear sRGB's (Rec. 709 primaries, D65) RGB -> XYZ, so a camera whose channels are linear sRGB's.
   std::array<double, 9> color_matrix{3.2404542, -1.5371385, -0.4985314, -0.9692660, 1.8760108,
                                      0.0415560, 0.0556434,  -0.2040259, 1.0572252};
-  PhotoMeta meta;  // exposure time, f-number, ISO, make, model (the other attributes are not written)
+  // Exposure time, f-number, ISO, make, model, and of the other attributes the lens's Exif ones
+  // (Exif:FocalLength, Exif:FocalPlaneX/YResolution, Exif:FocalPlaneResolutionUnit, Exif:FocalLengthIn35mmFilm).
+  PhotoMeta meta;
 };
 
 // Writes the DNG through an AtomicFile; throws ibl::Error naming the file (sizes, levels, a value above

@@ -112,6 +112,59 @@ TEST(Dng, LibRawReadsTheSensorLevelsWhiteBalanceAndExif) {
   fs::remove_all(d);
 }
 
+TEST(Dng, LinearRawComesBackToTheQuantisation) {
+  // Without a mosaic nothing is interpolated: every unclipped value is X · gain / 0.8 to 14-bit steps.
+  const fs::path d = temp_dir("linear");
+  const Image L = smooth_radiance(64, 32);
+  capture::SensorDesc s;
+  s.wb_gains = {1.1, 1.0, 0.8};
+  const std::string path = (d / "l.dng").string();
+  write_dng(path, capture::expose_dng(L, s, {.mosaic = false}, {0, 0, 0, "iblkit", "lab sensor"}));
+  const Photo p = read_photo(path);
+  EXPECT_EQ(p.raw.pattern, "LinearRaw");
+  double worst = 0;
+  for (int y = 0; y < 32; ++y)
+    for (int x = 0; x < 64; ++x)
+      for (int c = 0; c < 3; ++c) {
+        const double want = L.at(x, y, c) * s.wb_gains[c] / 0.8;
+        if (want < 0.05 || want > 0.95) continue;
+        worst = std::max(worst, std::abs(p.codes.at(x, y, c) - want));
+      }
+  EXPECT_LT(worst, 2.0 / 15871) << "LinearRaw values off by more than two sensor steps";
+  fs::remove_all(d);
+}
+
+// Where a row (or column) of channel c crosses `level` first, by linear interpolation, in pixel coordinates.
+double crossing(const Image& img, int c, int fixed, bool along_x, double level) {
+  const int n = along_x ? img.width() : img.height();
+  auto at = [&](int i) { return along_x ? img.at(i, fixed, c) : img.at(fixed, i, c); };
+  for (int i = 0; i + 1 < n; ++i)
+    if (at(i) < level && at(i + 1) >= level) return i + 0.5 + (level - at(i)) / (at(i + 1) - at(i));
+  return -1;
+}
+
+TEST(Dng, DecodedEdgesStayWhereTheyWere) {
+  // The camera solve finds board corners in a raw backplate: LibRaw's demosaicing must not shift an edge. A soft
+  // step across and one down, through the sensor (OLPF and mosaic) and back, against the same step after the OLPF.
+  const fs::path d = temp_dir("edge");
+  Image L(128, 64, 3);
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 128; ++x) {
+      const double v =
+          0.05 + 0.5 / (1 + std::exp(-(x + 0.5 - 60.3) / 1.5)) + 0.3 / (1 + std::exp(-(y + 0.5 - 30.7) / 1.5));
+      L.set_rgb(x, y, {v, v, v});
+    }
+  const std::string path = (d / "edge.dng").string();
+  write_dng(path, capture::expose_dng(L, {}, {}, {0, 0, 0, "iblkit", "lab sensor"}));
+  const Photo p = read_photo(path);
+  const Image want = capture::olpf_blur(L);
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(crossing(p.codes, c, 10, true, 0.30), crossing(want, c, 10, true, 0.30), 0.05) << "channel " << c;
+    EXPECT_NEAR(crossing(p.codes, c, 100, false, 0.70), crossing(want, c, 100, false, 0.70), 0.05) << "channel " << c;
+  }
+  fs::remove_all(d);
+}
+
 TEST(Dng, RawBracketMergesWithinOnePercent) {
   // The RAW target: 5 exposures 2 EV apart, shot and read noise, merged with the linear response
   // (no curve), median relative error <= 1 % over channel values well exposed in some frame, after the

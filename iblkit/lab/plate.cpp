@@ -90,6 +90,8 @@ Plate shoot_plate(const Scene& base, const PlateDesc& d, const ProgressFn& progr
   }
   capture::validate(s);
   p.exposure_s = s.exposure_s;
+  p.sensor = s;
+  p.backplate_radiance = without.radiance;
   p.backplate = capture::expose(without.radiance, s);
   const float top = 1.0f - 0.5f / static_cast<float>((1 << s.bits) - 1);
   for (size_t i = 0; i < p.backplate.pixel_count(); ++i)
@@ -100,6 +102,7 @@ Plate shoot_plate(const Scene& base, const PlateDesc& d, const ProgressFn& progr
   const int object = add_object(with, "object", d.object, d.albedo);
   with.build();
   View v = view(with, 0.5, 0.5);
+  p.truth_radiance = v.radiance;
   p.truth = capture::expose(v.radiance, s);  // the same seed: the same noise where the light is the same
   p.truth_mask = Image(cam.width, cam.height, 1);
   for (int y = 0; y < cam.height; ++y)

@@ -37,6 +37,10 @@ struct Plate {
   Image truth;            // the same with the object (empty without one)
   Image truth_mask;       // one channel: 1 where the pixel centre sees the object
   double exposure_s = 0;  // the exposure used
+  // The light on the sensor (before it: the radiance as the lens forms it) and the sensor with the exposure
+  // used, for a raw file of the same shot (capture::expose_dng).
+  Image backplate_radiance, truth_radiance;
+  capture::SensorDesc sensor;
   int64_t saturated = 0;  // backplate pixels with a channel at the top code
 };
 

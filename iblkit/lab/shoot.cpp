@@ -178,7 +178,10 @@ std::vector<BracketFrame> bracket(const Image& radiance, const BracketDesc& desc
     capture::SensorDesc s = desc.sensor;
     s.exposure_s = f.exposure_s;
     s.seed = desc.sensor.seed + k;
-    f.codes = capture::expose(moved, s);
+    if (desc.raw)
+      f.raw = capture::expose_dng(moved, s, *desc.raw, {});
+    else
+      f.codes = capture::expose(moved, s);
     frames.push_back(std::move(f));
   }
   return frames;

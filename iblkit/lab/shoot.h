@@ -8,6 +8,7 @@
 // see the scene. The ball itself is not in the scene (it casts no shadow and is not seen in the room),
 // so the lab's probe at its centre (ground_truth) is the exact answer.
 #pragma once
+#include <optional>
 #include <vector>
 
 #include "iblkit/capture/ball.h"
@@ -56,10 +57,13 @@ struct BracketDesc {
   std::vector<double> exposures_s;  // seconds, one per frame
   capture::SensorDesc sensor;       // f-number, ISO, response, noise, vignetting, white balance, bits
   int shift_px = 0;                 // hand-held shift bound, pixels (0: a tripod)
+  // Raw frames: each frame's sensor values (capture::expose_dng) instead of code values.
+  std::optional<capture::RawSensor> raw;
 };
 
 struct BracketFrame {
-  Image codes;         // code values in [0, 1], 3 channels
+  Image codes;         // code values in [0, 1], 3 channels (empty for a raw frame)
+  io::DngDesc raw;     // a raw frame (BracketDesc::raw): the sensor's values, levels and exposure
   double exposure_s;   // this frame's exposure time
   int dx = 0, dy = 0;  // its shift: frame pixel (x, y) shows the scene's (x − dx, y − dy)
 };
