@@ -58,5 +58,22 @@ check solve-exif ok "fixed \(Exif FocalLength" -- "$BIN" camera solve "$T/set/ba
 check solve-exif-contradicts fail "drop --fov, or give --no-exif" -- "$BIN" camera solve "$T/set/backplate.jpg" \
   --board checker:7x4:0.1 --board-origin "$O" --fov 40 --out "$T/x4.json"
 
+# The same set shot as raw files (DNG): the chain merges them linearly, reads the lens from their Exif, and writes
+# the composite as a 16-bit linear TIFF; a raw composite is refused.
+if [ -f "$(dirname "$BIN")/libiblkit_raw.so" ]; then
+  check raw-shoot ok "8 dng frames|dng frames" -- "$BIN" "${SHOOT[@]}" --format dng --out "$T/raw"
+  check raw-chain ok "response  linear \(raw files\)" -- "$BIN" composite --capture "$T/raw" --out "$T/raw/composite.tif" \
+    --samples 32 --object-samples 256
+  check raw-chain-lens ok "Exif FocalLength" -- "$BIN" composite --capture "$T/raw" --out "$T/raw/c2.jpg" \
+    --samples 32 --object-samples 256
+  if command -v iinfo > /dev/null; then
+    check raw-composite-16bit ok "uint16 tiff" -- iinfo "$T/raw/composite.tif"
+  fi
+  check raw-out-refused fail "iblkit writes no raw files" -- "$BIN" composite --capture "$T/raw" --out "$T/raw/x7.dng"
+  check raw-nothing-written ok "^none$" -- sh -c "ls '$T/raw' | grep '^x[0-9]' || echo none"
+else
+  echo "SKIP raw set: built without LibRaw (scripts/install-deps installs libraw-dev)"
+fi
+
 echo "cli_capture: $pass passed, $fail failed"
 [ $fail -eq 0 ]

@@ -36,5 +36,24 @@ fi
 check nothing-written ok "^none$" -- sh -c "ls '$T' | grep '^x[0-46]' || echo none"
 check bad-grey-card fail "grey-card" -- "$BIN" hdr merge "$T"/b-?.jpg --out "$T/x7.exr" --grey-card 1,2,3
 
+# Raw brackets (LibRaw, the raw plugin): the lab's DNGs merge linearly with their levels reported; a curve is
+# refused; a raw file LibRaw cannot read, or one cut short, fails naming it; nothing written.
+if [ -f "$(dirname "$BIN")/libiblkit_raw.so" ]; then
+  check raw-bracket ok "wrote .*/r-2.dng" -- "$BIN" hdr bracket "$PROBE" -o "$T/r" --format dng --exposures 1/16,1/2,4
+  check raw-merge ok "raw +RGGB black 512 white 16383" -- "$BIN" hdr merge "$T"/r-?.dng --out "$T/mr.exr"
+  check raw-merge-json ok '"response": ?"linear"' -- "$BIN" --json hdr merge "$T"/r-?.dng --out "$T/mr2.exr"
+  check raw-curve fail "r-0.dng: a raw file is linear .*drop --response srgb" -- \
+    "$BIN" hdr merge "$T"/r-?.dng --response srgb --out "$T/y1.exr"
+  echo "not a raw file" > "$T/junk.nef"
+  check raw-junk fail "junk.nef: not a raw file LibRaw can read" -- "$BIN" hdr merge "$T/junk.nef" "$T/r-1.dng" --out "$T/y2.exr"
+  head -c 300000 "$T/r-1.dng" > "$T/cut.dng"
+  check raw-cut fail "cut.dng: corrupt or truncated raw data" -- "$BIN" hdr merge "$T/r-0.dng" "$T/cut.dng" --out "$T/y3.exr"
+  check raw-mixed fail "b-0.jpg: a developed photograph, but .*r-0.dng is a raw file" -- \
+    "$BIN" hdr merge "$T/r-0.dng" "$T/b-0.jpg" --out "$T/y4.exr"
+  check raw-nothing-written ok "^none$" -- sh -c "ls '$T' | grep '^y[0-9]' || echo none"
+else
+  echo "SKIP raw brackets: built without LibRaw (scripts/install-deps installs libraw-dev)"
+fi
+
 echo "cli_hdr: $pass passed, $fail failed"
 [ $fail -eq 0 ]

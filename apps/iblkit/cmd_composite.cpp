@@ -19,6 +19,7 @@
 #include "iblkit/core/error.h"
 #include "iblkit/geometry/camera_io.h"
 #include "iblkit/geometry/mesh_io.h"
+#include "iblkit/io/dng.h"
 #include "iblkit/io/image_io.h"
 #include "iblkit/io/tonemap.h"
 #include "render_setup.h"
@@ -62,7 +63,25 @@ nlohmann::json errors_json(const ibl::augment::CompositeErrors& e) {
 
 nlohmann::json vec_json(Vec3 v) { return nlohmann::json::array({v.x, v.y, v.z}); }
 
+// The bit depth a photograph output gets: 8 for JPEG, else the backplate's own.
+int output_bits(const std::string& out, const ibl::capture::Backplate& plate) {
+  std::string ext = fs::path(out).extension().string();
+  for (char& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+  return ext == ".jpg" || ext == ".jpeg" ? 8 : plate.photo.bits;
+}
+
+// Before any work: a raw output is not written (no raw writer; the composite of a raw backplate is a 16-bit linear
+// TIFF, an 8-bit sRGB JPEG or an EXR).
+void refuse_raw_output(const std::string& out) {
+  if (ibl::io::is_raw_path(out))
+    ibl::fail(ibl::ErrorKind::Value,
+              "{}: iblkit writes no raw files: write the composite as .tif (16-bit, linear like the raw), .jpg (sRGB) "
+              "or .exr",
+              out);
+}
+
 void run(const Opts& o, const ibl::io::EnvReadDesc& read) {
+  refuse_raw_output(o.out);
   if (o.light.size() > 1) ibl::fail(ibl::ErrorKind::Value, "--light: give one light file");
   ibl::augment::CompositeJob job = o.job;
   job.backend = ibl::augment::parse_backend(o.backend);
@@ -101,9 +120,7 @@ void run(const Opts& o, const ibl::io::EnvReadDesc& read) {
   ibl::capture::BackplateReport br;
   const bool photo_out = plate.encoded && ibl::capture::is_photo_extension(o.out);
   if (photo_out) {  // back through the photograph's response, in its bit depth, with its metadata
-    std::string ext = fs::path(o.out).extension().string();
-    for (char& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
-    const int bits = ext == ".jpg" || ext == ".jpeg" ? 8 : plate.photo.bits;
+    const int bits = output_bits(o.out, plate);
     const ibl::Image codes = ibl::capture::encode_like(plate, r.composite, bits, &br);
     ibl::capture::write_like(o.out, plate, codes, bits, o.quality);
     if (br.saturated_darkened > 0)
@@ -194,6 +211,7 @@ void run(const Opts& o, const ibl::io::EnvReadDesc& read) {
 // composite --capture DIR: the chain from a capture folder (augment/capture_chain.h), and with the lab's truth in
 // the folder, its errors.
 void run_capture(const Opts& o) {
+  refuse_raw_output(o.out);
   ibl::augment::ChainDesc cd;
   cd.job = o.job;
   cd.job.backend = ibl::augment::parse_backend(o.backend);
@@ -211,7 +229,9 @@ void run_capture(const Opts& o) {
   const ibl::augment::CompositeResult& r = c.run.result;
   const ibl::geometry::Camera& cam = c.camera.camera;
   const bool photo_out = c.plate.encoded && ibl::capture::is_photo_extension(o.out);
-  if (photo_out)
+  if (photo_out && output_bits(o.out, c.plate) != c.plate.photo.bits)  // a 16-bit (or raw) backplate out as a JPEG
+    ibl::capture::write_like(o.out, c.plate, ibl::capture::encode_like(c.plate, r.composite, 8), 8, o.quality);
+  else if (photo_out)
     ibl::capture::write_like(o.out, c.plate, c.codes, 0, o.quality);
   else
     ibl::io::write_image(o.out, r.composite);
