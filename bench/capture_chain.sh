@@ -7,7 +7,8 @@
 # lab's exact probe at the ball's centre and the exact camera (what the chain would reach with a perfect probe).
 # Prints one line per case: camera error, reprojection, object / shadow / unchanged errors, wall time.
 #
-# Usage: bench/capture_chain.sh [BUILD/iblkit] [OUT]   (PLATE_SAMPLES=8: n×n rays per backplate pixel; TRUTH is
+# Usage: bench/capture_chain.sh [BUILD/iblkit] [OUT]   (FORMATS="jpg tif dng": the sets to shoot (dng: raw files,
+# linear, so no recovered curve; composites written as 16-bit TIFF); PLATE_SAMPLES=8: n×n rays per backplate pixel; TRUTH is
 # the same photograph with the object, so its noise is the backplate's, but its path-traced grain is its own)
 set -eu
 BIN=$(readlink -f "${1:-build/iblkit}")
@@ -27,7 +28,9 @@ print("%s: %sobject %.1f %%, shadow %.1f %% of a %.0f %% signal, unchanged %.2f 
     sys.argv[3]))
 PY
 }
-for fmt in jpg tif; do
+for fmt in ${FORMATS:-jpg tif dng}; do
+  out_ext=$fmt response=response.json modes="camera recovered"
+  [ "$fmt" = dng ] && out_ext=tif response=linear modes=camera
   set_dir="$OUT/set_$fmt"
   rm -rf "$set_dir"
   t0=$(date +%s.%N)
@@ -36,19 +39,19 @@ for fmt in jpg tif; do
     --plate-samples "$PS" --format "$fmt" --out "$set_dir" > /dev/null
   t1=$(date +%s.%N)
   echo "shoot ($fmt): $(printf '%.1f' "$(echo "$t1 - $t0" | bc)") s"
-  for mode in camera recovered; do
+  for mode in $modes; do
     extra=()
     [ "$mode" = recovered ] && extra=(--recover-response)
     t0=$(date +%s.%N)
-    "$BIN" --quiet --json composite --capture "$set_dir" --out "$set_dir/composite_$mode.$fmt" "${extra[@]}" \
+    "$BIN" --quiet --json composite --capture "$set_dir" --out "$set_dir/composite_$mode.$out_ext" "${extra[@]}" \
       > "$set_dir/chain_$mode.json"
     t1=$(date +%s.%N)
     summary "$set_dir/chain_$mode.json" "$fmt, $mode curve" "$(printf '%.1f' "$(echo "$t1 - $t0" | bc)")"
   done
   t0=$(date +%s.%N)
   (cd "$set_dir" && "$BIN" --quiet --json composite "backplate.$fmt" --camera camera_truth.json --light truth.exr \
-    --at-probe 0,0.15,0 --proxy proxy.obj --at 0,0.161,0 --response response.json --truth "truth.$fmt" \
-    --out "exact.$fmt" > exact.json)
+    --at-probe 0,0.15,0 --proxy proxy.obj --at 0,0.161,0 --response "$response" --truth "truth.$fmt" \
+    --out "exact.$out_ext" > exact.json)
   t1=$(date +%s.%N)
   summary "$set_dir/exact.json" "$fmt, the lab's exact probe and camera" "$(printf '%.1f' "$(echo "$t1 - $t0" | bc)")"
 done
