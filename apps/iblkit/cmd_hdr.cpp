@@ -17,7 +17,7 @@ namespace {
 struct MergeOpts {
   std::vector<std::string> inputs;
   std::string out, exposures, response, method = "debevec", response_out, grey_card;
-  double scale = 1, reflectance = 0.18;
+  double scale = 1, reflectance = 0.18, smoothness = ibl::capture::RecoverDesc{}.smoothness;
   bool no_align = false, full_float = false;
 };
 
@@ -102,6 +102,10 @@ void setup(CLI::App& app) {
       ->check(CLI::IsMember({"debevec", "robertson"}))
       ->capture_default_str();
   m->add_option("--response-out", o->response_out, "write the curve used (iblkit.response/1)");
+  m->add_option("--smoothness", o->smoothness,
+                "Debevec's smoothness weight kappa (lambda^2 = kappa x data rows per bin; docs/capture.md)")
+      ->check(CLI::Range(1e-4, 1e4))
+      ->capture_default_str();
   m->add_flag("--no-align", o->no_align, "no translation alignment (Ward's median threshold bitmaps)");
   m->add_option("--scale", o->scale, "multiply the result (after --grey-card)")->capture_default_str();
   m->add_option("--grey-card", o->grey_card,
@@ -119,6 +123,7 @@ void setup(CLI::App& app) {
     ibl::capture::MergeDesc md;
     if (!o->response.empty()) md.response = ibl::capture::response_by_name(o->response);
     md.method = o->method;
+    md.recover.smoothness = o->smoothness;
     md.align = !o->no_align;
     md.scale = o->scale;
     md.reflectance = o->reflectance;

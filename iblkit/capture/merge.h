@@ -37,7 +37,7 @@ double hat_weight(double z);
 struct RecoverDesc {
   int bins = 256;         // table size of the recovered curve
   int samples = 16384;    // pixels sampled for Debevec: one per cell of a 128 × 128 grid
-  double smoothness = 1;  // κ: λ² = κ · (data rows per bin) (docs/capture.md)
+  double smoothness = 5;  // κ: λ² = κ · (data rows per bin); 5 chosen on held-out probes (docs/capture.md)
 };
 // Debevec & Malik: least squares for g = ln(inverse) with a second-difference smoothness term.
 Response recover_debevec(const std::vector<Frame>& frames, const RecoverDesc& desc = {});

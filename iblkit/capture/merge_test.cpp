@@ -123,7 +123,11 @@ TEST(HdrMerge, DebevecRecoversTheCameraCurveAndTheRadiance) {
   const Image m = merge_hdr(frames, d, &rep);
   double s = 1;
   const double ce = curve_error(rep.response, truth, &s);
-  EXPECT_LT(ce, kCurveTol);
+  // 2.65 % at the default smoothness (κ = 5, chosen on 14 held-out probe brackets, JPEG and PNG:
+  // bench/hdr_smoothness_cv.py), which bends this curve's shoulder a little more than κ = 1 did (1.7 %) while it
+  // takes the JPEG benchmark from 6.25 % to 4.52 % and the PNG one from 1.16 % to 0.84 %.
+  constexpr double kCameraCurveTol = 0.03;
+  EXPECT_LT(ce, kCameraCurveTol);
   const double me = merge_error(m, L, s);
   EXPECT_LT(me, kMergeTol);
   std::printf("debevec camera curve: curve error %.4f, merge error %.4f, scale %.4f, noise %.4f, DR %.2f stops\n", ce,
@@ -158,8 +162,8 @@ TEST(HdrMerge, RobertsonRecoversTheCameraCurve) {
   const double me = merge_error(m, L, s);
   std::printf("robertson camera curve: curve error %.4f, merge error %.4f\n", ce, me);
   // Robertson's iteration has no smoothness term: on a bracket of one constant ratio it drifts from its
-  // start (Debevec's curve, 1.8 % here) along the ratio's ambiguity; measured 3.1 % (docs/capture.md).
-  constexpr double kRobertsonCurveTol = 0.04;
+  // start (Debevec's curve, 2.65 % here) along the ratio's ambiguity (docs/capture.md).
+  constexpr double kRobertsonCurveTol = 0.05;  // 4.2 % from Debevec's curve at κ = 5 (3.0 % from κ = 1's)
   EXPECT_LT(ce, kRobertsonCurveTol);
   EXPECT_LT(me, kMergeTol);
   EXPECT_EQ(rep.response.kind, "robertson");
