@@ -10,6 +10,9 @@
 # Usage: bench/capture_chain.sh [BUILD/iblkit] [OUT]   (FORMATS="jpg tif dng": the sets to shoot (dng: raw files,
 # linear, so no recovered curve; composites written as 16-bit TIFF); PLATE_SAMPLES=8: n×n rays per backplate pixel; TRUTH is
 # the same photograph with the object, so its noise is the backplate's, but its path-traced grain is its own)
+# NOISE=1 also shoots the backplate and truth again with render seed 2 at the first one's exposure and prints the
+# truth's own noise: what a composite that is right on average would score against this truth (the second seed's
+# difference truth − backplate against the first's, over √2; the same classes of pixels; docs/capture.md).
 set -eu
 BIN=$(readlink -f "${1:-build/iblkit}")
 OUT=${2:-/tmp/iblkit_capture_chain}
@@ -54,4 +57,37 @@ for fmt in ${FORMATS:-jpg tif dng}; do
     --out "exact.$out_ext" > exact.json)
   t1=$(date +%s.%N)
   summary "$set_dir/exact.json" "$fmt, the lab's exact probe and camera" "$(printf '%.1f' "$(echo "$t1 - $t0" | bc)")"
+  [ "${NOISE:-0}" = 1 ] || continue
+  exposure=$(/usr/bin/python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['backplate']['exposure_s'])" \
+    "$set_dir/shoot.json")
+  rm -rf "${set_dir}_seed2"
+  "$BIN" --quiet lab shoot low-scene2 --at 0,0.15,0 --two-sides --distance-radii 10 --width 384 --height 384 \
+    --samples 4 --bracket 12 --until-unsaturated --ev-step 3 --bounces 1 --noise --wb 1.1,1,0.8 --backplate \
+    --plate-samples "$PS" --format "$fmt" --seed 2 --plate-exposure "$exposure" --out "${set_dir}_seed2" > /dev/null
+  /usr/bin/python3 - "$set_dir" "${set_dir}_seed2" "$fmt" <<'PY'
+import json, os, sys
+os.environ["OPENCV_IO_ENABLE_OPENEXR"] = "1"
+import cv2, numpy as np
+a, b, fmt = sys.argv[1:4]
+resp = json.load(open(os.path.join(a, "response.json")))
+curve = [np.asarray(c, dtype=np.float64) for c in resp["channels"]]
+def linear(folder, name):  # code values through the camera's curve (iblkit.response/1), RGB
+    im = cv2.imread(os.path.join(folder, name), cv2.IMREAD_UNCHANGED)[..., ::-1]
+    code = im / (255.0 if im.dtype == np.uint8 else 65535.0)
+    x = np.linspace(0, 1, len(curve[0]))
+    return np.stack([np.interp(code[..., c], x, curve[c]) for c in range(3)], -1)
+P1, T1 = linear(a, "backplate." + fmt), linear(a, "truth." + fmt)
+P2, T2 = linear(b, "backplate." + fmt), linear(b, "truth." + fmt)
+mask = cv2.imread(os.path.join(a, "truth_mask.png"), cv2.IMREAD_GRAYSCALE) > 127
+lum = lambda x: x @ np.array([0.2125, 0.7154, 0.0721])
+l1 = lambda x: np.abs(x).sum(-1)
+box = lambda y: cv2.blur(y, (3, 3), borderType=cv2.BORDER_REPLICATE)  # augment/measure.cpp's 3×3 classification
+yp, yt = box(lum(P1)), box(lum(T1))
+shadow = ~mask & (yp - yt > 0.02 * yp)
+unchanged = ~mask & ~shadow & ~(yt - yp > 0.02 * yp)
+D1, D2, r2 = T1 - P1, T2 - P2, np.sqrt(2)
+print("%s, the truth's own noise: object %.1f %%, shadow %.1f %%, unchanged %.2f %%" % (
+    fmt, 100 * l1(T1 - T2)[mask].sum() / r2 / l1(T1)[mask].sum(), 100 * l1(D1 - D2)[shadow].sum() / r2 / l1(D1)[shadow].sum(),
+    100 * l1(D1 - D2)[unchanged].sum() / r2 / l1(T1)[unchanged].sum()))
+PY
 done
