@@ -10,6 +10,8 @@
 # Usage: bench/capture_chain.sh [BUILD/iblkit] [OUT]   (FORMATS="jpg tif dng": the sets to shoot (dng: raw files,
 # linear, so no recovered curve; composites written as 16-bit TIFF); PLATE_SAMPLES=8: n×n rays per backplate pixel; TRUTH is
 # the same photograph with the object, so its noise is the backplate's, but its path-traced grain is its own)
+# BOUNCES=1: the lab's indirect bounces for the ball, the backplate and the truth (with one, the truth's object is not lit
+# by the floor under it, so it sends none of that light into its shadow, which the compositor's object does).
 # NOISE=1 also shoots the backplate and truth again with render seed 2 at the first one's exposure and prints the
 # truth's own noise: what a composite that is right on average would score against this truth (the second seed's
 # difference truth − backplate against the first's, over √2; the same classes of pixels; docs/capture.md).
@@ -17,6 +19,7 @@ set -eu
 BIN=$(readlink -f "${1:-build/iblkit}")
 OUT=${2:-/tmp/iblkit_capture_chain}
 PS=${PLATE_SAMPLES:-8}
+B=${BOUNCES:-1}
 mkdir -p "$OUT"
 summary() {  # the chain's JSON -> one line
   /usr/bin/python3 - "$1" "$2" "$3" <<'PY'
@@ -38,7 +41,7 @@ for fmt in ${FORMATS:-jpg tif dng}; do
   rm -rf "$set_dir"
   t0=$(date +%s.%N)
   "$BIN" --quiet lab shoot low-scene2 --at 0,0.15,0 --two-sides --distance-radii 10 --width 384 --height 384 \
-    --samples 4 --bracket 12 --until-unsaturated --ev-step 3 --bounces 1 --noise --wb 1.1,1,0.8 --backplate \
+    --samples 4 --bracket 12 --until-unsaturated --ev-step 3 --bounces "$B" --noise --wb 1.1,1,0.8 --backplate \
     --plate-samples "$PS" --format "$fmt" --out "$set_dir" > /dev/null
   t1=$(date +%s.%N)
   echo "shoot ($fmt): $(printf '%.1f' "$(echo "$t1 - $t0" | bc)") s"
@@ -62,7 +65,7 @@ for fmt in ${FORMATS:-jpg tif dng}; do
     "$set_dir/shoot.json")
   rm -rf "${set_dir}_seed2"
   "$BIN" --quiet lab shoot low-scene2 --at 0,0.15,0 --two-sides --distance-radii 10 --width 384 --height 384 \
-    --samples 4 --bracket 12 --until-unsaturated --ev-step 3 --bounces 1 --noise --wb 1.1,1,0.8 --backplate \
+    --samples 4 --bracket 12 --until-unsaturated --ev-step 3 --bounces "$B" --noise --wb 1.1,1,0.8 --backplate \
     --plate-samples "$PS" --format "$fmt" --seed 2 --plate-exposure "$exposure" --out "${set_dir}_seed2" > /dev/null
   /usr/bin/python3 - "$set_dir" "${set_dir}_seed2" "$fmt" <<'PY'
 import json, os, sys
