@@ -33,7 +33,10 @@ if command -v oiiotool > /dev/null; then
 else
   echo "SKIP all-saturated: oiiotool missing"
 fi
-check nothing-written ok "^none$" -- sh -c "ls '$T' | grep '^x[0-46]' || echo none"
+"$BIN" hdr bracket "$PROBE" -o "$T/t16" --format tif --bits 16 --response camera --exposures 1/16,1/2,4 > /dev/null
+check curve-too-shallow fail "t16-0.tif: a 16-bit photograph, but the curve .*c.json has 256 code values" -- \
+  "$BIN" hdr merge "$T"/t16-?.tif --exposures 1/16,1/2,4 --response "$T/c.json" --out "$T/x8.exr"
+check nothing-written ok "^none$" -- sh -c "ls '$T' | grep '^x[0-468]' || echo none"
 check bad-grey-card fail "grey-card" -- "$BIN" hdr merge "$T"/b-?.jpg --out "$T/x7.exr" --grey-card 1,2,3
 
 # Raw brackets (LibRaw, the raw plugin): the lab's DNGs merge linearly with their levels reported; a curve is

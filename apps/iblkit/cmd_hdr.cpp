@@ -133,6 +133,7 @@ void setup(CLI::App& app) {
       md.grey_card = std::array<int, 4>{v[0], v[1], v[2], v[3]};
     }
     const auto bracket = ibl::capture::read_bracket(o->inputs, bd);
+    if (md.response && !bracket.linear) ibl::capture::check_fits(*md.response, bracket.bits, o->inputs[0], o->response);
     if (bracket.linear) {
       // Raw files are linear in the light: no curve to recover or apply.
       if (!o->response.empty() && o->response != "linear")

@@ -89,6 +89,8 @@ ChainResult run_capture(const capture::CaptureFolder& f, const ChainDesc& d) {
   }
   progress("merge", 0);
   out.response = chain_response(f, brackets[0], d.recover_response, &out.response_source);
+  for (const auto& b : brackets)
+    if (!b.linear) capture::check_fits(out.response, b.bits, b.frames.at(0).name, out.response_source);
   std::vector<capture::BallView> views;
   for (size_t k = 0; k < f.views.size(); ++k) {
     capture::MergeDesc md;
@@ -127,6 +129,8 @@ ChainResult run_capture(const capture::CaptureFolder& f, const ChainDesc& d) {
   // 3. The backplate through the same curve, and its camera from the board.
   progress("camera", 0.25);
   out.plate = capture::read_backplate(f.at(f.backplate), out.response);
+  if (out.plate.encoded && !out.plate.photo.linear)
+    capture::check_fits(out.response, out.plate.photo.bits, f.at(f.backplate), out.response_source);
   capture::LensMode mode;
   const geometry::Camera lens = chain_lens(f, out.plate, d.exif_lens, &mode, &out.lens_source);
   auto pts = capture::find_board(out.plate.linear, f.board);

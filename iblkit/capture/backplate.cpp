@@ -78,9 +78,11 @@ Backplate read_with(const std::string& path, const Pick& pick) {
 
 Backplate read_backplate(const std::string& path, const std::string& response) {
   const bool raw = io::is_raw_path(path);
-  return read_with(path, [&](bool encoded) {
+  Backplate b = read_with(path, [&](bool encoded) {
     return response_by_name(response.empty() ? (encoded && !raw ? "srgb" : "linear") : response);
   });
+  if (b.encoded && !response.empty()) check_fits(b.response, b.photo.bits, path, response);
+  return b;
 }
 
 Backplate read_backplate(const std::string& path, const Response& response) {

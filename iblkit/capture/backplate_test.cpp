@@ -114,5 +114,29 @@ TEST(Backplate, ALinearResponseAndAFloatFileAndBadInput) {
   EXPECT_THROW(encode_like(lin, Image(3, 3, 3)), Error);  // not the backplate's size
 }
 
+TEST(Backplate, ACurveOfFewerCodesThanThePhotographIsRefused) {
+  // A curve recovered from 8-bit codes (256 values) says nothing between them: refused for a 16-bit photograph,
+  // taken for an 8-bit one; the analytic curves fit any depth.
+  Fixture f;
+  const std::string tif = (f.dir / "in16.tif").string(), png = (f.dir / "in8.png").string();
+  io::write_photo(tif, f.codes, 16, f.meta);
+  io::write_photo(png, f.codes, 8, f.meta);
+  Response r = srgb_response(256);
+  r.kind = "debevec";
+  const std::string curve = (f.dir / "curve8.json").string();
+  write_response(curve, r);
+  try {
+    read_backplate(tif, curve);
+    FAIL() << "a 256-code curve taken for a 16-bit photograph";
+  } catch (const Error& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("in16.tif: a 16-bit photograph, but the curve"), std::string::npos) << m;
+    EXPECT_NE(m.find("256 code values (a 8-bit camera's)"), std::string::npos) << m;
+  }
+  EXPECT_NO_THROW(read_backplate(png, curve));
+  EXPECT_NO_THROW(read_backplate(tif, "srgb"));
+  EXPECT_NO_THROW(check_fits(srgb_response(256), 16, "x.tif", "srgb"));  // analytic: any depth
+}
+
 }  // namespace
 }  // namespace ibl::capture

@@ -127,4 +127,14 @@ void write_response(const std::string& path, const Response& r) {
   write_json_file(path, j, -1);
 }
 
+void check_fits(const Response& r, int bits, const std::string& photo, const std::string& curve) {
+  if (r.kind == "linear" || r.kind == "srgb" || r.kind == "camera") return;
+  const int64_t codes = int64_t(1) << bits;
+  if (r.size() >= codes) return;
+  fail(ErrorKind::Value,
+       "{}: a {}-bit photograph, but the curve {} has {} code values (a {}-bit camera's): recover one from {}-bit "
+       "brackets (hdr merge --response-out), or give srgb, linear or camera",
+       photo, bits, curve, r.size(), static_cast<int>(std::lround(std::log2(std::max(r.size() - 1, 1)))), bits);
+}
+
 }  // namespace ibl::capture

@@ -39,6 +39,11 @@ Response camera_response(double contrast = 0.8, double mid_stops = -2.5, int siz
 // "linear", "srgb", "camera", or else the path of an iblkit.response/1 file.
 Response response_by_name(const std::string& name_or_file);
 
+// Throws ibl::Error (one line naming the photograph and the curve) when a measured curve (kind debevec, robertson or
+// file; the analytic linear, srgb and camera tables fit any depth) has fewer code values than a `bits`-bit
+// photograph: it was recovered from a shallower camera's codes and says nothing between them.
+void check_fits(const Response& r, int bits, const std::string& photo, const std::string& curve);
+
 // iblkit.response/1 (docs/formats.md). read_response throws ibl::Error naming the file.
 Response read_response(const std::string& path);
 void write_response(const std::string& path, const Response& r);
