@@ -411,6 +411,9 @@ void setup(CLI::App& app) {
   app.add_flag(
       "--no-shadows", [o](int64_t) { o->job.desc.shadows = false; },
       "baseline: the object pasted without its shadow and light on the scene");
+  app.add_flag(
+      "--no-self-light", [o](int64_t) { o->job.desc.self_light = false; },
+      "leave out the object's light on itself (CPU; one bounce of it by default; GL never has it)");
   app.add_option("--backend", o->backend,
                  "cpu (the ray-traced reference), gl (OpenGL: shadow maps and a soft sphere term), auto (gl "
                  "when a GL context can be made)")

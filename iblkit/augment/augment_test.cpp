@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <random>
 #include <vector>
@@ -318,6 +319,68 @@ TEST(AugmentComposite, WhiteObjectInTheWhiteFurnaceSendsBackWhatItBlocks) {
   dn /= n;
   EXPECT_LT(dn, -0.1 * kL);                     // the shadow alone: more than a tenth of the light gone
   EXPECT_LT(std::abs(dw), 0.3 * std::abs(dn));  // the bounce gives most of it back
+}
+
+// The inside of a hemispherical bowl of radius r centred at c, opening up (+Y), its triangles facing its centre.
+geometry::TriMesh bowl(Vec3 c, double r, int rings = 24, int segments = 48) {
+  geometry::TriMesh m;
+  for (int i = 0; i <= rings; ++i) {
+    const double theta = 0.5 * kPi * i / rings;  // 0 at the bottom, π/2 at the rim
+    for (int j = 0; j < segments; ++j) {
+      const double phi = 2 * kPi * j / segments;
+      m.positions.push_back(
+          c + Vec3{r * std::sin(theta) * std::cos(phi), -r * std::cos(theta), r * std::sin(theta) * std::sin(phi)});
+    }
+  }
+  auto at = [&](int i, int j) { return static_cast<uint32_t>(i * segments + (j % segments)); };
+  for (int i = 0; i < rings; ++i)
+    for (int j = 0; j < segments; ++j) {
+      std::array<uint32_t, 3> t1{at(i, j), at(i + 1, j), at(i + 1, j + 1)},
+          t2{at(i, j), at(i + 1, j + 1), at(i, j + 1)};
+      for (auto t : {t1, t2}) {
+        if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) continue;
+        m.triangles.push_back(t);
+        const size_t k = m.triangles.size() - 1;
+        const Vec3 centroid = (m.positions[t[0]] + m.positions[t[1]] + m.positions[t[2]]) / 3.0;
+        if (dot(m.normal(k), c - centroid) < 0) std::swap(m.triangles[k][1], m.triangles[k][2]);
+      }
+    }
+  return m;
+}
+
+TEST(AugmentComposite, TheObjectLightsItselfOnceInABowl) {
+  // Closed form: every point inside a spherical surface sees any part of it with a view factor proportional to that
+  // part's area, so from any point of a hemispherical bowl half the cosine-weighted hemisphere leaves through the
+  // opening (to a constant sky L) and half meets the bowl. Its direct radiance is ρL/2 everywhere; one bounce of it
+  // on itself adds ρ·(ρL/2)/2: L_bowl = ρL/2 + ρ²L/4 (0.39 L against 0.30 L for ρ = 0.6).
+  constexpr double kL = 1.0, kRho = 0.6;
+  Image photo = constant_photo(kFloorAlbedo);
+  auto sky = constant_sky({kL, kL, kL}, {0, 1.2, 0});
+  CompositeDesc d;
+  d.object_samples = 2048;
+  d.triangle_samples = 256;
+  const geometry::TriMesh obj = bowl({0, 0.9, 0}, 0.6);
+  const auto with = composite(photo, top_camera(), floor_mesh(), sky, obj, Vec3{kRho, kRho, kRho}, d);
+  d.self_light = false;
+  const auto without = composite(photo, top_camera(), floor_mesh(), sky, obj, Vec3{kRho, kRho, kRho}, d);
+  // Pixels seeing the bowl's inside within 0.4 m of its axis (seen from above: away from the rim).
+  double w = 0, wo = 0;
+  int n = 0;
+  for (int k = 0; k < 25; ++k) {
+    auto [px, py] = pixel_of(0.08 * (k % 5 - 2) * 2, 0.08 * (k / 5 - 2) * 2);
+    if (with.mask.at(px, py, 0) < 1) continue;
+    w += with.composite.rgb(px, py).y;
+    wo += without.composite.rgb(px, py).y;
+    ++n;
+  }
+  ASSERT_GT(n, 15);
+  w /= n;
+  wo /= n;
+  std::printf("bowl: %.4f without its own light (closed form %.4f), %.4f with (%.4f)\n", wo, kRho * kL / 2, w,
+              kRho * kL / 2 + kRho * kRho * kL / 4);
+  EXPECT_NEAR(wo, kRho * kL / 2, 0.04 * kRho * kL / 2) << "direct light inside the bowl";
+  EXPECT_NEAR(w, kRho * kL / 2 + kRho * kRho * kL / 4, 0.04 * (kRho * kL / 2 + kRho * kRho * kL / 4))
+      << "with the bowl's light on itself";
 }
 
 TEST(AugmentComposite, BadInputFailsWithAClearMessage) {

@@ -85,9 +85,14 @@ PixelResult shade_pixel(const Shading& sh, int x, int y, Vec3 photo) {
       if (dot(normal, d) > 0) normal = -normal;
       Vec3 z = sh.cam.eye + d * h.t;
       Rng rng(stream_key(desc.seed, kStreamObject, pixel * 64 + static_cast<uint64_t>(ray)));
-      object_sum += object_radiance(t, z + normal * kRayEpsilon, normal, -d,
-                                    object_albedo(*t.object, sh.material, h.triangle, h.b1, h.b2), sh.material,
-                                    sh.object_samples_per_ray, rng);
+      const Vec3 rho = object_albedo(*t.object, sh.material, h.triangle, h.b1, h.b2);
+      object_sum +=
+          object_radiance(t, z + normal * kRayEpsilon, normal, -d, rho, sh.material, sh.object_samples_per_ray, rng);
+      if (desc.self_light)  // the object's own light on it: one bounce, its triangles' direct radiance
+        object_sum += rho *
+                      self_irradiance(t, sh.tri_radiance, z + normal * kRayEpsilon, normal,
+                                      std::max(16, sh.object_samples_per_ray / 4), rng) /
+                      kPi;
       ++object_hits;
     } else if (!have_proxy) {
       have_proxy = true;
@@ -131,7 +136,7 @@ PixelResult shade_pixel(const Shading& sh, int x, int y, Vec3 photo) {
 std::vector<Vec3> triangle_radiance(const Tracers& t, const render::Material& material, const CompositeDesc& desc) {
   const geometry::TriMesh& object = *t.object;
   std::vector<Vec3> radiance(object.triangle_count());
-  if (desc.bounce_samples == 0) return radiance;
+  if (desc.bounce_samples == 0 && !desc.self_light) return radiance;
   parallel_for(
       0, static_cast<int64_t>(object.triangle_count()),
       [&](int64_t ti) {

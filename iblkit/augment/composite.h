@@ -66,8 +66,11 @@ struct CompositeDesc {
   uint64_t seed = 1;           // random streams (same seed, same bytes)
   bool check_geometry = true;  // camera inside the proxy, object intersecting it: errors
   bool shadows = true;         // false: the object pasted without its shadow and light on the proxy (a baseline)
-  GlOptions gl;                // the real-time backend's own
-  ProgressFn progress;         // stages "object", "composite" (by rows)
+  // The object's light on itself (CPU): one bounce, its triangles' direct radiance seen from its own pixels; the GL
+  // backend leaves it out (docs/augment.md).
+  bool self_light = true;
+  GlOptions gl;         // the real-time backend's own
+  ProgressFn progress;  // stages "object", "composite" (by rows)
 };
 
 struct CompositeStats {

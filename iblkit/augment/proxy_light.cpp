@@ -70,6 +70,21 @@ Vec3 object_radiance(const Tracers& t, Vec3 z, Vec3 n, Vec3 v, Vec3 rho, const r
   return (rho * e / kPi + m.specular * g) / count;
 }
 
+Vec3 self_irradiance(const Tracers& t, const std::vector<Vec3>& tri_radiance, Vec3 z, Vec3 n, int count, Rng& rng) {
+  if (!t.object || tri_radiance.empty() || count <= 0) return {};
+  const Frame f = Frame::from_normal(n);
+  Vec3 sum;
+  for (int k = 0; k < count; ++k) {
+    const double u1 = rng.uniform(), u2 = rng.uniform(), r = std::sqrt(u1), phi = 2 * kPi * u2;
+    const Vec3 w = f.from_local({r * std::cos(phi), r * std::sin(phi), std::sqrt(std::max(0.0, 1 - u1))});
+    const geometry::Hit h = t.both_rt.intersect(z, w);
+    if (!h.hit || h.mesh != 1) continue;
+    if (dot(t.object->normal(h.triangle), w) >= 0) continue;  // a back face: its radiance is not the front's
+    sum += tri_radiance[h.triangle];
+  }
+  return sum * (kPi / count);
+}
+
 Vec3 object_albedo(const geometry::TriMesh& object, const render::Material& m, uint32_t tri, double b1, double b2) {
   if (!m.texture) return m.albedo;
   Vec2 uv{0, 0};

@@ -50,6 +50,11 @@ Vec3 irradiance(const Tracers& t, const geometry::RayTracer& rt, Vec3 x, Vec3 n,
 Vec3 object_radiance(const Tracers& t, Vec3 z, Vec3 n, Vec3 v, Vec3 rho, const render::Material& m, int count,
                      Rng& rng);
 
+// The object's light on itself at z (normal n): the irradiance from `count` cosine-weighted directions, each
+// that meets the object first (the proxy nearer hides it) on a triangle's front face taking that triangle's
+// radiance (tri_radiance: the object's direct light, so one bounce of it on itself). E = π/count · Σ L.
+Vec3 self_irradiance(const Tracers& t, const std::vector<Vec3>& tri_radiance, Vec3 z, Vec3 n, int count, Rng& rng);
+
 // The diffuse albedo at a point of object triangle `tri` with barycentrics b1, b2 (the texture at its UVs).
 Vec3 object_albedo(const geometry::TriMesh& object, const render::Material& m, uint32_t tri, double b1, double b2);
 

@@ -146,8 +146,9 @@ void init_augment(py::module_& m) {
       [](py::handle photo, ibl::geometry::Camera camera, const ibl::geometry::TriMesh& object, py::object probes,
          py::object light, py::object proxy, py::object at_probe, const std::string& probe_depth, py::handle albedo,
          int median_cut, int light_samples, int object_samples, int bounce_samples, int triangle_samples,
-         int pixel_samples, uint64_t seed, bool shadows, const std::string& backend, int gl_lights, double gl_threshold,
-         int gl_visibility, const std::string& match, const std::string& response, py::object progress) {
+         int pixel_samples, uint64_t seed, bool shadows, bool self_light, const std::string& backend, int gl_lights,
+         double gl_threshold, int gl_visibility, const std::string& match, const std::string& response,
+         py::object progress) {
         const ibl::capture::Backplate plate = photo_input(photo, response, "composite: photo");
         const ibl::Image& ph = plate.linear;
         camera.width = ph.width();
@@ -168,6 +169,7 @@ void init_augment(py::module_& m) {
         d.pixel_samples = pixel_samples;
         d.seed = seed;
         d.shadows = shadows;
+        d.self_light = self_light;
         d.gl.split.lights = gl_lights;
         d.gl.split.threshold = gl_threshold;
         d.gl.visibility_samples = gl_visibility;
@@ -212,7 +214,7 @@ void init_augment(py::module_& m) {
       py::arg("object_samples") = kDefaults.object_samples, py::arg("bounce_samples") = kDefaults.bounce_samples,
       py::arg("triangle_samples") = kDefaults.triangle_samples, py::arg("pixel_samples") = kDefaults.pixel_samples,
       py::arg("seed") = kDefaults.seed, py::arg("shadows") = kDefaults.shadows,
-      py::arg("backend") = std::string(ag::backend_name(kJob.backend)),
+      py::arg("self_light") = kDefaults.self_light, py::arg("backend") = std::string(ag::backend_name(kJob.backend)),
       py::arg("gl_lights") = kDefaults.gl.split.lights, py::arg("gl_threshold") = kDefaults.gl.split.threshold,
       py::arg("gl_visibility") = kDefaults.gl.visibility_samples,
       py::arg("match") = std::string(kJob.match == ag::Match::Auto ? "auto" : "off"), py::arg("response") = "",
@@ -225,7 +227,7 @@ The captured light, as the CLI takes it: probes= an iblkit.probes/1 manifest; or
 (.shgrid) or a probe image file (with at_probe=) and proxy= a mesh file; or light= a LocalRadiance with
 proxy= a TriMesh or mesh file. median_cut > 0: the N-light baseline. Sampling: light_samples,
 object_samples, bounce_samples (0: no bounce), triangle_samples, pixel_samples, seed; shadows=False
-pastes the object without its shadow. backend= "cpu" (the ray-traced reference), "gl" (OpenGL: shadow
+pastes the object without its shadow; self_light=False leaves out the object's light on itself (CPU). backend= "cpu" (the ray-traced reference), "gl" (OpenGL: shadow
 maps and the soft sphere term; gl_lights, gl_threshold, gl_visibility as --gl-lights, --gl-threshold,
 --gl-visibility) or "auto". match="auto" puts the light in the photograph's units (the gains from the
 proxy points both see; result.warnings says them), "off" keeps it as captured. A uint8/uint16 photo holds the
