@@ -1,3 +1,4 @@
+// (In capture/ because it drives the sensor model and the merge; the DNG writer is io/dng.h.)
 // The lab's DNG writer read back by LibRaw (the raw plugin's reader, read_photo): the sensor's values,
 // levels, white balance and Exif exposure come back, and a raw bracket merges to the radiance within the
 // issue's 1 % (issue 29 §1, RAW path).
