@@ -18,6 +18,8 @@ set -eu
 # doubles small lamps and the sun).
 BIN=$1; SIZE=${2:-160x120}; TS=${3:-32}; OUT=${OUT:-/tmp/augment_accuracy}
 read -ra PA <<<"${PHOTO_ARGS---bounces 2}"; read -ra CA <<<"${CAPTURE_ARGS---bounces 1 --samples 4}"; read -ra XA <<<"${COMPOSITE_ARGS---match off}"
+# KERNEL_SWEEP=1 adds a row for the SH grid built at each candidate kernel (1.5 … 4 cells), beside the kernel
+# `ilf build --focus` chose for the object and the one the whole volume's cross-validation chose.
 # BACKEND=gl|cpu (environment, default cpu): which compositor the rows measure (--backend); REUSE=1 keeps the
 # photographs, captures and grids a previous run left under $OUT (the GL rows measured on the CPU rows' truths).
 BACKEND=${BACKEND:-cpu}
@@ -51,11 +53,26 @@ scene_run() {  # scene_run SCENE AT EYE TARGET VOLUME FUSED_PROBES
   local probes=(); IFS=';' read -ra pts <<<"$fused"; for p in "${pts[@]}"; do probes+=(--probe "$p"); done
   "$BIN" lab capture "$scene" --fusion "${probes[@]}" --size 128 "${CA[@]}" --out "$d/fused" --quiet >/dev/null
   "$BIN" lab capture "$scene" --grid 6,6,6 --volume "$vol" --size 32 "${CA[@]}" --out "$d/seq" --quiet >/dev/null
-  "$BIN" ilf build "$d/seq/sequence.json" --grid 6 --bands 5 --out "$d/grid.shgrid" --quiet >/dev/null
+  # The SH grid's kernel chosen for the object's neighbourhood (--focus: the centre and the object's radius), and
+  # for comparison the whole volume's cross-validated choice.
+  "$BIN" ilf build "$d/seq/sequence.json" --grid 6 --bands 5 --focus "$at,0.15" --json --out "$d/grid.shgrid" \
+    >"$d/grid.json"
+  "$BIN" ilf build "$d/seq/sequence.json" --grid 6 --bands 5 --json --out "$d/grid_volume.shgrid" >"$d/grid_volume.json"
   fi
+  local kf kv
+  kf=$(python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["kernel"])' "$d/grid.json")
+  kv=$(python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["kernel"])' "$d/grid_volume.json")
   row "$scene" "one probe" --probes "$d/one/probes.json" --layers "$d/layers_$BACKEND"
   row "$scene" "fused probes" --probes "$d/fused/probes.json"
-  row "$scene" "SH grid" --light "$d/grid.shgrid" --proxy "$d/one/proxy.obj"
+  row "$scene" "SH grid (kernel $kf cells, for the object)" --light "$d/grid.shgrid" --proxy "$d/one/proxy.obj"
+  row "$scene" "SH grid (kernel $kv cells, for the volume)" --light "$d/grid_volume.shgrid" --proxy "$d/one/proxy.obj"
+  if [ "${KERNEL_SWEEP:-0}" = 1 ]; then  # every candidate kernel, fixed: which one the object wanted
+    for k in 1.5 2 2.5 3 4; do
+      [ -s "$d/grid_k$k.shgrid" ] && [ "${REUSE:-0}" = 1 ] ||
+        "$BIN" ilf build "$d/seq/sequence.json" --grid 6 --bands 5 --kernel "$k" --out "$d/grid_k$k.shgrid" --quiet >/dev/null
+      row "$scene" "SH grid (kernel $k cells, fixed)" --light "$d/grid_k$k.shgrid" --proxy "$d/one/proxy.obj"
+    done
+  fi
   row "$scene" "pasted, no shadows" --probes "$d/one/probes.json" --no-shadows
   row "$scene" "16 median-cut lights" --probes "$d/one/probes.json" --median-cut 16
 }

@@ -29,6 +29,15 @@ check cv-not-light fail "not radiance SH" -- "$BIN" --quiet ilf query "$T/e.shgr
 check cv-error-grid-needs-folds fail "cv-folds" -- "$BIN" --quiet ilf build "$T/cap/sequence.json" --grid 4 --cv-folds 0 --error-grid "$T/x.shgrid" --out "$T/g.shgrid"
 check cv-folds-range fail "cv-folds" -- "$BIN" --quiet ilf build "$T/cap/sequence.json" --grid 4 --cv-folds 1 --out "$T/g.shgrid"
 check kernel-word fail "kernel" -- "$BIN" --quiet ilf build "$T/cap/sequence.json" --grid 4 --kernel wide --out "$T/g.shgrid"
+# Issue 30: the kernel chosen for an object's neighbourhood (--focus); refused without a choice to make, far from every
+# probe, non-finite or malformed.
+check focus-summary ok "focus     0,1,0 " -- "$BIN" ilf build "$T/cap/sequence.json" --grid 4 --focus 0,1,0,0.1 --out "$T/f.shgrid"
+check focus-json ok '"focus_error"' -- "$BIN" --quiet --json ilf build "$T/cap/sequence.json" --grid 4 --focus 0,1,0 --out "$T/f.shgrid"
+check focus-fixed-kernel fail "kernel auto" -- "$BIN" --quiet ilf build "$T/cap/sequence.json" --grid 4 --kernel 3 --focus 0,1,0 --out "$T/f2.shgrid"
+check focus-far fail "no probe" -- "$BIN" --quiet ilf build "$T/cap/sequence.json" --grid 4 --focus 100,100,100 --out "$T/f2.shgrid"
+check focus-nan fail "focus" -- "$BIN" --quiet ilf build "$T/cap/sequence.json" --grid 4 --focus nan,1,0 --out "$T/f2.shgrid"
+check focus-count fail "focus" -- "$BIN" --quiet ilf build "$T/cap/sequence.json" --grid 4 --focus 0,1 --out "$T/f2.shgrid"
+check focus-nothing-written ok "" -- test ! -e "$T/f2.shgrid"
 
 # Issue 15 §4: adaptive grids. adapt at tolerance 0 answers as the dense grid; densify gives it back
 # byte for byte; query, slice, info, export-threejs read .shtree; a cut file and a cv-error volume fail.

@@ -100,13 +100,24 @@ nlohmann::json report_json(const ilf::BuildReport& r) {
 void add_crossval_json(nlohmann::json& j, const ilf::BuildReport& r) {
   if (r.choice) {
     nlohmann::json trials = nlohmann::json::array();
-    for (const auto& t : r.choice->trials)
-      trials.push_back({{"grid", t.n}, {"kernel", t.kernel}, {"cv_error", t.cv_error}});
+    for (const auto& t : r.choice->trials) {
+      nlohmann::json t_j = {{"grid", t.n}, {"kernel", t.kernel}, {"cv_error", t.cv_error}};
+      if (r.choice->focus) t_j["focus_error"] = t.focus_error;
+      trials.push_back(t_j);
+    }
     j["choice"] = {{"resolution", {r.choice->nx, r.choice->ny, r.choice->nz}},
                    {"kernel", r.choice->kernel},
                    {"buckets_used", r.choice->buckets_used},
                    {"seconds", r.choice->seconds},
                    {"trials", trials}};
+    if (const auto& f = r.choice->focus)
+      j["choice"]["focus"] = {{"centre", {f->centre.x, f->centre.y, f->centre.z}},
+                              {"radius", f->radius},
+                              {"sigma", r.choice->focus_sigma},
+                              {"weight", r.choice->focus_weight},
+                              {"error", r.choice->trials[r.choice->chosen].focus_error},
+                              {"volume_kernel", r.choice->volume_kernel},
+                              {"volume_grid", r.choice->volume_n}};
   }
   if (r.crossval) {
     const auto& c = *r.crossval;
@@ -171,7 +182,7 @@ std::string positive_number(const std::string& v) {
 // Defaults come from BuildDesc (and the descs it holds); the strings are their parsed forms.
 struct BuildOptions {
   ilf::BuildDesc bd;
-  std::string seq, out, volume, buckets, vdb, error_grid, kernel = "auto";
+  std::string seq, out, volume, buckets, vdb, error_grid, focus, kernel = "auto";
   std::string grid =
       bd.nx == bd.ny && bd.ny == bd.nz ? std::to_string(bd.nx) : fmt::format("{},{},{}", bd.nx, bd.ny, bd.nz);
   std::string repair = ilf::repair_name(bd.project.repair), memory = format_bytes(bd.buckets.memory_bytes);
@@ -232,6 +243,15 @@ void run_build(const BuildOptions& opts, const ilf::SequenceReadDesc& rd, const 
                                         bd.auto_grid ? ", with the grid" : "")
                           : "",
                rep.ball_radius > 0 ? fmt::format("; rays start on the ball (radius {:g} m)", rep.ball_radius) : "");
+    if (rep.choice && rep.choice->focus) {
+      const auto& ch = *rep.choice;
+      const auto& f = *ch.focus;
+      fmt::print(
+          "focus     {:g},{:g},{:g} (σ {:.3g} m, {:.1f} probes' weight): cv error there {:.4f}; the whole "
+          "volume's choice would be {:g} cells{}\n",
+          f.centre.x, f.centre.y, f.centre.z, ch.focus_sigma, ch.focus_weight, ch.trials[ch.chosen].focus_error,
+          ch.volume_kernel, bd.auto_grid ? fmt::format(" at {}", ch.volume_n) : "");
+    }
     if (rep.crossval) {
       const auto& c = *rep.crossval;
       fmt::print("cv error  {:.4f} relative ({}-fold, {} probes; median probe {:.4f})\n", c.rel_error, c.folds,
@@ -298,6 +318,9 @@ void setup_build(CLI::App& app) {
                    ? std::string()
                    : "expected 0 or 2 to 255, got " + v;
       });
+  app.add_option("--focus", o->focus,
+                 "x,y,z[,radius]: choose the kernel (and an auto grid) for this neighbourhood, where the object "
+                 "will be lit: the cross-validated error of the probes around it, not the whole volume's");
   app.add_option("--error-grid", o->error_grid,
                  "write the cross-validated error volume here (a one-band .shgrid; ilf slice shows it)");
   app.add_option("--repair", o->repair, "filling of grid points no ray reached: mip (the paper's), pullpush, none")
@@ -330,6 +353,8 @@ void setup_build(CLI::App& app) {
       ->check(CLI::Range(1.0, 86400.0));
   app.footer(
       "Examples:\n  iblkit ilf build cap/sequence.json --grid 8 --bands 5 --out room8.shgrid\n"
+      "  iblkit ilf build cap/sequence.json --grid 8 --focus 0.1,0.3,0.1,0.15 --out object8.shgrid   # the kernel "
+      "for an object there\n"
       "  mpirun -np 4 iblkit ilf build captures/sequence.json --grid 32 --out room.shgrid   (docs/ilf.md, \"On a "
       "cluster\")");
   app.callback([o, &app] {
@@ -346,6 +371,17 @@ void setup_build(CLI::App& app) {
     if (!o->error_grid.empty() && bd.crossval.folds < 2)
       fail(ErrorKind::Value, "--error-grid needs the cross-validation (--cv-folds ≥ 2)");
     if (!o->volume.empty()) bd.volume = parse_box(o->volume);
+    if (!o->focus.empty()) {
+      auto v = iblcli::parse_double_list(o->focus, "--focus");
+      if (v.size() != 3 && v.size() != 4)
+        fail(ErrorKind::Value, "--focus: expected x,y,z or x,y,z,radius, got {}", o->focus);
+      bd.focus = ilf::Focus{{v[0], v[1], v[2]}, v.size() == 4 ? v[3] : 0.0};
+      if (!bd.auto_kernel && !bd.auto_grid)
+        fail(ErrorKind::Value,
+             "--focus chooses the kernel for a neighbourhood: it needs --kernel auto (the default) "
+             "or --grid auto, not --kernel {}",
+             o->kernel);
+    }
     bd.project.repair = ilf::parse_repair(o->repair);
     bd.buckets.memory_bytes = parse_bytes(o->memory);
     bd.buckets.dir = o->buckets.empty() ? o->out + ".buckets" : o->buckets;

@@ -65,6 +65,15 @@ GridDesc build_grid(const Sequence& seq, const BuildDesc& desc) {
     fail(ErrorKind::Value, "kernel_cells {} must be a finite number of grid cells", desc.project.kernel_cells);
   GridDesc grid{desc.nx, desc.ny, desc.nz, desc.volume ? *desc.volume : seq.volume};
   SHGrid check(grid, 1);  // validates resolution and volume
+  if (desc.focus) {
+    const Focus& f = *desc.focus;
+    if (!desc.auto_kernel && !desc.auto_grid)
+      fail(ErrorKind::Value, "focus: it chooses the kernel or the grid for a neighbourhood; ask for one (kernel auto)");
+    if (!std::isfinite(f.centre.x) || !std::isfinite(f.centre.y) || !std::isfinite(f.centre.z) ||
+        !std::isfinite(f.radius) || f.radius < 0)
+      fail(ErrorKind::Value, "focus {},{},{} radius {}: a finite point and a radius ≥ 0 (m)", f.centre.x, f.centre.y,
+           f.centre.z, f.radius);
+  }
   {  // project_bucket's raster per thread: the projected volume plus the kernel's support, at Δ = raster_cells·h
     Vec3 sp = grid.spacing();
     double h = std::max({sp.x, sp.y, sp.z}), R = desc.project.kernel_cells * h / 2,
@@ -153,7 +162,8 @@ void cross_validate_build(const BucketStore& store, const std::vector<Vec3>& ori
                       .kernel_cells = pd.kernel_cells,
                       .bands = desc.bands,
                       .memory_bytes = desc.buckets.memory_bytes,
-                      .max_buckets = desc.auto_max_buckets};
+                      .max_buckets = desc.auto_max_buckets,
+                      .focus = desc.focus};
     rep.choice = choose_resampling(store, origins, pd, rs, desc.crossval, desc.ball_parallax, share);
     rep.t_choose = rep.choice->seconds;
     pd.kernel_cells = rep.choice->kernel;
@@ -258,6 +268,9 @@ std::vector<DescribedValue> describe_build(const Sequence& seq, const BuildDesc&
           {"subsample", subsample},
           {"cv-folds", std::to_string(desc.crossval.folds)},
           {"auto buckets", std::to_string(desc.auto_max_buckets)},
+          {"focus", desc.focus ? fmt::format("{},{},{} r {}", desc.focus->centre.x, desc.focus->centre.y,
+                                             desc.focus->centre.z, desc.focus->radius)
+                               : "none"},
           {"parallax", desc.ball_parallax ? "on" : "off"}};
 }
 

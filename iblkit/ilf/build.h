@@ -37,6 +37,8 @@ struct BuildDesc {
   CrossValDesc crossval{.folds = 0};       // folds ≥ 2: report the cross-validated error (BuildReport::crossval)
   int auto_max_buckets = 2048;             // cross-validation and the automatic choice use at most this many
                                            // buckets (every s-th; all when there are fewer)
+  std::optional<Focus> focus;              // make the automatic choice for this neighbourhood (crossval.h):
+                                           // where an object will be lit; needs auto_kernel or auto_grid
   bool ball_parallax = true;               // start each ray at its reflection point on the ball (Sequence::ball);
                                            // false: every ray through the probe position (single viewpoint)
 };

@@ -150,6 +150,28 @@ CrossValResult CrossValidator::result() const {
   return r;
 }
 
+double focus_sigma(const Focus& f, const Box& volume, int probes) {
+  Vec3 s = volume.size();
+  return std::max(f.radius, std::cbrt(s.x * s.y * s.z / std::max(probes, 1)));
+}
+
+double focus_error(const CrossValResult& r, const Focus& f, const Box& volume, double* weight) {
+  double sigma = focus_sigma(f, volume, int(r.positions.size()));
+  double inv2s2 = 1 / (2 * sigma * sigma), cut2 = 9 * sigma * sigma;
+  double we = 0, wn = 0, w = 0;
+  for (size_t p = 0; p < r.positions.size(); ++p) {
+    Vec3 d = r.positions[p] - f.centre;
+    double d2 = dot(d, d);
+    if (d2 > cut2) continue;
+    double k = std::exp(-d2 * inv2s2);
+    we += k * r.sq_error[p];
+    wn += k * r.sq_norm[p];
+    w += k;
+  }
+  if (weight) *weight = w;
+  return wn > 0 ? std::sqrt(we / wn) : std::numeric_limits<double>::quiet_NaN();
+}
+
 SHGrid error_volume(const CrossValResult& r, const GridDesc& grid, int max_res) {
   GridDesc g{std::clamp(grid.nx, 2, max_res), std::clamp(grid.ny, 2, max_res), std::clamp(grid.nz, 2, max_res),
              grid.volume};
@@ -348,6 +370,8 @@ ResampleChoice choose_resampling(const BucketStore& store, const std::vector<Vec
   int stride = sample_stride(store.table(), s.max_buckets);
   CrossValDesc cv = cvd;
   if (cv.folds < 2) cv.folds = 5;
+  // A trial's score: the whole volume's error, or with a focus the error around it.
+  auto score = [&](const ResampleTrial& t) { return s.focus ? t.focus_error : t.cv_error; };
   auto run = [&](const std::vector<std::pair<int, double>>& pairs) {  // (n, kernel); n 0 = the given resolution
     std::vector<Candidate> cands;
     for (auto [n, kern] : pairs) {
@@ -361,16 +385,33 @@ ResampleChoice choose_resampling(const BucketStore& store, const std::vector<Vec
     evaluate(store, origins, cands, s.bands, stride, use_starts, &ch.buckets_used, share);
     for (size_t i = 0; i < cands.size(); ++i) {
       CrossValResult r = cands[i].cv->result();
-      bool better = ch.trials.empty() || r.rel_error < ch.best.rel_error;
-      ch.trials.push_back(
-          {std::max({cands[i].grid.nx, cands[i].grid.ny, cands[i].grid.nz}), pairs[i].second, r.rel_error});
-      if (better) ch.best = std::move(r);
+      ResampleTrial t{std::max({cands[i].grid.nx, cands[i].grid.ny, cands[i].grid.nz}), pairs[i].second, r.rel_error,
+                      std::numeric_limits<double>::quiet_NaN()};
+      double w = 0;
+      if (s.focus) {
+        t.focus_error = focus_error(r, *s.focus, s.volume, &w);
+        if (!std::isfinite(t.focus_error))
+          fail(ErrorKind::Value,
+               "--focus {},{},{}: no probe of the sequence lies within {:.3g} m of it (3σ); give a point inside the "
+               "captured volume or a larger radius",
+               s.focus->centre.x, s.focus->centre.y, s.focus->centre.z,
+               3 * focus_sigma(*s.focus, s.volume, r.evaluated));
+      }
+      bool better = ch.trials.empty() || score(t) < score(ch.trials[ch.chosen]);
+      ch.trials.push_back(t);
+      if (better) {
+        ch.chosen = ch.trials.size() - 1;
+        ch.best = std::move(r);
+        ch.focus_weight = w;
+      }
     }
   };
-  auto best = [&](size_t from) {
+  auto best = [&](size_t from, bool by_focus) {
     size_t b = from;
     for (size_t i = from; i < ch.trials.size(); ++i)
-      if (ch.trials[i].cv_error < ch.trials[b].cv_error) b = i;
+      if ((by_focus ? ch.trials[i].focus_error : ch.trials[i].cv_error) <
+          (by_focus ? ch.trials[b].focus_error : ch.trials[b].cv_error))
+        b = i;
     return ch.trials[b];
   };
   std::vector<std::pair<int, double>> pairs;
@@ -387,27 +428,29 @@ ResampleChoice choose_resampling(const BucketStore& store, const std::vector<Vec
       for (double kern : s.kernel ? std::vector<double>{2.0, 3.0} : std::vector<double>{s.kernel_cells})
         pairs.push_back({n, kern});
     run(pairs);
-    ResampleTrial b = best(0);
+    ResampleTrial b = best(0, bool(s.focus));
     if (s.kernel) {
       pairs.clear();
       for (double kern : kAutoKernels)
         if (kern != 2.0 && kern != 3.0) pairs.push_back({b.n, kern});
       run(pairs);
     }
-    ResampleTrial w = best(0);
-    GridDesc g = grid_of(s, w.n);
-    ch.nx = g.nx;
-    ch.ny = g.ny;
-    ch.nz = g.nz;
-    ch.kernel = w.kernel;
   } else {
     for (double kern : kAutoKernels) pairs.push_back({0, kern});
     run(pairs);
-    ResampleTrial w = best(0);
-    ch.nx = s.nx;
-    ch.ny = s.ny;
-    ch.nz = s.nz;
-    ch.kernel = w.kernel;
+  }
+  const ResampleTrial& w = ch.trials[ch.chosen];
+  GridDesc g = s.grid ? grid_of(s, w.n) : GridDesc{s.nx, s.ny, s.nz, s.volume};
+  ch.nx = g.nx;
+  ch.ny = g.ny;
+  ch.nz = g.nz;
+  ch.kernel = w.kernel;
+  ResampleTrial v = best(0, false);  // the whole volume's choice among the trials run
+  ch.volume_kernel = v.kernel;
+  ch.volume_n = v.n;
+  if (s.focus) {
+    ch.focus = s.focus;
+    ch.focus_sigma = focus_sigma(*s.focus, s.volume, ch.best.evaluated);
   }
   ch.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return ch;

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -99,20 +100,43 @@ Image error_slice(const SHGrid& ev, int axis, double value, int width);
 inline constexpr double kErrorMinWeight = 1.0;
 Image error_colours(const Image& slice, double max_error);
 
+// Where the grid will be read — an object to be lit (`ilf build --focus`, augment/): the automatic
+// choice then minimises the cross-validated error of the probes around it rather than the whole
+// volume's, each probe weighted by a Gaussian of σ = max(radius, the mean probe spacing (V/P)^⅓ of the
+// P evaluated probes in the volume V) around the centre, cut at 3σ (the same σ for every candidate, so
+// that resolutions compare).
+struct Focus {
+  Vec3 centre;
+  double radius = 0;  // the object's radius (m); 0: a point
+};
+// The focus's σ for a cross-validation of `probes` evaluated probes over `volume`.
+double focus_sigma(const Focus& f, const Box& volume, int probes);
+// √(Σw·e²/Σw·‖C‖²) over the evaluated probes, w the focus's weights; *weight: Σw (≈ probes within σ).
+// NaN when no probe lies within 3σ.
+double focus_error(const CrossValResult& r, const Focus& f, const Box& volume, double* weight = nullptr);
+
 // The automatic choice of kernel width and resolution: cross-validated error of each candidate on a
-// subset of the buckets (every s-th, at most max_buckets), the least wins.
+// subset of the buckets (every s-th, at most max_buckets), the least wins (with a focus: the least
+// focus_error).
 struct ResampleTrial {
   int n = 0;
   double kernel = 0;
-  double cv_error = 0;
+  double cv_error = 0;     // over the whole volume
+  double focus_error = 0;  // around the focus (NaN without one)
 };
 struct ResampleChoice {
   int nx = 0, ny = 0, nz = 0;
   double kernel = 0;
   std::vector<ResampleTrial> trials;
+  size_t chosen = 0;    // the chosen trial (index into trials)
   CrossValResult best;  // the chosen candidate's cross-validation
   int buckets_used = 0;
   double seconds = 0;
+  std::optional<Focus> focus;  // the choice was made for this neighbourhood
+  double focus_weight = 0;     // Σw of the chosen trial (≈ probes within σ)
+  double focus_sigma = 0;      // σ of its weights (m)
+  double volume_kernel = 0;    // the whole volume's best trial (with a focus: what it would have chosen
+  int volume_n = 0;            // among the trials run)
 };
 inline constexpr double kAutoKernels[] = {1.5, 2.0, 2.5, 3.0, 4.0};
 inline constexpr int kAutoGrids[] = {8, 12, 16, 24, 32, 48, 64};
@@ -126,6 +150,7 @@ struct ResampleSearch {
   int bands = 5;
   size_t memory_bytes = size_t(2) << 30;  // grids whose build needs more are not tried
   int max_buckets = 2048;
+  std::optional<Focus> focus;  // choose for this neighbourhood (focus_error) instead of the whole volume
 };
 
 // Bytes a build of this resolution holds (grid, SH accumulator, one block of bucket columns).

@@ -179,6 +179,67 @@ TEST(IlfCrossVal, AutoChoiceAndErrorVolume) {
   EXPECT_NE(std::find(std::begin(kAutoGrids), std::end(kAutoGrids), r3.nx), std::end(kAutoGrids));
 }
 
+// A focus (where an object will be lit) weights the probes around it: the closed form on two probes,
+// one at the centre and one beyond 3σ; then a build whose choice is the least error there (not the
+// whole volume's, which it reports beside), and a focus no probe is near is refused.
+TEST(IlfCrossVal, FocusChoosesForTheNeighbourhood) {
+  CrossValResult r;
+  r.positions = {{0.5, 0.5, 0.5}, {0.5, 0.5, 0.95}, {0.05, 0.05, 0.05}};
+  r.sq_error = {1, 0, 100};
+  r.sq_norm = {4, 0, 1};
+  const Box unit{{0, 0, 0}, {1, 1, 1}};
+  Focus f{{0.5, 0.5, 0.5}, 0.1};
+  EXPECT_NEAR(focus_sigma(f, unit, 3), std::cbrt(1.0 / 3), 1e-12);  // the probe spacing beats the radius
+  Focus tight{{0.5, 0.5, 0.5}, 0};
+  Box wide{{0, 0, 0}, {0.3, 0.3, 0.3}};  // σ = (0.027/3)^⅓ ≈ 0.21: 3σ ≈ 0.62 excludes the corner probe (0.78 away)
+  double w = 0;
+  double sigma = focus_sigma(tight, wide, 3);
+  double k = std::exp(-0.45 * 0.45 / (2 * sigma * sigma));  // the probe 0.45 above: weight k, no error, no norm
+  EXPECT_NEAR(focus_error(r, tight, wide, &w), std::sqrt(1.0 / 4), 1e-12);
+  EXPECT_NEAR(w, 1 + k, 1e-12);
+  Focus nowhere{{5, 5, 5}, 0};
+  EXPECT_TRUE(std::isnan(focus_error(r, nowhere, wide)));
+
+  auto field = AnalyticField::three_spheres();
+  auto seq = capture(field, "focus", 150, 16);
+  BuildDesc bd = cv_build(8, temp_dir("focus_b"));
+  bd.auto_kernel = true;
+  const Vec3 lo = seq.volume.min, sz = seq.volume.size();
+  bd.focus = Focus{lo + Vec3{0.25 * sz.x, 0.3 * sz.y, 0.7 * sz.z}, 0};
+  BuildReport rep;
+  build_shgrid(seq, bd, {}, &rep);
+  ASSERT_TRUE(rep.choice && rep.choice->focus);
+  const auto& ch = *rep.choice;
+  ASSERT_EQ(ch.trials.size(), std::size(kAutoKernels));
+  size_t by_focus = 0, by_volume = 0;
+  for (size_t i = 0; i < ch.trials.size(); ++i) {
+    EXPECT_TRUE(std::isfinite(ch.trials[i].focus_error));
+    if (ch.trials[i].focus_error < ch.trials[by_focus].focus_error) by_focus = i;
+    if (ch.trials[i].cv_error < ch.trials[by_volume].cv_error) by_volume = i;
+  }
+  std::printf("[ilf] focus: chosen %g cells (error there %.4f), the volume's choice %g (%.4f)\n", rep.kernel_cells,
+              ch.trials[by_focus].focus_error, ch.volume_kernel, ch.trials[by_volume].cv_error);
+  EXPECT_EQ(ch.chosen, by_focus);
+  EXPECT_EQ(rep.kernel_cells, ch.trials[by_focus].kernel);
+  EXPECT_EQ(ch.volume_kernel, ch.trials[by_volume].kernel);
+  EXPECT_NEAR(rep.crossval->rel_error, ch.trials[by_focus].cv_error, 1e-6);  // the chosen trial's cross-validation
+  EXPECT_NEAR(focus_error(*rep.crossval, *bd.focus, seq.volume), ch.trials[by_focus].focus_error, 1e-9);
+  EXPECT_GT(ch.focus_weight, 1);
+  // Refused: a focus far outside every probe, and a focus with nothing to choose.
+  BuildDesc far = bd;
+  far.buckets.dir = temp_dir("focus_far");
+  far.focus = Focus{seq.volume.max + 10 * sz, 0};
+  try {
+    build_shgrid(seq, far);
+    ADD_FAILURE() << "a focus no probe is near was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("no probe"), std::string::npos) << e.what();
+  }
+  BuildDesc fixed = bd;
+  fixed.auto_kernel = false;
+  EXPECT_THROW(build_shgrid(seq, fixed), Error);
+}
+
 // A job of N processes, here N threads of this one: each evaluates its share of the blocks (contiguous
 // ranges, one of them empty) and `sum` adds the partial sums through shared memory. The job's error,
 // its per-probe figures and its automatic choice equal one process's to float rounding of the sum in
