@@ -19,18 +19,10 @@ import argparse, json, os, subprocess, sys, tempfile
 
 import numpy as np
 
-os.environ.setdefault("OPENCV_IO_ENABLE_OPENEXR", "1")
-import cv2  # noqa: E402
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from hdr_merge_vs_peers import TIMES, read_exr  # noqa: E402 (the HDR bench's bracket and EXR reader)
 
 WORLD = "/usr/share/blender/datafiles/studiolights/world"
-TIMES = ["1/64", "1/16", "1/4", "1", "4"]
-
-
-def read_exr(path):
-    img = cv2.imread(path, cv2.IMREAD_ANYCOLOR | cv2.IMREAD_ANYDEPTH | cv2.IMREAD_UNCHANGED)
-    if img is None:
-        sys.exit(f"cannot read {path}")
-    return img[:, :, :3][:, :, ::-1].astype(np.float64)
 
 
 def merge_error(merged, truth):

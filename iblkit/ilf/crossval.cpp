@@ -155,21 +155,31 @@ double focus_sigma(const Focus& f, const Box& volume, int probes) {
   return std::max(f.radius, std::cbrt(s.x * s.y * s.z / std::max(probes, 1)));
 }
 
-double focus_error(const CrossValResult& r, const Focus& f, const Box& volume, double* weight) {
-  double sigma = focus_sigma(f, volume, int(r.positions.size()));
-  double inv2s2 = 1 / (2 * sigma * sigma), cut2 = 9 * sigma * sigma;
+namespace {
+// Σ k·e², Σ k·‖C‖², Σ k over the probes within 3σ of x, k = exp(−d²/2σ²): the error around a point.
+struct WeightedError {
   double we = 0, wn = 0, w = 0;
+};
+WeightedError weighted_error(const CrossValResult& r, Vec3 x, double sigma) {
+  double inv2s2 = 1 / (2 * sigma * sigma), cut2 = 9 * sigma * sigma;
+  WeightedError s;
   for (size_t p = 0; p < r.positions.size(); ++p) {
-    Vec3 d = r.positions[p] - f.centre;
+    Vec3 d = r.positions[p] - x;
     double d2 = dot(d, d);
-    if (d2 > cut2) continue;
+    if (!(d2 <= cut2)) continue;
     double k = std::exp(-d2 * inv2s2);
-    we += k * r.sq_error[p];
-    wn += k * r.sq_norm[p];
-    w += k;
+    s.we += k * r.sq_error[p];
+    s.wn += k * r.sq_norm[p];
+    s.w += k;
   }
-  if (weight) *weight = w;
-  return wn > 0 ? std::sqrt(we / wn) : std::numeric_limits<double>::quiet_NaN();
+  return s;
+}
+}  // namespace
+
+double focus_error(const CrossValResult& r, const Focus& f, const Box& volume, double* weight) {
+  WeightedError s = weighted_error(r, f.centre, focus_sigma(f, volume, int(r.positions.size())));
+  if (weight) *weight = s.w;
+  return s.wn > 0 ? std::sqrt(s.we / s.wn) : std::numeric_limits<double>::quiet_NaN();
 }
 
 SHGrid error_volume(const CrossValResult& r, const GridDesc& grid, int max_res) {
@@ -180,21 +190,10 @@ SHGrid error_volume(const CrossValResult& r, const GridDesc& grid, int max_res) 
   Vec3 s = grid.volume.size(), sp = g.spacing();
   int P = int(r.positions.size());
   double sigma = std::max({std::cbrt(s.x * s.y * s.z / std::max(P, 1)), sp.x, sp.y, sp.z});
-  double inv2s2 = 1 / (2 * sigma * sigma), cut2 = 9 * sigma * sigma;
   parallel_for(
       0, g.count(),
       [&](int64_t i) {
-        Vec3 x = g.point(i);
-        double we = 0, wn = 0, w = 0;
-        for (int p = 0; p < P; ++p) {
-          Vec3 d = r.positions[p] - x;
-          double d2 = dot(d, d);
-          if (d2 > cut2) continue;
-          double k = std::exp(-d2 * inv2s2);
-          we += k * r.sq_error[p];
-          wn += k * r.sq_norm[p];
-          w += k;
-        }
+        auto [we, wn, w] = weighted_error(r, g.point(i), sigma);
         float* v = out.data().data() + size_t(i) * 3;
         v[0] = wn > 0 ? float(std::sqrt(we / wn)) : 0.0f;
         v[1] = w > 0 ? float(std::sqrt(we / w)) : 0.0f;
