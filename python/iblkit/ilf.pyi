@@ -48,6 +48,7 @@ def adapt(grid: SHGrid, tolerance: float = 0.01, brick: int = 4) -> AdaptiveGrid
 def build(source: Union[str, ArrayLike, Sequence[ArrayLike]], positions: Optional[ArrayLike] = None,
           grid: Union[int, Tuple[int, int, int]] = 16, bands: int = 5, volume: Optional[Tuple[ArrayLike, ArrayLike]] = None,
           mapping: str = "auto", dead_angle: float = 0.0, rotation: Optional[ArrayLike] = None, repair: str = "mip",
-          kernel_cells: float = 3.0, raster_cells: float = 0.5, directions: Union[str, int] = "auto", memory: str = "2G",
-          skip_bad: bool = False, sanitize: bool = False, subsample: Optional[Tuple[float, float]] = None, work_dir: str = "",
-          progress: Progress = None) -> Tuple[SHGrid, dict]: ...
+          kernel_cells: Union[float, str] = 3.0, raster_cells: float = 0.5, directions: Union[str, int] = "auto",
+          memory: str = "2G", skip_bad: bool = False, sanitize: bool = False, subsample: Optional[Tuple[float, float]] = None,
+          work_dir: str = "", progress: Progress = None,
+          focus: Optional[Sequence[float]] = None) -> Tuple[SHGrid, dict]: ...

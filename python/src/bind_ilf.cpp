@@ -90,6 +90,27 @@ py::dict report_dict(const ibl::ilf::BuildReport& r) {
   d["t_accumulate"] = r.t_accumulate;
   d["t_total"] = r.t_total;
   d["gemm_flops"] = r.gemm_flops;
+  d["kernel_cells"] = r.kernel_cells;
+  if (r.choice) {
+    py::list trials;
+    for (const auto& t : r.choice->trials) {
+      py::dict td;
+      td["kernel"] = t.kernel;
+      td["cv_error"] = t.cv_error;
+      if (r.choice->focus) td["focus_error"] = t.focus_error;
+      trials.append(td);
+    }
+    py::dict c;
+    c["kernel"] = r.choice->kernel;
+    c["trials"] = trials;
+    if (r.choice->focus) {
+      c["focus_error"] = r.choice->trials[r.choice->chosen].focus_error;
+      c["focus_sigma"] = r.choice->focus_sigma;
+      c["focus_weight"] = r.choice->focus_weight;
+      c["volume_kernel"] = r.choice->volume_kernel;
+    }
+    d["choice"] = c;
+  }
   return d;
 }
 
@@ -305,8 +326,8 @@ coefficients kept at full resolution only where coarser levels miss them by more
       "build",
       [](py::object source, py::object positions, py::object grid, int bands, py::object volume,
          const std::string& mapping, double dead_angle, py::object rotation, const std::string& repair,
-         double kernel_cells, double raster_cells, py::object directions, const std::string& memory, bool skip_bad,
-         bool sanitize, py::object subsample, const std::string& work_dir, py::object progress) {
+         py::object kernel_cells, double raster_cells, py::object directions, const std::string& memory, bool skip_bad,
+         bool sanitize, py::object subsample, const std::string& work_dir, py::object progress, py::object focus) {
         ibl::ilf::BuildDesc bd;
         // grid: n or (nx, ny, nz)
         if (py::isinstance<py::int_>(grid)) {
@@ -325,7 +346,21 @@ coefficients kept at full resolution only where coarser levels miss them by more
           bd.volume = ibl::ilf::Box{to_vec3(v[0], "ilf.build: volume min"), to_vec3(v[1], "ilf.build: volume max")};
         }
         bd.project.repair = ibl::ilf::parse_repair(repair);
-        bd.project.kernel_cells = kernel_cells;
+        if (py::isinstance<py::str>(kernel_cells)) {
+          if (kernel_cells.cast<std::string>() != "auto")
+            throw py::value_error("ilf.build: kernel_cells must be a number of grid cells or 'auto'");
+          bd.auto_kernel = true;  // cross-validated among 1.5 … 4 cells (`ilf build --kernel auto`)
+        } else {
+          bd.project.kernel_cells = kernel_cells.cast<double>();
+        }
+        if (!focus.is_none()) {
+          auto f = focus.cast<std::vector<double>>();
+          if (f.size() != 3 && f.size() != 4)
+            throw py::value_error("ilf.build: focus must be (x, y, z) or (x, y, z, radius)");
+          bd.focus = ibl::ilf::Focus{{f[0], f[1], f[2]}, f.size() == 4 ? f[3] : 0.0};
+          if (!bd.auto_kernel)
+            throw py::value_error("ilf.build: focus chooses the kernel for a neighbourhood: give kernel_cells='auto'");
+        }
         bd.project.raster_cells = raster_cells;
         if (directions.is_none() || (py::isinstance<py::str>(directions) && directions.cast<std::string>() == "auto")) {
           bd.buckets.octahedral = -1;
@@ -444,6 +479,7 @@ coefficients kept at full resolution only where coarser levels miss them by more
       py::arg("raster_cells") = ibl::ilf::ProjectDesc{}.raster_cells, py::arg("directions") = "auto",
       py::arg("memory") = "2G", py::arg("skip_bad") = false, py::arg("sanitize") = false,
       py::arg("subsample") = py::none(), py::arg("work_dir") = "", py::arg("progress") = py::none(),
+      py::arg("focus") = py::none(),
       R"doc(Builds an SH grid from a probe sequence, as `iblkit ilf build`; returns (SHGrid, report dict).
 
 source: an iblkit.sequence/1 manifest path (its buckets go to work_dir, default PATH.buckets, and are
@@ -452,7 +488,9 @@ positions=(N, 3) capture positions (then `mapping` ("auto": from the shape), `de
 `rotation` (probe frame → world) describe the frames; the volume defaults to the positions' bounds;
 frames and buckets live in a temporary folder under work_dir, default the system's, removed after).
 grid: n or (nx, ny, nz); bands 1..10; volume: (min, max); repair: mip, pullpush or none;
-kernel_cells, raster_cells: the projection's kernel and raster in grid cells; directions: "auto",
+kernel_cells, raster_cells: the projection's kernel and raster in grid cells (kernel_cells="auto": chosen by
+5-fold cross-validation among 1.5 … 4, the report's "choice"; with focus=(x, y, z[, radius]) for the neighbourhood
+of an object there, `ilf build --focus`); directions: "auto",
 "pixel" or N (N×N octahedral buckets); memory: the build's budget ("2G"); subsample: (threshold,
 max_distance) to drop redundant probes first. Releases the GIL; progress(stage, fraction).
 The report holds the probe counts, buckets, samples, uncovered share and the stage times (seconds).)doc");

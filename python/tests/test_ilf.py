@@ -32,6 +32,28 @@ def test_build_from_file_matches_cli(tmp_path, sequence):
     assert seen
 
 
+def test_build_focus_matches_cli(tmp_path, sequence):
+    """kernel_cells="auto" with a focus chooses what `ilf build --focus` chooses, and builds the same grid."""
+    c = json.loads(open(sequence).read())
+    lo, hi = np.array(c["volume"]["min"]), np.array(c["volume"]["max"])
+    at = list(lo + 0.3 * (hi - lo))
+    out = tmp_path / "cli.shgrid"
+    j = run_cli("ilf", "build", sequence, "--grid", 4, "--bands", 3, "--focus", ",".join(map(str, at + [0.1])),
+                "--out", out, "--buckets", tmp_path / "b1", json_out=True)
+    grid, report = ilf.build(str(sequence), grid=4, bands=3, kernel_cells="auto", focus=at + [0.1],
+                             work_dir=str(tmp_path / "b2"))
+    ch = report["choice"]
+    assert report["kernel_cells"] == j["kernel"] == ch["kernel"]
+    assert ch["focus_error"] == pytest.approx(j["choice"]["focus"]["error"], rel=1e-9)
+    assert min(t["focus_error"] for t in ch["trials"]) == ch["focus_error"]
+    assert ch["volume_kernel"] == j["choice"]["focus"]["volume_kernel"]
+    assert np.array_equal(grid.coefficients, ilf.SHGrid.load(str(out)).coefficients)
+    with pytest.raises(ValueError, match="kernel_cells='auto'"):
+        ilf.build(str(sequence), grid=4, bands=3, focus=at, work_dir=str(tmp_path / "b3"))
+    with pytest.raises(ValueError, match="focus"):
+        ilf.build(str(sequence), grid=4, bands=3, kernel_cells="auto", focus=[0, 1], work_dir=str(tmp_path / "b3"))
+
+
 def test_build_from_arrays_equals_the_file_build(tmp_path, sequence):
     seq = json.loads(sequence.read_text())
     frames = np.stack([iblkit.read_image(str(sequence.parent / p["image"])) for p in seq["probes"]])
