@@ -43,6 +43,11 @@ printf 'v -2 0 -2\nv 2 0 -2\nv 2 0 2\nv -2 0 2\nf 1 3 2\nf 1 4 3\n' > floor.obj
 "$BIN" --quiet lab shoot low-scene1 --at 0,1,0 --distance-radii 8 --out ball >/dev/null || echo "FAIL setup: ball/"
 "$BIN" --quiet lab shoot low-scene2 --two-sides --distance 2 --bracket 5 --ev-step 2 --noise --quality 95 --out brackets \
   >/dev/null || echo "FAIL setup: brackets/"
+# window/: a ball in t-corridor seeing its bright panel, and the panel photographed from there (probe calibrate's)
+"$BIN" --quiet lab shoot t-corridor --at 0,1.5,-1 --distance-radii 8 --width 256 --height 256 --truth-size 0 \
+  --out window >/dev/null &&
+  "$BIN" --quiet lab photograph t-corridor --eye 0,1.5,-1 --target 5.95,1.5,-1 --fov 40 --width 64 --height 64 \
+    --out window/light.exr >/dev/null || echo "FAIL setup: window/"
 # photo.jpg, pts.json, b1..b4.jpg (= board1..4.jpg) and lens.json: chessboards on the floor photographed by OpenCV
 # (camera_test_tool.py, the peer of cli_camera) for `camera`'s examples; without python3-opencv they are skipped.
 have_cv=no

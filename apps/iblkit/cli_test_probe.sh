@@ -63,5 +63,29 @@ check from-ball-fresnel fail "--fresnel" -- "$BIN" probe from-ball "$S/view0.exr
 check from-ball-missing fail "no such file" -- "$BIN" probe from-ball "$T/nothere.exr" --distance 40 --out "$T/o.exr"
 check shoot-close fail "--distance" -- "$BIN" lab shoot low-scene1 --distance 0.01 --out "$T/bad"
 
+# The ball's reflectance from a light seen in the ball and directly: t-corridor's bright panel (a 1.5 × 2 m quad 6 m
+# down the crossbar) in a ball of r0 0.6,0.55,0.5 with chrome's rise, 256², and the panel photographed from the ball's
+# place; the lab renders both, so r0 comes back to the renderer's rounding (the rise taken out at 44–52°).
+W="$T/window"
+check calib-shoot ok "" -- "$BIN" --quiet lab shoot t-corridor --at 0,1.5,-1 --distance-radii 8 --width 256 \
+  --height 256 --reflectance 0.6,0.55,0.5 --truth-size 0 --out "$W"
+check calib-light ok "" -- "$BIN" --quiet lab photograph t-corridor --eye 0,1.5,-1 --target 5.95,1.5,-1 --fov 40 \
+  --width 64 --height 64 --out "$W/light.exr"
+check calib ok "reflectance 0.600[0-9],0.550[0-9],0.500[0-9]|reflectance 0.599[0-9],0.549[0-9],0.499[0-9]" -- \
+  "$BIN" probe calibrate "$W/view0.exr" --distance 8 --light-in-ball 200,105,25,45 --direct "$W/light.exr" \
+  --light 15,12,35,40
+check calib-json ok '"incidence_deg"' -- "$BIN" --json probe calibrate "$W/view0.exr" --distance 8 \
+  --light-in-ball 200,105,25,45 --direct "$W/light.exr" --light 15,12,35,40
+check calib-box-outside fail "leaves its 256x256 image" -- "$BIN" probe calibrate "$W/view0.exr" --distance 8 \
+  --light-in-ball 240,105,25,45 --direct "$W/light.exr" --light 15,12,35,40
+check calib-box-off-ball fail "no pixel inside the ball" -- "$BIN" probe calibrate "$W/view0.exr" --distance 8 \
+  --ball 128,128,115 --light-in-ball 0,0,10,10 --direct "$W/light.exr" --light 15,12,35,40
+check calib-box-words fail "x,y,w,h" -- "$BIN" probe calibrate "$W/view0.exr" --distance 8 \
+  --light-in-ball 200,105,25 --direct "$W/light.exr" --light 15,12,35,40
+check calib-no-direct fail "no such file" -- "$BIN" probe calibrate "$W/view0.exr" --distance 8 \
+  --light-in-ball 200,105,25,45 --direct "$T/nothere.exr" --light 15,12,35,40
+check calib-no-lens fail "--distance" -- "$BIN" probe calibrate "$W/view0.exr" --light-in-ball 200,105,25,45 \
+  --direct "$W/light.exr" --light 15,12,35,40
+
 echo "cli_probe: $pass passed, $fail failed, $skip skipped"
 [ $fail -eq 0 ]

@@ -8,6 +8,7 @@
 #include <functional>
 #include <random>
 
+#include "iblkit/capture/ball_calibrate.h"
 #include "iblkit/capture/probe_eval.h"
 #include "iblkit/core/error.h"
 #include "iblkit/core/parallel.h"
@@ -243,6 +244,56 @@ TEST(CaptureBall, BadInput) {
   EXPECT_THROW(probe_from_ball({{photo, {90, 50, 30}, 5, 0, "x"}}, fd), Error);    // partly outside
   EXPECT_THROW(probe_from_ball({{photo, {50, 50, 30}, 0.5, 0, "x"}}, fd), Error);  // inside the ball
   EXPECT_DOUBLE_EQ(distance_from_lens(100, 1000, 50, 36), 1 / std::sin(std::atan(100 / (50.0 / 36 * 1000))));
+}
+
+// The reflectance calibrated from a light seen in the ball and directly: a dim room with a window of
+// radiance (8, 6, 4) filling a 12° cone, photographed in a ball of r0 = (0.6, 0.55, 0.5) with chrome's rise,
+// at 8 radii; the light's own image a block of the same radiance. r0 comes back within 0.5 % near normal
+// incidence and at 59–71° (where chrome's F(θ)/F(0) dips 5 %, which a plain ratio keeps); bad boxes are refused.
+TEST(CaptureBall, ReflectanceCalibratedFromAKnownLight) {
+  const Vec3 Lw{8, 6, 4}, r0{0.6, 0.55, 0.5};
+  BallReflectance refl;
+  refl.r0 = r0;
+  const double D = 8, r = 230;
+  const int W = 512;
+  Image direct(64, 64, 3, 0.05f);
+  for (int y = 20; y < 44; ++y)
+    for (int x = 20; x < 44; ++x) direct.set_rgb(x, y, Lw);
+  for (double from_axis_deg : {30.0, 124.0}) {  // the window's direction from +Z (the camera's side)
+    const double t = from_axis_deg * kPi / 180;
+    const Vec3 dl{std::sin(t), 0.2, std::cos(t)};
+    const Vec3 dw = normalize(dl);
+    Env room = [&](Vec3 d) { return dot(d, dw) > std::cos(12 * kPi / 180) ? Lw : Vec3{0.05, 0.05, 0.05}; };
+    BallView v{photograph(room, W, r, D, 0, refl, 3), {W / 2.0, W / 2.0, r}, D, 0, "ball"};
+    Vec3 view, nrm;
+    ASSERT_TRUE(ilf::ball_view_for({1.0, D}, dw, &view, &nrm));
+    double px = 0, py = 0;
+    ilf::ball_image_point({1.0, D}, view, nrm, v.ball.cx, v.ball.cy, v.ball.r, &px, &py);
+    const PixelBox in_ball{px - 30, py - 30, 60, 60}, in_direct{10, 10, 44, 44};
+    ReflectanceFit f = calibrate_reflectance(v, refl, in_ball, direct, in_direct);
+    std::printf(
+        "[capture] window %.0f° from the camera: r0 %.4f %.4f %.4f from %d ball pixels at %.1f–%.1f°, "
+        "spread %.4f\n",
+        from_axis_deg, f.r0.x, f.r0.y, f.r0.z, f.ball_pixels, f.incidence_min_deg, f.incidence_max_deg, f.spread);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(f.r0[c] / r0[c], 1, 0.005) << from_axis_deg << " channel " << c;
+    EXPECT_NEAR(f.light.x, Lw.x, 1e-6);
+    EXPECT_GT(f.ball_pixels, 20);
+    EXPECT_EQ(f.direct_pixels, 24 * 24);
+    if (from_axis_deg > 90) {
+      EXPECT_GT(f.incidence_min_deg, 50);
+      BallReflectance flat = refl;  // the ratio without the metal's curve taken out is off by F(θ)/F(0)
+      flat.fresnel = false;
+      ReflectanceFit g = calibrate_reflectance(v, flat, in_ball, direct, in_direct);
+      std::printf("[capture] without the metal's curve: r0 %.4f (%.1f %% off)\n", g.r0.y, 100 * (g.r0.y / r0.y - 1));
+      EXPECT_GT(std::abs(g.r0.y / r0.y - 1), 0.02);
+    }
+  }
+  Image photo(W, W, 3, 0.0f);  // a black ball: no light in any box
+  BallView v{photo, {W / 2.0, W / 2.0, r}, D, 0, "ball"};
+  EXPECT_THROW(calibrate_reflectance(v, refl, {500, 500, 40, 40}, direct, {10, 10, 44, 44}), Error);  // leaves it
+  EXPECT_THROW(calibrate_reflectance(v, refl, {0, 0, 20, 20}, direct, {10, 10, 44, 44}), Error);      // beside the ball
+  EXPECT_THROW(calibrate_reflectance(v, refl, {200, 200, 40, 40}, direct, {10, 10, 44, 44}), Error);  // no light
+  EXPECT_THROW(calibrate_reflectance(v, refl, {200, 200, 40, 40}, direct, {10, 10, NAN, 44}), Error);
 }
 
 }  // namespace
