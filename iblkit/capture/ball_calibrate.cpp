@@ -63,8 +63,7 @@ Vec3 channel_median(const std::vector<Sample>& s) {
 }  // namespace
 
 ReflectanceFit calibrate_reflectance(const BallView& view, const BallReflectance& metal, PixelBox in_ball,
-                                     const Image& direct, PixelBox in_direct, double plateau,
-                                     const std::string& what) {
+                                     const Image& direct, PixelBox in_direct, double plateau, const std::string& what) {
   if (!(plateau > 0 && plateau < 1)) fail(ErrorKind::Value, "{}: plateau {} must lie in (0, 1)", what, plateau);
   if (view.photo.channels() < 3 || direct.channels() < 3)
     fail(ErrorKind::Value, "{}: the ball photograph and the light's image must be RGB", what);

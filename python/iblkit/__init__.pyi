@@ -36,6 +36,9 @@ def tonemap(img: ArrayLike, exposure: float = 0.0, auto_exposure: bool = True, k
 
 # chrome-ball probes (capture/ball.h, docs/capture.md)
 def find_ball(photo: ArrayLike) -> dict: ...
+def calibrate_ball(photo: ArrayLike, light_in_ball: Sequence[float], direct: ArrayLike, light: Sequence[float],
+                   ball: Optional[Sequence[float]] = None, distance: float = 0.0, fresnel: str = "chrome",
+                   plateau: float = 0.8) -> dict: ...
 def probe_from_ball(photos: Sequence[ArrayLike], balls: Optional[Sequence[Vec3]] = None, distance: float = 0.0,
                     angle: float = 90.0, reflectance: Optional[Sequence[float]] = None, fresnel: str = "chrome",
                     mapping: str = "latlong", size: int = 256, samples: int = 2, rotate: float = 0.0,

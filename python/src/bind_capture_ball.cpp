@@ -4,6 +4,7 @@
 
 #include "common.h"
 #include "iblkit/capture/ball.h"
+#include "iblkit/capture/ball_calibrate.h"
 #include "iblkit/core/error.h"
 
 namespace iblpy {
@@ -88,6 +89,53 @@ distance: camera to ball centre in ball radii (0: orthographic); angle: where th
 degrees about +Y; reflectance: r or (r, g, b) at normal incidence (None: the metal's own); fresnel:
 "chrome", "steel", "none" or "n,k". Returns (probe (H, W, 4) RGBA — alpha 0 where no view sees —,
 weights (H, W): the first photograph's share).)doc");
+
+  m.def(
+      "calibrate_ball",
+      [](py::handle photo, std::vector<double> light_in_ball, py::handle direct, std::vector<double> light,
+         std::optional<std::vector<double>> ball, double distance, const std::string& fresnel, double plateau) {
+        auto box = [](const std::vector<double>& b, const char* what) {
+          if (b.size() != 4) ibl::fail(ibl::ErrorKind::Value, "calibrate_ball: {} is (x, y, w, h) in pixels", what);
+          return ibl::capture::PixelBox{b[0], b[1], b[2], b[3]};
+        };
+        ibl::capture::BallView v;
+        v.photo = to_checked_image(photo, "calibrate_ball: photo");
+        v.name = "photo";
+        v.distance = distance;
+        ibl::Image d = to_checked_image(direct, "calibrate_ball: direct");
+        ibl::capture::BallReflectance metal;
+        ibl::capture::parse_fresnel(fresnel, &metal, "fresnel");
+        ibl::capture::ReflectanceFit f;
+        {
+          py::gil_scoped_release nogil;
+          if (ball) {
+            if (ball->size() != 3) ibl::fail(ibl::ErrorKind::Value, "calibrate_ball: a ball is (cx, cy, r)");
+            v.ball = {(*ball)[0], (*ball)[1], (*ball)[2]};
+          } else {
+            v.ball = ibl::capture::find_ball(v.photo, v.name, "ball=").circle;
+          }
+          f = ibl::capture::calibrate_reflectance(v, metal, box(light_in_ball, "light_in_ball"), d, box(light, "light"),
+                                                  plateau, "calibrate_ball");
+        }
+        py::dict r;
+        r["reflectance"] = py::make_tuple(f.r0.x, f.r0.y, f.r0.z);
+        r["light"] = py::make_tuple(f.light.x, f.light.y, f.light.z);
+        r["incidence_deg"] = py::make_tuple(f.incidence_min_deg, f.incidence_max_deg);
+        r["ball_pixels"] = f.ball_pixels;
+        r["direct_pixels"] = f.direct_pixels;
+        r["spread"] = f.spread;
+        r["ball"] = py::make_tuple(v.ball.cx, v.ball.cy, v.ball.r);
+        return r;
+      },
+      py::arg("photo"), py::arg("light_in_ball"), py::arg("direct"), py::arg("light"), py::arg("ball") = py::none(),
+      py::arg("distance") = 0.0, py::arg("fresnel") = "chrome", py::arg("plateau") = 0.8,
+      R"doc(The chrome ball's reflectance from a light seen in the ball and directly, as `iblkit probe calibrate`.
+
+photo: the ball's linear photograph (H, W, 3); light_in_ball: (x, y, w, h) around the light's reflection; direct:
+a linear image of the light in the same units (the same camera and exposure); light: (x, y, w, h) around it;
+ball: (cx, cy, r) (None: found); distance: camera to ball centre in ball radii (0: orthographic); fresnel: the
+metal's rise taken out. Returns {"reflectance": (r, g, b) at normal incidence — probe_from_ball's reflectance —,
+"light", "incidence_deg", "ball_pixels", "direct_pixels", "spread", "ball"}.)doc");
 }
 
 }  // namespace iblpy

@@ -42,3 +42,18 @@ def test_bad_input():
         iblkit.probe_from_ball([], distance=5)
     with pytest.raises(iblkit.InvalidValue, match="partly outside"):
         iblkit.probe_from_ball([ball_photo()], balls=[(150, 80, 70)], distance=5)
+
+
+def test_calibrate_ball_from_a_known_light():
+    """A light of radiance 10 seen in an orthographic ball of reflectance 0.6 (no rise) and directly: r0 = 0.6."""
+    img = ball_photo(value=0.05)
+    img[40:60, 90:110] = 6.0  # the light's reflection, inside the disc
+    direct = np.full((32, 32, 3), 0.1, np.float32)
+    direct[8:24, 8:24] = 10.0
+    fit = iblkit.calibrate_ball(img, (85, 35, 30, 30), direct, (4, 4, 24, 24), ball=(80, 80, 70), fresnel="none")
+    assert fit["reflectance"] == pytest.approx((0.6, 0.6, 0.6), rel=1e-6)
+    assert fit["ball_pixels"] == 400 and fit["direct_pixels"] == 256
+    with pytest.raises(iblkit.InvalidValue, match="leaves its"):
+        iblkit.calibrate_ball(img, (150, 35, 30, 30), direct, (4, 4, 24, 24), ball=(80, 80, 70))
+    with pytest.raises(iblkit.InvalidValue, match=r"\(x, y, w, h\)"):
+        iblkit.calibrate_ball(img, (85, 35, 30), direct, (4, 4, 24, 24), ball=(80, 80, 70))
