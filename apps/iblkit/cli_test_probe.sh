@@ -84,6 +84,8 @@ check calib-box-words fail "x,y,w,h" -- "$BIN" probe calibrate "$W/view0.exr" --
   --light-in-ball 200,105,25 --direct "$W/light.exr" --light 15,12,35,40
 check calib-no-direct fail "no such file" -- "$BIN" probe calibrate "$W/view0.exr" --distance 8 \
   --light-in-ball 200,105,25,45 --direct "$T/nothere.exr" --light 15,12,35,40
+check calib-brighter fail "brighter than the light" -- "$BIN" probe calibrate "$W/view0.exr" --distance 8 \
+  --light-in-ball 200,105,25,45 --direct "$W/view0.exr" --light 0,0,40,40
 check calib-no-lens fail "--distance" -- "$BIN" probe calibrate "$W/view0.exr" --light-in-ball 200,105,25,45 \
   --direct "$W/light.exr" --light 15,12,35,40
 

@@ -121,6 +121,11 @@ ReflectanceFit calibrate_reflectance(const BallView& view, const BallReflectance
          f.light.y, f.light.z);
   Vec3 m = channel_median(bl);
   f.r0 = {m.x / f.light.x, m.y / f.light.y, m.z / f.light.z};
+  if (std::max({f.r0.x, f.r0.y, f.r0.z}) > 1.05)
+    fail(ErrorKind::Value,
+         "{}: the reflection is brighter than the light ({:.3g},{:.3g},{:.3g} of it): the boxes hold different lights, "
+         "or the two images are not in the same units (merge both with the same curve and scale)",
+         what, f.r0.x, f.r0.y, f.r0.z);
   f.ball_pixels = int(bl.size());
   f.direct_pixels = int(dl.size());
   f.incidence_min_deg = 90;

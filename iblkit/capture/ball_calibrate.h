@@ -31,7 +31,8 @@ struct ReflectanceFit {
 // F(θ)/F(0) at the pixel's incidence) is at least `plateau` × the box's 95th percentile; ball pixels
 // count only inside 0.97 of the silhouette's radius. r0 per channel = median over the reflection pixels
 // of their rise-corrected value / the light's median. Throws naming `what` (the options) when a box
-// leaves its image, misses the ball, holds fewer than 4 light pixels, or the light is not positive.
+// leaves its image, misses the ball, holds fewer than 4 light pixels, the light is not positive, or the
+// reflection comes out brighter than the light (r0 > 1.05: different lights, or different units).
 ReflectanceFit calibrate_reflectance(const BallView& view, const BallReflectance& metal, PixelBox in_ball,
                                      const Image& direct, PixelBox in_direct, double plateau = 0.8,
                                      const std::string& what = "--light-in-ball/--light");
