@@ -250,7 +250,7 @@ void run_build(const BuildOptions& opts, const ilf::SequenceReadDesc& rd, const 
           "focus     {:g},{:g},{:g} (σ {:.3g} m, {:.1f} probes' weight): cv error there {:.4f}; the whole "
           "volume's choice would be {:g} cells{}\n",
           f.centre.x, f.centre.y, f.centre.z, ch.focus_sigma, ch.focus_weight, ch.trials[ch.chosen].focus_error,
-          ch.volume_kernel, bd.auto_grid ? fmt::format(" at {}", ch.volume_n) : "");
+          ch.volume_kernel, bd.auto_grid ? fmt::format(" on a {}-point grid", ch.volume_n) : "");
     }
     if (rep.crossval) {
       const auto& c = *rep.crossval;
