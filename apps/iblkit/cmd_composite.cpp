@@ -368,7 +368,9 @@ void setup(CLI::App& app) {
                  "JPEG quality of a .jpg --out (default: the input JPEG's own, estimated from its tables; else 95)")
       ->check(CLI::Range(1, 100));
   iblcli::add_photo_scene_options(app, &o->scene, "");
-  app.add_option("--light", o->light, "an SH grid (.shgrid) or a probe image (with --at-probe), with --proxy");
+  app.add_option("--light", o->light,
+                 "an SH grid (.shgrid; built for the object: ilf build --focus AT,R) or a probe image (with "
+                 "--at-probe), with --proxy");
   app.add_option("--probe-depth", o->probe_depth,
                  "the --light probe's depth map (metres; lights in front of the proxy)");
   auto& rd = iblcli::add_probe_read_options(app);
