@@ -150,6 +150,14 @@ void run(const Opts& o) {
   });
 }
 
+// The ball camera's lens: --distance, or --focal-mm with --sensor-mm, or --orthographic (check_lens).
+void add_lens_options(CLI::App* c, double* distance, double* focal_mm, double* sensor_mm, bool* orthographic) {
+  c->add_option("--distance", *distance, "camera to ball centre, in ball radii (> 1)");
+  c->add_option("--focal-mm", *focal_mm, "lens focal length, mm (with --sensor-mm: the distance from the ball's size)");
+  c->add_option("--sensor-mm", *sensor_mm, "sensor width, mm");
+  c->add_flag("--orthographic", *orthographic, "the orthographic approximation (a camera infinitely far)");
+}
+
 struct CalOpts {
   std::string photo, ball, direct, in_ball, in_direct, fresnel = "chrome";
   double distance = 0, focal_mm = 0, sensor_mm = 0, plateau = 0.8;
@@ -202,11 +210,7 @@ void setup_calibrate(CLI::App& app) {
                                "camera and exposure: a window, a softbox, a panel)");
   c->add_option("photo", o->photo, "the ball's linear HDR photograph (.exr .hdr .pfm)")->required();
   c->add_option("--ball", o->ball, "the silhouette cx,cy,r (pixels, continuous coordinates; default: fitted)");
-  c->add_option("--distance", o->distance, "camera to ball centre, in ball radii (> 1)");
-  c->add_option("--focal-mm", o->focal_mm,
-                "lens focal length, mm (with --sensor-mm: the distance from the ball's size)");
-  c->add_option("--sensor-mm", o->sensor_mm, "sensor width, mm");
-  c->add_flag("--orthographic", o->orthographic, "the orthographic approximation (a camera infinitely far)");
+  add_lens_options(c, &o->distance, &o->focal_mm, &o->sensor_mm, &o->orthographic);
   c->add_option("--light-in-ball", o->in_ball,
                 "x,y,w,h: a box around the light's reflection in the ball photograph (pixels)")
       ->required();
@@ -237,11 +241,7 @@ void setup(CLI::App& app) {
   c->add_option("--ball", o->balls,
                 "the ball's silhouette cx,cy,r in pixels (continuous: the image spans [0,W]×[0,H]); once per "
                 "photograph; default: found by a circle fit to its edge");
-  c->add_option("--distance", o->distance, "camera to ball centre, in ball radii (> 1)");
-  c->add_option("--focal-mm", o->focal_mm,
-                "lens focal length, mm (with --sensor-mm: the distance from the ball's size)");
-  c->add_option("--sensor-mm", o->sensor_mm, "sensor width, mm");
-  c->add_flag("--orthographic", o->orthographic, "the orthographic approximation (a camera infinitely far)");
+  add_lens_options(c, &o->distance, &o->focal_mm, &o->sensor_mm, &o->orthographic);
   c->add_option("--reflectance", o->reflectance,
                 "the ball's normal-incidence reflectance, r or r,g,b (default: the metal's own)");
   c->add_option("--fresnel", o->fresnel, "the rise towards grazing: chrome, steel, none or n,k")->capture_default_str();
