@@ -39,6 +39,20 @@ check curve-too-shallow fail "t16-0.tif: a 16-bit photograph, but the curve .*c.
 check nothing-written ok "^none$" -- sh -c "ls '$T' | grep '^x[0-468]' || echo none"
 check bad-grey-card fail "grey-card" -- "$BIN" hdr merge "$T"/b-?.jpg --out "$T/x7.exr" --grey-card 1,2,3
 
+# A chrome ball's bracket on a tripod (the lab shoots without a shift): a mostly dark room of a few large flat areas,
+# the longest frame 70 % saturated, where Ward's pyramid once landed a step off (shift 1,1) at a coarse level; every
+# shift must come back 0,0.
+if "$BIN" --help | grep -q "^  lab"; then
+  "$BIN" --quiet lab shoot low-scene2 --at 0,0.15,0 --distance-radii 10 --width 384 --height 384 --samples 4 \
+    --bracket 12 --until-unsaturated --ev-step 3 --bounces 1 --noise --wb 1.1,1,0.8 --out "$T/ball" > /dev/null
+  "$BIN" --json hdr merge "$T"/ball/view0_e*.jpg --out "$T/ball.exr" > "$T/ball.json"
+  check tripod-shifts ok "8 frames, all 0,0" -- /usr/bin/python3 -c "
+import json, sys
+f = json.load(open(sys.argv[1]))['frames']
+bad = [(x['file'], x['shift']) for x in f if x['shift'] != [0, 0]]
+print('%d frames, all 0,0' % len(f) if not bad else bad)" "$T/ball.json"
+fi
+
 # Raw brackets (LibRaw, the raw plugin): the lab's DNGs merge linearly with their levels reported; a curve is
 # refused; a raw file LibRaw cannot read, or one cut short, fails naming it; nothing written.
 if [ -f "$(dirname "$BIN")/libiblkit_raw.so" ]; then

@@ -396,11 +396,18 @@ int64_t mismatch(const Bitmaps& a, const Bitmaps& b, int dx, int dy) {
   return n;
 }
 
-// Ward's pyramid search of the shift of b relative to a.
+// Ward's pyramid search of the shift of b relative to a. The pyramid only speeds the search up: a coarse level can
+// land a step away from the truth where a bracket holds a few large flat areas (a chrome ball's dark room; seen: a
+// 1,1 shift for frames shot on a tripod), and the finer levels cannot come back by more than one pixel each. So the
+// search's answer is then checked at full resolution against the unshifted frame and its 8 neighbours: the smallest
+// mismatch there wins (ties to the smaller shift).
 std::array<int, 2> align_pair(const std::vector<Grey>& a, const std::vector<Grey>& b) {
   const int levels = static_cast<int>(a.size());
   const double q = pair_quantile(a[0], b[0]);
   int sx = 0, sy = 0;
+  auto better = [](int64_t e, int x, int y, int64_t best, int bx, int by) {
+    return e < best || (e == best && std::abs(x) + std::abs(y) < std::abs(bx) + std::abs(by));
+  };
   for (int l = levels - 1; l >= 0; --l) {
     sx *= 2, sy *= 2;
     const Bitmaps ba = bitmaps(a[l], quantile(a[l].v, q)), bb = bitmaps(b[l], quantile(b[l].v, q));
@@ -409,9 +416,14 @@ std::array<int, 2> align_pair(const std::vector<Grey>& a, const std::vector<Grey
     for (int dy = -1; dy <= 1; ++dy)
       for (int dx = -1; dx <= 1; ++dx) {
         const int64_t e = mismatch(ba, bb, sx + dx, sy + dy);
-        if (e < best || (e == best && std::abs(sx + dx) + std::abs(sy + dy) < std::abs(bx) + std::abs(by)))
-          best = e, bx = sx + dx, by = sy + dy;
+        if (better(e, sx + dx, sy + dy, best, bx, by)) best = e, bx = sx + dx, by = sy + dy;
       }
+    if (l == 0)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int64_t e = mismatch(ba, bb, dx, dy);
+          if (better(e, dx, dy, best, bx, by)) best = e, bx = dx, by = dy;
+        }
     sx = bx, sy = by;
   }
   return {sx, sy};
