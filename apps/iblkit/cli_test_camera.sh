@@ -99,6 +99,10 @@ check nan-points fail "nan.json" -- "$BIN" camera solve "$T/photo.exr" --points 
 check nan-fov fail "\-\-fov" -- "$BIN" camera solve "$T/photo.exr" --points "$T/depth.json" --fov nan --out "$T/bad3.json"
 check no-board fail "\-\-board checker:9x6:0.08: no 9x6-corner chessboard found" -- \
   "$BIN" camera solve "$T/photo.exr" --board checker:9x6:0.08 --fov 42 --out "$T/bad4.json"
+check charuco-bad-spec fail "\-\-board charuco:5x4:0.2:0.25: marker size" -- \
+  "$BIN" camera solve "$T/photo.exr" --board charuco:5x4:0.2:0.25 --fov 42 --out "$T/bad8.json"
+check charuco-not-found fail "no 5x4-square ChArUco board found|no aruco module" -- \
+  "$BIN" camera solve "$T/board.png" --board charuco:5x4:0.08:0.06 --fov 50 --out "$T/bad9.json"
 check symmetric-board fail "\-\-board checker:8x6" -- \
   "$BIN" camera solve "$T/board.png" --board checker:8x6:0.08 --fov 50 --out "$T/bad5.json"
 check board-axes-backwards fail "\-\-board-axes" -- "$BIN" camera solve "$T/board.png" --board checker:9x6:0.08 \

@@ -34,6 +34,24 @@ assert e["object"] < 0.6 and e["shadow"] < 0.8 and e["unchanged"] < 0.05, e
 print("camera ok", c["eye_error_mm"], c["view_error_deg"], e["object"], e["shadow"])
 PY
 check layers ok "probe_matched.exr" -- ls "$T/set/layers"
+# A ChArUco board (docs/camera.md): the lab prints OpenCV's board, the chain finds it by its markers, leaves out the
+# corners it misread (a pool of light crosses the board) and meets the camera targets on a 640×480 plate.
+if ! "$BIN" lab shoot low-scene2 --backplate --bracket 2 --board charuco:5x4:0.2:0.15 --width 32 --height 32 \
+    --plate-width 64 --plate-height 48 --plate-samples 1 --out "$T/probe_charuco" 2>&1 | grep -q "no aruco module"; then
+  "$BIN" --quiet lab shoot low-scene2 --at 0,0.15,0 --two-sides --distance-radii 10 --width 128 --height 128 --samples 1 \
+    --bracket 12 --until-unsaturated --ev-step 3 --bounces 1 --noise --wb 1.1,1,0.8 --backplate --plate-samples 3 \
+    --plate-width 640 --plate-height 480 --board charuco:5x4:0.2:0.15 --board-at -0.2,0,0.6 --out "$T/ch" > /dev/null
+  "$BIN" --json composite --capture "$T/ch" --out "$T/ch/c.jpg" --samples 8 --object-samples 64 2>/dev/null > "$T/ch.json"
+  check charuco-chain ok "charuco camera ok" -- /usr/bin/python3 - "$T/ch.json" <<'PY'
+import json, sys
+c = json.load(open(sys.argv[1]))["camera"]
+assert c["board_corners"] >= 8, c
+assert c["eye_error_mm"] < 5 and c["view_error_deg"] < 0.2 and c["reprojection_rms_px"] < 0.5, c
+print("charuco camera ok", c["board_corners"], c["board_corners_dropped"], c["eye_error_mm"], c["view_error_deg"])
+PY
+else
+  echo "SKIP charuco-chain: this build's OpenCV has no aruco module (libopencv-contrib-dev)"
+fi
 if command -v oiiotool > /dev/null; then
   check exif-kept ok "Exif:FocalLength" -- oiiotool --info -v "$T/set/composite.jpg"
 else

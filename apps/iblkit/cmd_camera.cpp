@@ -67,9 +67,7 @@ std::vector<Correspondence> board_points(const std::string& photo, const Board& 
   auto pts = ibl::capture::find_board(img, b);
   if (!pts)
     fail(ErrorKind::Value,
-         "--board {}: no {}x{}-corner chessboard found in {} (check the counts: inner corners; the whole board "
-         "must be in the frame)",
-         spec, b.cols, b.rows, photo);
+         "--board {}: no {} found in {} ({})", spec, b.describe(), photo, b.find_hint());
   return *pts;
 }
 
@@ -162,7 +160,8 @@ void run_solve(const SolveOpts& o) {
   const std::string source = o.points.empty() ? "--board " + o.board.spec : "--points " + o.points;
   ibl::capture::Solved s;
   try {
-    s = ibl::capture::solve_camera(pts, lens, mode);
+    s = o.points.empty() ? ibl::capture::solve_board_camera(board, pts, lens, mode)
+                         : ibl::capture::solve_camera(pts, lens, mode);
   } catch (const ibl::Error& e) {
     fail(e.kind(), "{}: {}", source, e.what());
   }
@@ -186,6 +185,7 @@ void run_solve(const SolveOpts& o) {
   nlohmann::json j = {{"camera", o.out},
                       {"points", pts.size()},
                       {"coplanar", s.coplanar},
+                      {"dropped", s.dropped},
                       {"lens", mode == ibl::capture::LensMode::Fixed ? "fixed" : "focal solved"},
                       {"lens_source", lens_source},
                       {"eye", vec(s.camera.eye)},
@@ -200,6 +200,7 @@ void run_solve(const SolveOpts& o) {
                mode == ibl::capture::LensMode::Fixed ? "fixed (" + lens_source + ")" : lens_source);
     print_camera(s.camera);
     fmt::print("reprojection error {:.4g} px RMS, {:.4g} px max\n", s.error.rms_px, s.error.max_px);
+    if (s.dropped) fmt::print("dropped   {} corners as misread (over 3 x the median error)\n", s.dropped);
     fmt::print("wrote     {}\n", o.out);
   });
 }

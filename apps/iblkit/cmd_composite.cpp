@@ -269,6 +269,7 @@ void run_capture(const Opts& o) {
                         {"fov_y_deg", cam.fov_y_deg},
                         {"lens", c.lens_source},
                         {"board_corners", c.board_corners},
+                        {"board_corners_dropped", c.camera.dropped},
                         {"reprojection_rms_px", c.camera.error.rms_px},
                         {"reprojection_max_px", c.camera.error.max_px}}},
                       {"backend", ibl::augment::backend_name(c.run.backend)},

@@ -285,13 +285,18 @@ struct ShootOpts {
   int plate_width = 320, plate_height = 240, plate_samples = 8;
 };
 
+// --board: COLSxROWS:SQUARE_M is a checker's inner corners; a full spec (checker:…, charuco:…) is taken as it is.
+std::string board_spec(const std::string& b) {
+  return b.rfind("checker:", 0) == 0 || b.rfind("charuco:", 0) == 0 ? b : "checker:" + b;
+}
+
 // lab shoot --backplate: the backplate (the scene with the board printed on the floor, no object), the truth (the
 // same photograph with the object), their camera, the proxy, and capture.json naming the views' brackets.
 nlohmann::json shoot_backplate(const ShootOpts& o, const ibl::lab::ShootDesc& d, const ibl::lab::BracketDesc& bd,
                                const nlohmann::json& jviews, const fs::path& out) {
   ibl::lab::Scene scene = ibl::lab::load_scene(o.scene, false);
   const ibl::geometry::TriMesh proxy = scene.proxy_mesh();
-  ibl::capture::Board board = ibl::capture::parse_board("checker:" + o.board, "--board");
+  ibl::capture::Board board = ibl::capture::parse_board(board_spec(o.board), "--board");
   const Vec3 centre = iblcli::parse_vec3(o.board_at, "--board-at");
   const Vec3 u{1, 0, 0}, v{0, 0, -1};  // on the floor, face up
   const Vec3 origin = centre - (u * ((board.cols - 1) / 2.0) + v * ((board.rows - 1) / 2.0)) * board.square;
@@ -351,7 +356,7 @@ nlohmann::json shoot_backplate(const ShootOpts& o, const ibl::lab::ShootDesc& d,
   // The camera's curve, as a user who calibrated it once (hdr merge --response-out) names it; without "response"
   // the chain recovers one from the ball's brackets (docs/capture.md measures both).
   f.response = bd.raw ? "linear" : "response.json";  // a raw file is linear
-  f.board_spec = "checker:" + o.board;
+  f.board_spec = board_spec(o.board);
   f.board = board;
   if (cam.intrinsics) {  // the lens as `camera calibrate` would have found it beforehand
     ibl::geometry::Camera lens = cam;
@@ -395,7 +400,7 @@ nlohmann::json shoot_backplate(const ShootOpts& o, const ibl::lab::ShootDesc& d,
 void run_shoot(const ShootOpts& o) {
   if (o.backplate && o.bracket == 0)  // before anything is shot or written
     ibl::fail(ibl::ErrorKind::Value, "--backplate: the ball needs its brackets (--bracket N)");
-  if (o.backplate) ibl::capture::parse_board("checker:" + o.board, "--board");
+  if (o.backplate) ibl::capture::parse_board(board_spec(o.board), "--board");
   ibl::lab::Scene scene = ibl::lab::load_scene(o.scene, false);
   ibl::lab::ShootDesc d;
   d.ball_center = iblcli::parse_vec3(o.at, "--at");
@@ -698,7 +703,8 @@ void setup(CLI::App& app) {
   sh->add_option("--plate-wb", so->plate_wb, "the backplate's white-balance gains r,g,b")->capture_default_str();
   sh->add_option("--plate-exposure", so->plate_exposure,
                  "the backplate's exposure, seconds (default: its median at middle grey, its highlights kept)");
-  sh->add_option("--board", so->board, "the board on the floor: COLSxROWS:SQUARE_M (inner corners)")
+  sh->add_option("--board", so->board, "the board on the floor: COLSxROWS:SQUARE_M (a checker's inner corners) or a full spec, "
+                 "charuco:SQXxSQY:SQUARE_M:MARKER_M[:DICT] (docs/camera.md)")
       ->capture_default_str();
   sh->add_option("--board-at", so->board_at, "the board's centre on the floor x,y,z")->capture_default_str();
   sh->add_option("--object", so->object, "the object of the truth: blob, sphere or a mesh file")->capture_default_str();

@@ -136,11 +136,9 @@ ChainResult run_capture(const capture::CaptureFolder& f, const ChainDesc& d) {
   auto pts = capture::find_board(out.plate.linear, f.board);
   if (!pts)
     fail(ErrorKind::Value,
-         "{}: no {}x{}-corner chessboard ({}) found (check the board's counts: inner corners; the whole board must be "
-         "in the frame)",
-         f.at(f.backplate), f.board.cols, f.board.rows, f.board_spec);
+         "{}: no {} ({}) found ({})", f.at(f.backplate), f.board.describe(), f.board_spec, f.board.find_hint());
   out.board_corners = pts->size();
-  out.camera = capture::solve_camera(*pts, lens, mode);
+  out.camera = capture::solve_board_camera(f.board, *pts, lens, mode);
   const Vec3 n = cross(f.board.u, f.board.v);
   if (n.y < -0.9 && out.camera.camera.eye.y < f.board.origin.y)
     fail(ErrorKind::Value,

@@ -69,13 +69,98 @@ std::vector<Vec3> Board::corners() const {
   return c;
 }
 
+std::string Board::describe() const {
+  return charuco ? fmt::format("{}x{}-square ChArUco board", cols + 1, rows + 1)
+                 : fmt::format("{}x{}-corner chessboard", cols, rows);
+}
+
+std::string Board::find_hint() const {
+  return charuco ? fmt::format("fewer than {} of its corners: at least two markers about each must be readable, a few "
+                               "pixels a marker bit",
+                               kMinCorrespondences)
+                 : "check the counts: inner corners; the whole board must be in the frame";
+}
+
+namespace {
+
+// OpenCV's predefined dictionaries DICT_4X4_50 (0) … DICT_7X7_1000 (15): bits 4..7, 50/100/250/1000 markers.
+int dictionary_id(const std::string& name, int* size) {
+  static const int kSizes[4] = {50, 100, 250, 1000};
+  for (int bits = 4; bits <= 7; ++bits)
+    for (int k = 0; k < 4; ++k)
+      if (name == fmt::format("{}x{}_{}", bits, bits, kSizes[k])) {
+        *size = kSizes[k];
+        return (bits - 4) * 4 + k;
+      }
+  return -1;
+}
+
+Board parse_charuco(const std::string& spec, const std::string& option) {
+  Board b;
+  b.charuco = true;
+  int sx = 0, sy = 0, n = 0;
+  char dict[32] = {0};
+  const int got = std::sscanf(spec.c_str(), "charuco:%dx%d:%lf:%lf%n", &sx, &sy, &b.square, &b.marker, &n);
+  std::string rest = got == 4 ? spec.substr(static_cast<size_t>(n)) : std::string("?");
+  if (got == 4 && rest.size() > 1 && rest[0] == ':' && rest.size() < sizeof dict + 1) {
+    std::copy(rest.begin() + 1, rest.end(), dict);
+    rest.clear();
+  }
+  if (got != 4 || !rest.empty())
+    fail(ErrorKind::Value,
+         "{} {}: expected charuco:SQXxSQY:SQUARE_M:MARKER_M[:DICT] (squares, metres; DICT 4x4_50 by default), e.g. "
+         "charuco:5x4:0.2:0.15",
+         option, spec);
+  b.dictionary_name = dict[0] ? dict : "4x4_50";
+  int size = 0;
+  b.dictionary = dictionary_id(b.dictionary_name, &size);
+  if (b.dictionary < 0)
+    fail(ErrorKind::Value, "{} {}: dictionary '{}': use NxN_M with N 4..7 and M 50, 100, 250 or 1000 (4x4_50)",
+         option, spec, b.dictionary_name);
+  if (sx < 3 || sy < 3 || sx > 100 || sy > 100)
+    fail(ErrorKind::Value, "{} {}: {}x{} squares; each count must lie in 3..100", option, spec, sx, sy);
+  if (!(b.square > 0 && b.square <= 10))
+    fail(ErrorKind::Value, "{} {}: square size {} m must lie in (0, 10]", option, spec, b.square);
+  if (!(b.marker > 0 && b.marker < b.square))
+    fail(ErrorKind::Value, "{} {}: marker size {} m must be positive and smaller than the square ({} m)", option,
+         spec, b.marker, b.square);
+  if (sx * sy / 2 > size)
+    fail(ErrorKind::Value, "{} {}: {} markers, but dictionary {} holds {}; name a larger one (e.g. :{}_1000)", option,
+         spec, sx * sy / 2, b.dictionary_name, size, b.dictionary_name.substr(0, 3));
+  b.cols = sx - 1;
+  b.rows = sy - 1;
+  return b;
+}
+
+const detail::CvSolver& aruco(const char* what) {
+  const detail::CvSolver& cv = detail::cv_solver.get();
+  if (!cv.find_charuco || !cv.draw_charuco)
+    fail(ErrorKind::Value,
+         "{}: this build's OpenCV has no aruco module (scripts/install-deps installs libopencv-contrib-dev); use a "
+         "checker:COLSxROWS:SQUARE_M board",
+         what);
+  return cv;
+}
+
+}  // namespace
+
+Image draw_charuco(const Board& board, int px_per_square) {
+  if (!board.charuco) fail(ErrorKind::Internal, "draw_charuco: not a ChArUco board");
+  if (px_per_square < 8 || px_per_square > 512)
+    fail(ErrorKind::Value, "draw_charuco: {} pixels a square outside 8..512", px_per_square);
+  return aruco("a ChArUco board").draw_charuco(board, px_per_square);
+}
+
 Board parse_board(const std::string& spec, const std::string& option) {
+  if (spec.rfind("charuco:", 0) == 0) return parse_charuco(spec, option);
   Board b;
   int n = 0;
   char tail = 0;
   if (std::sscanf(spec.c_str(), "checker:%dx%d:%lf%n%c", &b.cols, &b.rows, &b.square, &n, &tail) != 3 ||
       n != static_cast<int>(spec.size()))
-    fail(ErrorKind::Value, "{} {}: expected checker:COLSxROWS:SQUARE_M (inner corners, metres), e.g. checker:9x6:0.05",
+    fail(ErrorKind::Value,
+         "{} {}: expected checker:COLSxROWS:SQUARE_M (inner corners, metres), e.g. checker:9x6:0.05, or "
+         "charuco:SQXxSQY:SQUARE_M:MARKER_M[:DICT]",
          option, spec);
   if (b.cols < 3 || b.rows < 3 || b.cols > 100 || b.rows > 100)
     fail(ErrorKind::Value, "{} {}: {}x{} inner corners; each count must lie in 3..100", option, spec, b.cols, b.rows);
@@ -162,6 +247,16 @@ std::optional<std::vector<Correspondence>> find_board(const Image& photo, const 
       const float* p = photo.pixel(x, y);
       grey.at(x, y, 0) = photo.channels() >= 3 ? 0.2126f * p[0] + 0.7152f * p[1] + 0.0722f * p[2] : p[0];
     }
+  if (board.charuco) {
+    const auto ids = aruco(board.describe().c_str()).find_charuco(grey, board);
+    if (static_cast<int>(ids.size()) < kMinCorrespondences) return std::nullopt;
+    std::vector<Correspondence> out;
+    for (const auto& [id, px] : ids) {
+      if (id < 0 || id >= board.cols * board.rows) continue;
+      out.push_back({px, board.corner(id % board.cols, board.rows - 1 - id / board.cols)});
+    }
+    return out;
+  }
   auto found = detail::cv_solver.get().find_chessboard(grey, board.cols, board.rows);
   if (!found) return std::nullopt;
   const int C = board.cols, R = board.rows;
@@ -187,6 +282,32 @@ std::optional<std::vector<Correspondence>> find_board(const Image& photo, const 
       out.push_back({px, board.corner(a, b)});
     }
   return out;
+}
+
+Solved solve_board_camera(const Board& board, std::vector<Correspondence> pts, const geometry::Camera& lens,
+                          LensMode mode) {
+  Solved s = solve_camera(pts, lens, mode);
+  if (!board.charuco) return s;
+  int dropped = 0;
+  for (int round = 0; round < 3; ++round) {
+    std::vector<double> err;
+    for (const auto& p : pts) {
+      const auto q = s.camera.project(p.world);
+      err.push_back(q ? std::hypot(q->x - p.pixel.x, q->y - p.pixel.y) : 1e300);
+    }
+    std::vector<double> sorted = err;
+    std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
+    const double limit = std::max(1.0, 3 * sorted[sorted.size() / 2]);
+    std::vector<Correspondence> kept;
+    for (size_t i = 0; i < pts.size(); ++i)
+      if (err[i] <= limit) kept.push_back(pts[i]);
+    if (kept.size() == pts.size() || static_cast<int>(kept.size()) < kMinCorrespondences) break;
+    dropped += static_cast<int>(pts.size() - kept.size());
+    pts.swap(kept);
+    s = solve_camera(pts, lens, mode);
+  }
+  s.dropped = dropped;
+  return s;
 }
 
 Calibrated calibrate_camera(const std::vector<std::vector<Correspondence>>& views, int width, int height) {

@@ -70,6 +70,31 @@ TEST(CameraSolve, BoardsAreParsedPlacedAndChecked) {
   EXPECT_THROW(place_board(b, {0, 0, 0}, {1, 0, 0}, {2, 0, 0}, "--board-axes"), Error);
 }
 
+TEST(CameraSolve, CharucoBoardsCountSquaresAndNameTheirDictionary) {
+  Board b = parse_board("charuco:5x4:0.2:0.15", "--board");
+  EXPECT_TRUE(b.charuco);
+  EXPECT_EQ(b.cols, 4);  // inner corners: one fewer than the squares
+  EXPECT_EQ(b.rows, 3);
+  EXPECT_EQ(b.marker, 0.15);
+  EXPECT_EQ(b.dictionary_name, "4x4_50");
+  EXPECT_EQ(b.dictionary, 0);  // cv::aruco::DICT_4X4_50
+  EXPECT_EQ(b.describe(), "5x4-square ChArUco board");
+  Board c = parse_board("charuco:12x9:0.03:0.022:5x5_100", "--board");
+  EXPECT_EQ(c.dictionary, 5);  // DICT_5X5_100
+  EXPECT_EQ(parse_board("checker:7x4:0.1", "--board").describe(), "7x4-corner chessboard");
+  // Squares out of range, a marker no smaller than its square, a dictionary unknown or too small for the board's
+  // 11·9/2 = 49… (12·10/2 = 60 > 50) markers, a tail.
+  for (const char* bad : {"charuco:2x4:0.2:0.15", "charuco:5x4:0.2:0.2", "charuco:5x4:0.2:0", "charuco:5x4:0.2:0.15:3x3_50",
+                          "charuco:12x10:0.03:0.02", "charuco:5x4:0.2:0.15x", "charuco:5x4:0.2:0.15:"}) {
+    try {
+      parse_board(bad, "--board");
+      ADD_FAILURE() << bad << " was accepted";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("--board " + std::string(bad)), std::string::npos) << e.what();
+    }
+  }
+}
+
 TEST(CameraSolve, ReprojectionCountsPointsBehindTheCamera) {
   geometry::Camera c;
   c.width = 64;

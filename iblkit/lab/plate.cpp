@@ -40,13 +40,27 @@ void add_board(Scene& scene, const capture::Board& board) {
   Surface print;
   print.name = "board";
   print.mesh = print_quad(outer + n * 0.001, board.u, board.v, a, b);
+  print.proxy = false;
+  if (board.charuco) {
+    // OpenCV's print, 64 pixels a square, the page's bottom at the origin's side (the texture's v runs up the page).
+    const Image page = capture::draw_charuco(board, 64);
+    auto tex = std::make_shared<Image>(page.width(), page.height(), 3);
+    for (int y = 0; y < page.height(); ++y)
+      for (int x = 0; x < page.width(); ++x) {
+        const double t = page.at(x, y, 0);
+        const float al = static_cast<float>(kBoardDark + t * (kBoardWhite - kBoardDark));
+        tex->set_rgb(x, y, {al, al, al});
+      }
+    print.albedo.image = tex;
+    scene.surfaces.push_back(std::move(print));
+    return;
+  }
   print.albedo.checker = true;
   print.albedo.tiles = {static_cast<double>(board.cols + 1), static_cast<double>(board.rows + 1)};
   // Texture::eval gives `a` where the square's indices sum to an even number: square (1, 1), between the first
   // four inner corners, is dark.
   print.albedo.a = {kBoardDark, kBoardDark, kBoardDark};
   print.albedo.b = {kBoardWhite, kBoardWhite, kBoardWhite};
-  print.proxy = false;
   scene.surfaces.push_back(std::move(print));
 }
 

@@ -17,8 +17,9 @@
 namespace ibl::lab {
 
 // Prints `board` onto the floor it lies on: its (cols + 1) × (rows + 1) squares, dark where the board's
-// convention has them (capture::Board: the square between the first four inner corners is dark), on a white
-// margin of one square, 1 mm above the board's plane on the side u × v points to. Not part of the proxy.
+// convention has them (capture::Board: the square between the first four inner corners is dark; a ChArUco
+// board as OpenCV draws it, through the "cv" plugin), on a white margin of one square, 1 mm above the board's
+// plane on the side u × v points to. Not part of the proxy.
 inline constexpr double kBoardDark = 0.04, kBoardWhite = 0.85;  // the print's albedos
 void add_board(Scene& scene, const capture::Board& board);
 

@@ -117,8 +117,8 @@ void init_capture(py::module_& m) {
             found = cap::find_board(img, b);
           }
           if (!found)
-            ibl::fail(ibl::ErrorKind::Value, "camera_solve: no {}x{}-corner chessboard ({}) found in the photo", b.cols,
-                      b.rows, board);
+            ibl::fail(ibl::ErrorKind::Value, "camera_solve: no {} ({}) found in the photo ({})", b.describe(), board,
+                      b.find_hint());
           pts = *found;
         } else if (py::isinstance<py::str>(points)) {
           pts = cap::read_points(points.cast<std::string>());
@@ -136,7 +136,7 @@ void init_capture(py::module_& m) {
         cap::Solved s;
         {
           py::gil_scoped_release release;
-          s = cap::solve_camera(pts, lens, mode);
+          s = from_board ? cap::solve_board_camera(b, pts, lens, mode) : cap::solve_camera(pts, lens, mode);
         }
         py::dict report;
         report["points"] = pts.size();
