@@ -65,9 +65,7 @@ Board make_board(const BoardOpts& o) {
 std::vector<Correspondence> board_points(const std::string& photo, const Board& b, const std::string& spec) {
   ibl::Image img = ibl::io::read_image(photo);
   auto pts = ibl::capture::find_board(img, b);
-  if (!pts)
-    fail(ErrorKind::Value,
-         "--board {}: no {} found in {} ({})", spec, b.describe(), photo, b.find_hint());
+  if (!pts) fail(ErrorKind::Value, "--board {}: no {} found in {} ({})", spec, b.describe(), photo, b.find_hint());
   return *pts;
 }
 

@@ -703,7 +703,8 @@ void setup(CLI::App& app) {
   sh->add_option("--plate-wb", so->plate_wb, "the backplate's white-balance gains r,g,b")->capture_default_str();
   sh->add_option("--plate-exposure", so->plate_exposure,
                  "the backplate's exposure, seconds (default: its median at middle grey, its highlights kept)");
-  sh->add_option("--board", so->board, "the board on the floor: COLSxROWS:SQUARE_M (a checker's inner corners) or a full spec, "
+  sh->add_option("--board", so->board,
+                 "the board on the floor: COLSxROWS:SQUARE_M (a checker's inner corners) or a full spec, "
                  "charuco:SQXxSQY:SQUARE_M:MARKER_M[:DICT] (docs/camera.md)")
       ->capture_default_str();
   sh->add_option("--board-at", so->board_at, "the board's centre on the floor x,y,z")->capture_default_str();

@@ -135,8 +135,8 @@ ChainResult run_capture(const capture::CaptureFolder& f, const ChainDesc& d) {
   const geometry::Camera lens = chain_lens(f, out.plate, d.exif_lens, &mode, &out.lens_source);
   auto pts = capture::find_board(out.plate.linear, f.board);
   if (!pts)
-    fail(ErrorKind::Value,
-         "{}: no {} ({}) found ({})", f.at(f.backplate), f.board.describe(), f.board_spec, f.board.find_hint());
+    fail(ErrorKind::Value, "{}: no {} ({}) found ({})", f.at(f.backplate), f.board.describe(), f.board_spec,
+         f.board.find_hint());
   out.board_corners = pts->size();
   out.camera = capture::solve_board_camera(f.board, *pts, lens, mode);
   const Vec3 n = cross(f.board.u, f.board.v);

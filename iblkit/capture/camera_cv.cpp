@@ -303,7 +303,8 @@ Calibrated cv_calibrate(const std::vector<std::vector<Correspondence>>& views, i
 #ifdef IBLKIT_HAVE_ARUCO
 cv::Ptr<cv::aruco::CharucoBoard> charuco_board(const Board& b) {
   return cv::aruco::CharucoBoard::create(b.cols + 1, b.rows + 1, static_cast<float>(b.square),
-                                         static_cast<float>(b.marker), cv::aruco::getPredefinedDictionary(b.dictionary));
+                                         static_cast<float>(b.marker),
+                                         cv::aruco::getPredefinedDictionary(b.dictionary));
 }
 
 // Two tone maps of the photograph: the 8-bit one the chessboard gets (99.5th percentile white, 1/2.2 gamma), and its
@@ -313,7 +314,8 @@ std::vector<cv::Mat> marker_views(const Image& grey) {
   for (int y = 0; y < g8.rows; ++y)
     for (int x = 0; x < g8.cols; ++x) {
       const double t = std::pow(g8.at<uint8_t>(y, x) / 255.0, 2.2);  // back to linear over the white point
-      lg.at<uint8_t>(y, x) = static_cast<uint8_t>(std::lround(255 * std::max(0.0, 1 + std::log2(std::max(t, 1e-4)) / 8)));
+      lg.at<uint8_t>(y, x) =
+          static_cast<uint8_t>(std::lround(255 * std::max(0.0, 1 + std::log2(std::max(t, 1e-4)) / 8)));
     }
   return {g8, lg};
 }

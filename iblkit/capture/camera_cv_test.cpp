@@ -105,7 +105,8 @@ Image render_charuco(const Camera& cam, const Board& b, Vec3 hide, double hide_r
             double a = dot(p, b.u) / b.square, bb = dot(p, b.v) / b.square;  // corner units
             if (a > -1 && a < b.cols && bb > -1 && bb < b.rows) {
               const int i = static_cast<int>((a + 1) * px), j = page.height() - 1 - static_cast<int>((bb + 1) * px);
-              v = page.at(std::clamp(i, 0, page.width() - 1), std::clamp(j, 0, page.height() - 1), 0) > 0.5 ? 0.8 : 0.05;
+              v = page.at(std::clamp(i, 0, page.width() - 1), std::clamp(j, 0, page.height() - 1), 0) > 0.5 ? 0.8
+                                                                                                            : 0.05;
             }
             if (length(q - hide) < hide_r) v = 0.45;
           }
@@ -230,7 +231,7 @@ TEST(CameraCv, ACharucoBoardPartlyHiddenGivesTheCornersItShows) {
   truth.height = 480;
   Board b = parse_board("charuco:7x5:0.1:0.075", "--board");
   place_board(b, {-0.25, 0, 0.45}, {1, 0, 0}, {0, 0, -1}, "--board");  // on the floor, face up
-  const Vec3 hide = b.corner(1, 1);                                      // a disc over the corners about (1, 1)
+  const Vec3 hide = b.corner(1, 1);                                    // a disc over the corners about (1, 1)
   Image img = render_charuco(truth, b, hide, 0.12);
   auto pts = find_board(img, b);
   ASSERT_TRUE(pts) << "board not found";

@@ -75,9 +75,10 @@ std::string Board::describe() const {
 }
 
 std::string Board::find_hint() const {
-  return charuco ? fmt::format("fewer than {} of its corners: at least two markers about each must be readable, a few "
-                               "pixels a marker bit",
-                               kMinCorrespondences)
+  return charuco ? fmt::format(
+                       "fewer than {} of its corners: at least two markers about each must be readable, a few "
+                       "pixels a marker bit",
+                       kMinCorrespondences)
                  : "check the counts: inner corners; the whole board must be in the frame";
 }
 
@@ -115,15 +116,15 @@ Board parse_charuco(const std::string& spec, const std::string& option) {
   int size = 0;
   b.dictionary = dictionary_id(b.dictionary_name, &size);
   if (b.dictionary < 0)
-    fail(ErrorKind::Value, "{} {}: dictionary '{}': use NxN_M with N 4..7 and M 50, 100, 250 or 1000 (4x4_50)",
-         option, spec, b.dictionary_name);
+    fail(ErrorKind::Value, "{} {}: dictionary '{}': use NxN_M with N 4..7 and M 50, 100, 250 or 1000 (4x4_50)", option,
+         spec, b.dictionary_name);
   if (sx < 3 || sy < 3 || sx > 100 || sy > 100)
     fail(ErrorKind::Value, "{} {}: {}x{} squares; each count must lie in 3..100", option, spec, sx, sy);
   if (!(b.square > 0 && b.square <= 10))
     fail(ErrorKind::Value, "{} {}: square size {} m must lie in (0, 10]", option, spec, b.square);
   if (!(b.marker > 0 && b.marker < b.square))
-    fail(ErrorKind::Value, "{} {}: marker size {} m must be positive and smaller than the square ({} m)", option,
-         spec, b.marker, b.square);
+    fail(ErrorKind::Value, "{} {}: marker size {} m must be positive and smaller than the square ({} m)", option, spec,
+         b.marker, b.square);
   if (sx * sy / 2 > size)
     fail(ErrorKind::Value, "{} {}: {} markers, but dictionary {} holds {}; name a larger one (e.g. :{}_1000)", option,
          spec, sx * sy / 2, b.dictionary_name, size, b.dictionary_name.substr(0, 3));

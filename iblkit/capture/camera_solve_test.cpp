@@ -84,8 +84,9 @@ TEST(CameraSolve, CharucoBoardsCountSquaresAndNameTheirDictionary) {
   EXPECT_EQ(parse_board("checker:7x4:0.1", "--board").describe(), "7x4-corner chessboard");
   // Squares out of range, a marker no smaller than its square, a dictionary unknown or too small for the board's
   // 11·9/2 = 49… (12·10/2 = 60 > 50) markers, a tail.
-  for (const char* bad : {"charuco:2x4:0.2:0.15", "charuco:5x4:0.2:0.2", "charuco:5x4:0.2:0", "charuco:5x4:0.2:0.15:3x3_50",
-                          "charuco:12x10:0.03:0.02", "charuco:5x4:0.2:0.15x", "charuco:5x4:0.2:0.15:"}) {
+  for (const char* bad :
+       {"charuco:2x4:0.2:0.15", "charuco:5x4:0.2:0.2", "charuco:5x4:0.2:0", "charuco:5x4:0.2:0.15:3x3_50",
+        "charuco:12x10:0.03:0.02", "charuco:5x4:0.2:0.15x", "charuco:5x4:0.2:0.15:"}) {
     try {
       parse_board(bad, "--board");
       ADD_FAILURE() << bad << " was accepted";
