@@ -30,8 +30,8 @@ struct BoardOpts {
 
 void add_board_options(CLI::App* c, BoardOpts& b, bool required) {
   auto* o = c->add_option("--board", b.spec,
-                          "a chessboard in the photograph: checker:COLSxROWS:SQUARE_M (inner corners, metres; one "
-                          "count odd, one even)");
+                          "the board in the photograph: checker:COLSxROWS:SQUARE_M (inner corners, metres; one "
+                          "count odd, one even) or charuco:SQXxSQY:SQUARE_M:MARKER_M[:DICT] (squares; docs/camera.md)");
   if (required) o->required();
   c->add_option("--board-origin", b.origin, "world position of the board's first inner corner x,y,z (metres)")
       ->capture_default_str();

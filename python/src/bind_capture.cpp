@@ -145,6 +145,7 @@ void init_capture(py::module_& m) {
         report["reprojection_rms_px"] = s.error.rms_px;
         report["reprojection_max_px"] = s.error.max_px;
         report["worst"] = s.error.worst;
+        report["dropped"] = s.dropped;
         return py::make_tuple(s.camera, report);
       },
       py::arg("photo") = py::none(), py::kw_only(), py::arg("points") = py::none(), py::arg("board") = "",
@@ -152,8 +153,9 @@ void init_capture(py::module_& m) {
       py::arg("fov") = 0.0, py::arg("intrinsics") = py::none(), py::arg("width") = 0, py::arg("height") = 0,
       "The camera of a photograph, as `iblkit camera solve` finds it (docs/camera.md): from points= (an\n"
       "iblkit.points/1 file, or [((u, v), (x, y, z)), ...], pixels in continuous coordinates, at least 6) or from a\n"
-      "chessboard seen in photo (board='checker:COLSxROWS:SQUARE_M', inner corners, placed by board_origin and\n"
-      "board_axes). The lens: fov= (vertical degrees, a pinhole), intrinsics= (a Camera with intrinsics), or neither\n"
+      "board seen in photo (board='checker:COLSxROWS:SQUARE_M', inner corners, or\n"
+      "'charuco:SQXxSQY:SQUARE_M:MARKER_M[:DICT]', squares; placed by board_origin and board_axes; misread ChArUco\n"
+      "corners left out, report['dropped']). The lens: fov= (vertical degrees, a pinhole), intrinsics= (a Camera with intrinsics), or neither\n"
       "(one focal length solved). Returns (Camera, report); report['reprojection_rms_px'] says how well it fits.");
 }
 
