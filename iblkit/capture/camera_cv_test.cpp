@@ -52,9 +52,10 @@ std::vector<Correspondence> exact(const Camera& c, const std::vector<Vec3>& worl
   return out;
 }
 
-// A chessboard (Board's convention) on its plane, seen through `cam`: 3×3 samples a pixel, white paper 0.8
-// and dark squares 0.05, a 0.3 floor around it.
-Image render_board(const Camera& cam, const Board& b) {
+// The board's plane seen through `cam`, 3×3 samples a pixel: `shade(a, b, q)` gives the reflectance where a ray meets
+// the plane at world point q, (a, b) in corner units (Board::corner); 0.3 where it misses.
+template <class Shade>
+Image render_plane(const Camera& cam, const Board& b, Shade shade) {
   Image img(cam.width, cam.height, 1);
   Vec3 n = normalize(cross(b.u, b.v));
   for (int y = 0; y < cam.height; ++y)
@@ -64,57 +65,40 @@ Image render_board(const Camera& cam, const Board& b) {
         for (int sx = 0; sx < 3; ++sx) {
           Vec3 d = cam.ray_direction(x + (sx + 0.5) / 3, y + (sy + 0.5) / 3);
           double den = dot(d, n), t = dot(b.origin - cam.eye, n) / den;
-          double v = 0.3;
           if (den != 0 && t > 0) {
-            Vec3 p = cam.eye + d * t - b.origin;
-            double a = dot(p, b.u) / b.square, bb = dot(p, b.v) / b.square;  // corner units
-            if (a > -1.6 && a < b.cols + 0.6 && bb > -1.6 && bb < b.rows + 0.6) {
-              v = 0.8;  // the paper's margin
-              if (a > -1 && a < b.cols && bb > -1 && bb < b.rows) {
-                long i = static_cast<long>(std::floor(a)) + 1, j = static_cast<long>(std::floor(bb)) + 1;
-                v = (i + j) % 2 == 0 ? 0.05 : 0.8;  // square (1, 1), between the first four corners, is dark
-              }
-            }
+            const Vec3 q = cam.eye + d * t, p = q - b.origin;
+            sum += shade(dot(p, b.u) / b.square, dot(p, b.v) / b.square, q);
+          } else {
+            sum += 0.3;
           }
-          sum += v;
         }
       img.at(x, y, 0) = static_cast<float>(sum / 9);
     }
   return img;
 }
 
-// A ChArUco board (Board's convention: u across the page, v up it, the origin its bottom-left inner corner) on its
-// plane, seen through `cam`, its page from draw_charuco (0.05 dark, 0.8 light), a 0.3 floor around it, and a disc of
-// grey (0.45) lying on it at `hide` (radius `hide_r`, in the board's plane): an object hiding part of the board.
+// A chessboard (Board's convention): white paper 0.8 and dark squares 0.05, a 0.3 floor around it.
+Image render_board(const Camera& cam, const Board& b) {
+  return render_plane(cam, b, [&](double a, double bb, Vec3) {
+    if (!(a > -1.6 && a < b.cols + 0.6 && bb > -1.6 && bb < b.rows + 0.6)) return 0.3;
+    if (!(a > -1 && a < b.cols && bb > -1 && bb < b.rows)) return 0.8;  // the paper's margin
+    long i = static_cast<long>(std::floor(a)) + 1, j = static_cast<long>(std::floor(bb)) + 1;
+    return (i + j) % 2 == 0 ? 0.05 : 0.8;  // square (1, 1), between the first four corners, is dark
+  });
+}
+
+// A ChArUco board (Board's convention: u across the page, v up it, the origin its bottom-left inner corner), its
+// page from draw_charuco (0.05 dark, 0.8 light), a 0.3 floor around it, and a disc of grey (0.45) lying on it at
+// `hide` (radius `hide_r`, in the board's plane): an object hiding part of the board.
 Image render_charuco(const Camera& cam, const Board& b, Vec3 hide, double hide_r) {
   const int px = 64;
   const Image page = draw_charuco(b, px);
-  Image img(cam.width, cam.height, 1);
-  Vec3 n = normalize(cross(b.u, b.v));
-  for (int y = 0; y < cam.height; ++y)
-    for (int x = 0; x < cam.width; ++x) {
-      double sum = 0;
-      for (int sy = 0; sy < 3; ++sy)
-        for (int sx = 0; sx < 3; ++sx) {
-          Vec3 d = cam.ray_direction(x + (sx + 0.5) / 3, y + (sy + 0.5) / 3);
-          double den = dot(d, n), t = dot(b.origin - cam.eye, n) / den;
-          double v = 0.3;
-          if (den != 0 && t > 0) {
-            Vec3 q = cam.eye + d * t;
-            Vec3 p = q - b.origin;
-            double a = dot(p, b.u) / b.square, bb = dot(p, b.v) / b.square;  // corner units
-            if (a > -1 && a < b.cols && bb > -1 && bb < b.rows) {
-              const int i = static_cast<int>((a + 1) * px), j = page.height() - 1 - static_cast<int>((bb + 1) * px);
-              v = page.at(std::clamp(i, 0, page.width() - 1), std::clamp(j, 0, page.height() - 1), 0) > 0.5 ? 0.8
-                                                                                                            : 0.05;
-            }
-            if (length(q - hide) < hide_r) v = 0.45;
-          }
-          sum += v;
-        }
-      img.at(x, y, 0) = static_cast<float>(sum / 9);
-    }
-  return img;
+  return render_plane(cam, b, [&](double a, double bb, Vec3 q) {
+    if (length(q - hide) < hide_r) return 0.45;
+    if (!(a > -1 && a < b.cols && bb > -1 && bb < b.rows)) return 0.3;
+    const int i = static_cast<int>((a + 1) * px), j = page.height() - 1 - static_cast<int>((bb + 1) * px);
+    return page.at(std::clamp(i, 0, page.width() - 1), std::clamp(j, 0, page.height() - 1), 0) > 0.5 ? 0.8 : 0.05;
+  });
 }
 
 }  // namespace

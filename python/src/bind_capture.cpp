@@ -155,7 +155,8 @@ void init_capture(py::module_& m) {
       "iblkit.points/1 file, or [((u, v), (x, y, z)), ...], pixels in continuous coordinates, at least 6) or from a\n"
       "board seen in photo (board='checker:COLSxROWS:SQUARE_M', inner corners, or\n"
       "'charuco:SQXxSQY:SQUARE_M:MARKER_M[:DICT]', squares; placed by board_origin and board_axes; misread ChArUco\n"
-      "corners left out, report['dropped']). The lens: fov= (vertical degrees, a pinhole), intrinsics= (a Camera with intrinsics), or neither\n"
+      "corners left out, report['dropped']). The lens: fov= (vertical degrees, a pinhole), intrinsics= (a Camera with "
+      "intrinsics), or neither\n"
       "(one focal length solved). Returns (Camera, report); report['reprojection_rms_px'] says how well it fits.");
 }
 
