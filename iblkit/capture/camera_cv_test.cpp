@@ -101,6 +101,17 @@ Image render_charuco(const Camera& cam, const Board& b, Vec3 hide, double hide_r
   });
 }
 
+// A 50° pinhole looking down at the floor from 1.4 m away.
+Camera floor_camera(int width, int height) {
+  Camera c;
+  c.eye = {0.35, 0.9, 1.1};
+  c.target = {0.05, 0, 0.1};
+  c.fov_y_deg = 50;
+  c.width = width;
+  c.height = height;
+  return c;
+}
+
 }  // namespace
 
 TEST(CameraCv, ProjectAgreesWithOpenCvsProjectPoints) {
@@ -178,12 +189,7 @@ TEST(CameraCv, ExactPointsGiveTheCameraBack) {
 }
 
 TEST(CameraCv, ABoardRenderedThroughACameraGivesItBack) {
-  Camera truth;
-  truth.eye = {0.35, 0.9, 1.1};
-  truth.target = {0.05, 0, 0.1};
-  truth.fov_y_deg = 50;
-  truth.width = 480;
-  truth.height = 360;
+  const Camera truth = floor_camera(480, 360);
   Board b = parse_board("checker:9x6:0.05", "--board");
   place_board(b, {-0.2, 0, 0.25}, {1, 0, 0}, {0, 0, -1}, "--board");  // on the floor, face up
   Image img = render_board(truth, b);
@@ -207,12 +213,7 @@ TEST(CameraCv, ABoardRenderedThroughACameraGivesItBack) {
 }
 
 TEST(CameraCv, ACharucoBoardPartlyHiddenGivesTheCornersItShows) {
-  Camera truth;
-  truth.eye = {0.35, 0.9, 1.1};
-  truth.target = {0.05, 0, 0.1};
-  truth.fov_y_deg = 50;
-  truth.width = 640;
-  truth.height = 480;
+  const Camera truth = floor_camera(640, 480);
   Board b = parse_board("charuco:7x5:0.1:0.075", "--board");
   place_board(b, {-0.25, 0, 0.45}, {1, 0, 0}, {0, 0, -1}, "--board");  // on the floor, face up
   const Vec3 hide = b.corner(1, 1);                                    // a disc over the corners about (1, 1)
