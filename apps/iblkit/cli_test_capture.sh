@@ -34,6 +34,27 @@ assert e["object"] < 0.6 and e["shadow"] < 0.8 and e["unchanged"] < 0.05, e
 print("camera ok", c["eye_error_mm"], c["view_error_deg"], e["object"], e["shadow"])
 PY
 check layers ok "probe_matched.exr" -- ls "$T/set/layers"
+# Registration (docs/augment.md): a folder whose ball faced 40° elsewhere than it says; `--register yaw` finds the turn
+# from the floor and walls both see and turns the probe back (a 40° error halves, here, to 4°: the spread must fall).
+mkdir -p "$T/turned" && cp "$T/set/"* "$T/turned/" 2>/dev/null
+/usr/bin/python3 - "$T/turned/capture.json" <<'PY'
+import json, math, sys
+j = json.load(open(sys.argv[1]))
+f, a = j["ball"]["facing"], math.radians(40)
+j["ball"]["facing"] = [math.cos(a) * f[0] + math.sin(a) * f[2], f[1], -math.sin(a) * f[0] + math.cos(a) * f[2]]
+json.dump(j, open(sys.argv[1], "w"))
+PY
+"$BIN" --json composite --capture "$T/turned" --out "$T/turned/c.jpg" --samples 8 --object-samples 64 --register yaw \
+  2>/dev/null > "$T/turned.json"
+check register-yaw ok "turned back" -- /usr/bin/python3 - "$T/turned.json" <<'PY'
+import json, sys
+r = json.load(open(sys.argv[1]))["registration"]
+# This set's ball is 192² at 2×2 rays: 4.1° off here (the bench's 384² set: 1.2°, the lab's exact probe 0.0°).
+assert r["valid"] and r["applied"] and abs(r["yaw_deg"] + 40) < 6, r
+assert r["spread_stops"] < 0.7 * r["spread_given_stops"], r
+print("turned back", r["yaw_deg"])
+PY
+check register-bad fail "\-\-register" -- "$BIN" composite --capture "$T/set" --out "$T/x9.jpg" --register north
 # A ChArUco board (docs/camera.md): the lab prints OpenCV's board, the chain finds it by its markers, leaves out the
 # corners it misread (a pool of light crosses the board) and meets the camera targets on a 640×480 plate.
 if ! "$BIN" lab shoot low-scene2 --backplate --bracket 2 --board charuco:5x4:0.2:0.15 --width 32 --height 32 \

@@ -29,6 +29,14 @@ namespace {
 namespace fs = std::filesystem;
 using ibl::Vec3;
 
+// The light's turn registered from the proxy both see (--register).
+nlohmann::json registration_json(const ibl::augment::CompositeRun& run) {
+  const ibl::augment::YawFit& f = run.yaw;
+  return {{"yaw_deg", f.yaw_deg},          {"spread_stops", f.spread},        {"spread_given_stops", f.spread_given},
+          {"runner_up_deg", f.runner_up_deg}, {"runner_up_spread_stops", f.runner_up_spread}, {"points", f.points},
+          {"valid", f.valid},               {"applied", run.turned}};
+}
+
 struct Opts {
   std::string photo, probe_depth, object, at, albedo = "0.7,0.7,0.7", out = "composite.exr", layers, backend = "cpu",
                                               response, match = "auto", grey_card, capture;
@@ -36,7 +44,7 @@ struct Opts {
   bool recover_response = false;
   iblcli::PhotoSceneOptions scene;
   std::vector<std::string> light, truth;
-  std::string lobe = "phong", texture;
+  std::string lobe = "phong", texture, reg = "off";
   double gloss = 0, exponent = 20;
   ibl::augment::CompositeJob job;  // its object's and sampling's defaults are the library's
   Opts() {
@@ -96,6 +104,7 @@ void run(const Opts& o, const ibl::io::EnvReadDesc& read) {
   job.light.read = read;
   job.material = iblcli::object_material(o.albedo, o.gloss, o.exponent, o.lobe, o.texture);
   job.match = o.match == "off" ? ibl::augment::Match::Off : ibl::augment::Match::Auto;
+  job.reg = ibl::augment::parse_register(o.reg);
   if (!o.grey_card.empty()) {  // the card's rectangle: the match from its pixels alone
     int v[4];
     char tail = 0;
@@ -163,6 +172,7 @@ void run(const Opts& o, const ibl::io::EnvReadDesc& read) {
                   {"points", run.match.points},
                   {"spread_stops", run.match.spread},
                   {"applied", run.matched}};
+  if (run.yaw.points > 0) j["registration"] = registration_json(run);
   if (plate.encoded)
     j["backplate"] = {{"bits", plate.photo.bits},
                       {"response", plate.response.kind},
@@ -216,6 +226,7 @@ void run_capture(const Opts& o) {
   cd.job = o.job;
   cd.job.backend = ibl::augment::parse_backend(o.backend);
   cd.job.match = o.match == "off" ? ibl::augment::Match::Off : ibl::augment::Match::Auto;
+  cd.job.reg = ibl::augment::parse_register(o.reg);
   if (o.match == "grey-card" || !o.grey_card.empty())
     ibl::fail(ibl::ErrorKind::Value, "--capture: the match is from the proxy (--match auto) or off");
   cd.job.material = iblcli::object_material(o.albedo, o.gloss, o.exponent, o.lobe, o.texture);
@@ -286,6 +297,7 @@ void run_capture(const Opts& o) {
                   {"points", c.run.match.points},
                   {"spread_stops", c.run.match.spread},
                   {"applied", c.run.matched}};
+  if (c.run.yaw.points > 0) j["registration"] = registration_json(c.run);
   // The lab's answers: the composite as written, in linear light, against the truth photographed through the same
   // camera; the camera against the exact one.
   ibl::augment::CompositeErrors e;
@@ -360,6 +372,11 @@ void setup(CLI::App& app) {
                  "probe both see, and applied (a probe's map; not an SH grid); grey-card: from --grey-card's pixels "
                  "alone; off: the light as captured")
       ->check(CLI::IsMember({"auto", "off", "grey-card"}))
+      ->capture_default_str();
+  app.add_option("--register", o->reg,
+                 "the light's turn about +Y (which way the probe faced) from the proxy points the photograph and the "
+                 "light both see, before the match: check (measured, reported), yaw (applied) or off (docs/augment.md)")
+      ->check(CLI::IsMember({"off", "check", "yaw"}))
       ->capture_default_str();
   app.add_option(
       "--grey-card", o->grey_card,

@@ -15,6 +15,7 @@
 // surfaces and the shadows are right (a 1-stop mismatch: docs/augment.md).
 #pragma once
 #include <cstdint>
+#include <vector>
 
 #include "iblkit/augment/light.h"
 #include "iblkit/core/image.h"
@@ -44,5 +45,18 @@ MatchResult estimate_match(const Image& photo, const geometry::Camera& cam, cons
 
 // The light times the gains (its map; the depth stays).
 LocalRadiance scaled(const LocalRadiance& light, Vec3 gain);
+
+// What estimate_match compares, before the light is looked up: the photograph's value at a proxy point y both can see,
+// and the unit direction and distance from the light's centre to y. (estimate_match and register_yaw share it.)
+struct SeenPoint {
+  Vec3 photo, dir;
+  double dist = 0;
+};
+std::vector<SeenPoint> seen_points(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy,
+                                   Vec3 centre, double saturated, int64_t max_points, const PixelRect* region);
+// The light towards `dir` for the point p: false where it is below `floor` (light_floor_of: 1 % of the light's
+// median) or not positive, or where the light's depth map says something nearer lies that way.
+bool light_at(const LocalRadiance& light, const SeenPoint& p, Vec3 dir, double floor, Vec3* out);
+double light_floor_of(const LocalRadiance& light);
 
 }  // namespace ibl::augment

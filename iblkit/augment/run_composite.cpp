@@ -27,7 +27,41 @@ Backend parse_backend(const std::string& name) {
   fail(ErrorKind::Value, "backend {}: expected cpu, gl or auto", name);
 }
 
+Register parse_register(const std::string& name) {
+  if (name == "off") return Register::Off;
+  if (name == "check") return Register::Check;
+  if (name == "yaw") return Register::Yaw;
+  fail(ErrorKind::Value, "--register {}: expected off, check or yaw", name);
+}
+
+namespace {
+
+void register_light(CompositeScene& s, const Image& photo, const geometry::Camera& cam, const CompositeJob& job) {
+  if (job.reg == Register::Off) return;
+  s.yaw = register_yaw(photo, cam, s.light.proxy, s.light.light, job.saturated);
+  if (!s.yaw.valid) {
+    s.notes.push_back(fmt::format("register: the photograph and the light see only {} proxy points in common (< {}): "
+                                  "the light is used as it was given",
+                                  s.yaw.points, kMinMatchPoints));
+    return;
+  }
+  const YawFit& f = s.yaw;
+  const bool apply = job.reg == Register::Yaw;
+  s.notes.push_back(fmt::format(
+      "register: the light agrees best with the photograph turned {:+.1f}° about +Y (spread {:.3f} stops, {:.3f} as "
+      "given; the best more than 20° away {:+.0f}°, {:.3f}) from {} proxy points: {}",
+      f.yaw_deg, f.spread, f.spread_given, f.runner_up_deg, f.runner_up_spread, f.points,
+      apply ? "turned" : "not applied (--register yaw turns it)"));
+  if (apply) {
+    s.light.light = turned(s.light.light, f.yaw_deg);
+    s.turned = true;
+  }
+}
+
+}  // namespace
+
 void match_light(CompositeScene& s, const Image& photo, const geometry::Camera& cam, const CompositeJob& job) {
+  register_light(s, photo, cam, job);
   if (job.match == Match::Off) return;
   if (job.match == Match::Auto && s.light.light.source == "SH grid") return;  // a grid's map is band-limited
   const bool card = job.match == Match::GreyCard;
@@ -110,6 +144,8 @@ CompositeRun run_composite(const Image& photo, const geometry::Camera& cam, cons
   run.proxy = L.proxy;
   run.match = scene.match;
   run.matched = scene.matched;
+  run.yaw = scene.yaw;
+  run.turned = scene.turned;
   run.notes.insert(run.notes.begin(), scene.notes.begin(), scene.notes.end());
   return run;
 }

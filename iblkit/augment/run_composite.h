@@ -8,6 +8,7 @@
 #include "iblkit/augment/composite.h"
 #include "iblkit/augment/load.h"
 #include "iblkit/augment/match.h"
+#include "iblkit/augment/register.h"
 #include "iblkit/core/image.h"
 #include "iblkit/geometry/camera.h"
 #include "iblkit/geometry/mesh.h"
@@ -37,12 +38,18 @@ inline render::ObjectDesc inserted_object_defaults() { return {"blob", 0.3, 2000
 // grey_card alone (a matte card both see: any light, an SH grid's too); Off leaves the light as captured.
 enum class Match { Auto, Off, GreyCard };
 
+// Registration of the light's turn about +Y (augment/register.h): off; check (measured and reported, not applied);
+// yaw (applied).
+enum class Register { Off, Check, Yaw };
+Register parse_register(const std::string& name);
+
 struct CompositeJob {
   render::ObjectDesc object = inserted_object_defaults();  // made by render::make_object
   render::Material material{{0.7, 0.7, 0.7}, {0, 0, 0}};   // its surface (render::check_material)
   LightInput light;                                        // the captured light and the proxy, from files (load.h)
   int median_cut = 0;         // > 0: the baseline of this many median-cut lights (cut after the match)
   Match match = Match::Auto;  // the light put in the photograph's units (match.h)
+  Register reg = Register::Off;  // the light's turn about +Y from the proxy both see (register.h), before the match
   double saturated = 0;       // linear value at which the photograph saturates (0: never), left out of the match
   PixelRect grey_card;        // Match::GreyCard: the card's pixels in the photograph
   Backend backend = Backend::Cpu;
@@ -55,13 +62,16 @@ struct CompositeScene {
   LoadedLight light;
   MatchResult match;               // the gains estimated (match.valid false: none)
   bool matched = false;            // the light was multiplied by match.gain
+  YawFit yaw;                      // job.reg: the turn registered (yaw.valid false: not measured or no points)
+  bool turned = false;             // the light was turned by yaw.yaw_deg
   std::vector<std::string> notes;  // the match, in words
 };
 // Makes the object and reads the light (checked against where the object goes); with the photograph and
 // its camera, the radiometric match (job.match); then the median cut.
 CompositeScene prepare_composite(const CompositeJob& job, const Image* photo = nullptr,
                                  const geometry::Camera* cam = nullptr);
-// The match alone, on a scene made otherwise (Python's in-memory light): estimates and applies job.match.
+// The registration (job.reg) and the match alone, on a scene made otherwise (Python's in-memory light): estimates and
+// applies them.
 void match_light(CompositeScene& scene, const Image& photo, const geometry::Camera& cam, const CompositeJob& job);
 
 struct CompositeRun {
@@ -72,6 +82,8 @@ struct CompositeRun {
   std::vector<std::string> notes;  // what the caller may tell the user (the backend auto chose, the match)
   MatchResult match;               // the gains estimated (match.valid false: none)
   bool matched = false;            // the light was multiplied by match.gain
+  YawFit yaw;                      // the turn registered (job.reg)
+  bool turned = false;             // and applied
 };
 // `photo` (linear RGB) seen by `cam` (its size the photograph's). Throws ibl::Error on bad input, and
 // (ErrorKind::Unsupported) for Backend::Gl when iblkit has no OpenGL or no context can be made.

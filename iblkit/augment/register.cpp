@@ -1,0 +1,117 @@
+#include "iblkit/augment/register.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "iblkit/core/error.h"
+#include "iblkit/core/parallel.h"
+
+namespace ibl::augment {
+
+Vec3 turn_y(Vec3 d, double deg) {
+  const double a = deg * kPi / 180, c = std::cos(a), s = std::sin(a);
+  return {c * d.x + s * d.z, d.y, -s * d.x + c * d.z};
+}
+
+namespace {
+
+// The spread (median absolute deviation of log2 photo / light, luminance) with the light turned by `deg`, over
+// the points the turned light sees; the count in *n.
+double spread_at(const std::vector<SeenPoint>& pts, const LocalRadiance& light, double floor, double deg, int64_t* n) {
+  std::vector<double> lr;
+  lr.reserve(pts.size());
+  for (const SeenPoint& p : pts) {
+    Vec3 lp;
+    // The turned light towards dir is the given one towards R⁻¹ dir.
+    if (!light_at(light, p, turn_y(p.dir, -deg), floor, &lp)) continue;
+    lr.push_back(std::log2(luminance(p.photo) / luminance(lp)));
+  }
+  *n = static_cast<int64_t>(lr.size());
+  if (lr.empty()) return 1e300;
+  auto mid = lr.begin() + static_cast<std::ptrdiff_t>(lr.size() / 2);
+  std::nth_element(lr.begin(), mid, lr.end());
+  const double m = *mid;
+  for (double& v : lr) v = std::abs(v - m);
+  std::nth_element(lr.begin(), mid, lr.end());
+  return *mid;
+}
+
+}  // namespace
+
+YawFit register_yaw(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy,
+                    const LocalRadiance& light, double saturated, double range_deg) {
+  if (!(range_deg > 0 && range_deg <= 180)) fail(ErrorKind::Value, "register: range {}° must lie in (0, 180]", range_deg);
+  const std::vector<SeenPoint> pts = seen_points(photo, cam, proxy, light.centre, saturated, 40000, nullptr);
+  const double floor = light_floor_of(light);
+  YawFit f;
+  int64_t n0 = 0;
+  f.spread_given = spread_at(pts, light, floor, 0, &n0);
+  f.points = n0;
+  if (n0 < kMinMatchPoints) return f;
+  const int steps = static_cast<int>(std::floor(range_deg));
+  std::vector<double> deg, val(static_cast<size_t>(2 * steps + 1));
+  for (int k = -steps; k <= steps; ++k) deg.push_back(k);
+  parallel_for(0, static_cast<int64_t>(deg.size()), [&](int64_t i) {
+    int64_t n = 0;
+    const double v = spread_at(pts, light, floor, deg[i], &n);
+    val[i] = n >= kMinMatchPoints ? v : 1e300;
+  });
+  const size_t best = static_cast<size_t>(std::min_element(val.begin(), val.end()) - val.begin());
+  // Golden section on [best − 1°, best + 1°].
+  double a = deg[best] - 1, b = deg[best] + 1;
+  const double g = (std::sqrt(5.0) - 1) / 2;
+  int64_t n = 0;
+  double x1 = b - g * (b - a), x2 = a + g * (b - a);
+  double f1 = spread_at(pts, light, floor, x1, &n), f2 = spread_at(pts, light, floor, x2, &n);
+  while (b - a > 0.05) {
+    if (f1 < f2) {
+      b = x2, x2 = x1, f2 = f1, x1 = b - g * (b - a), f1 = spread_at(pts, light, floor, x1, &n);
+    } else {
+      a = x1, x1 = x2, f1 = f2, x2 = a + g * (b - a), f2 = spread_at(pts, light, floor, x2, &n);
+    }
+  }
+  const double refined = 0.5 * (a + b);
+  const double fr = spread_at(pts, light, floor, refined, &n);
+  if (fr <= val[best] && n >= kMinMatchPoints) {
+    f.yaw_deg = refined, f.spread = fr, f.points = n;
+  } else {
+    f.yaw_deg = deg[best], f.spread = val[best];
+  }
+  f.runner_up_spread = 1e300;
+  for (size_t i = 0; i < deg.size(); ++i) {
+    double dd = std::abs(deg[i] - f.yaw_deg);
+    dd = std::min(dd, 360 - dd);
+    if (dd > 20 && val[i] < f.runner_up_spread) f.runner_up_spread = val[i], f.runner_up_deg = deg[i];
+  }
+  f.valid = f.spread < 1e300;
+  return f;
+}
+
+LocalRadiance turned(const LocalRadiance& light, double yaw_deg) {
+  if (!std::isfinite(yaw_deg)) fail(ErrorKind::Value, "turn {}° is not a number", yaw_deg);
+  LocalRadiance out = light;
+  const sphere::Mapping& m = light.map.mapping;
+  Image& img = out.map.image;
+  const int W = img.width(), H = img.height(), C = img.channels();
+  const bool depth = !light.depth.empty();
+  parallel_for(0, H, [&](int64_t y) {
+    std::vector<float> v(static_cast<size_t>(C));
+    for (int x = 0; x < W; ++x) {
+      Vec3 d;
+      if (!m.to_direction(x + 0.5, static_cast<double>(y) + 0.5, &d)) continue;
+      const Vec3 src = turn_y(d, -yaw_deg);
+      light.map.sample(src, v.data());
+      for (int c = 0; c < C; ++c) img.at(x, static_cast<int>(y), c) = v[static_cast<size_t>(c)];
+      if (depth) {
+        double px, py;
+        if (m.to_pixel(src, &px, &py))
+          out.depth.at(x, static_cast<int>(y), 0) =
+              light.depth.at(std::clamp(static_cast<int>(px), 0, light.depth.width() - 1),
+                             std::clamp(static_cast<int>(py), 0, light.depth.height() - 1), 0);
+      }
+    }
+  });
+  return out;
+}
+
+}  // namespace ibl::augment
