@@ -32,9 +32,14 @@ using ibl::Vec3;
 // The light's turn registered from the proxy both see (--register).
 nlohmann::json registration_json(const ibl::augment::CompositeRun& run) {
   const ibl::augment::YawFit& f = run.yaw;
-  return {{"yaw_deg", f.yaw_deg},          {"spread_stops", f.spread},        {"spread_given_stops", f.spread_given},
-          {"runner_up_deg", f.runner_up_deg}, {"runner_up_spread_stops", f.runner_up_spread}, {"points", f.points},
-          {"valid", f.valid},               {"applied", run.turned}};
+  return {{"yaw_deg", f.yaw_deg},
+          {"spread_stops", f.spread},
+          {"spread_given_stops", f.spread_given},
+          {"runner_up_deg", f.runner_up_deg},
+          {"runner_up_spread_stops", f.runner_up_spread},
+          {"points", f.points},
+          {"valid", f.valid},
+          {"applied", run.turned}};
 }
 
 struct Opts {

@@ -3,8 +3,8 @@
 // camera faced (north) is what users get wrong. A Lambertian surface looks the same from every side, so where
 // the probe is turned right, the photograph's value over the light's at each proxy point both see differs only by
 // the exposure's one scale and the surfaces' gloss: the spread of log2(photo / light) over the points (the
-// radiometric match's, augment/match.h) is smallest. The turn is searched over ±range_deg in 1° steps, then
-// refined by golden section to 0.05°; the points' geometry is traced once.
+// radiometric match's, augment/match.h) is smallest. The turn is searched over ±range_deg in 1° steps on at most
+// 10,000 of the points, then refined by golden section to 0.05° on all of them; their geometry is traced once.
 #pragma once
 #include <cstdint>
 #include <vector>
@@ -18,13 +18,13 @@
 namespace ibl::augment {
 
 struct YawFit {
-  double yaw_deg = 0;         // turn the light by this about +Y (right-handed: +X towards −Z for a positive turn)
-  double spread = 0;          // the match's spread (stops) at that turn
-  double spread_given = 0;    // and as the light was given (0°)
-  double runner_up_deg = 0;   // the best turn more than 20° from it, and its spread: an ambiguous scene has both close
+  double yaw_deg = 0;        // turn the light by this about +Y (right-handed: +X towards −Z for a positive turn)
+  double spread = 0;         // the match's spread (stops) at that turn
+  double spread_given = 0;   // and as the light was given (0°)
+  double runner_up_deg = 0;  // the best turn more than 20° from it, and its spread: an ambiguous scene has both close
   double runner_up_spread = 0;
-  int64_t points = 0;         // proxy points both saw
-  bool valid = false;         // enough points (kMinMatchPoints)
+  int64_t points = 0;  // proxy points both saw
+  bool valid = false;  // enough points (kMinMatchPoints)
 };
 
 YawFit register_yaw(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy,

@@ -25,7 +25,8 @@ Image floor_photo(const geometry::Camera& cam) {
   for (int y = 0; y < cam.height; ++y)
     for (int x = 0; x < cam.width; ++x) {
       const Vec3 d = cam.pixel_direction(x, y);
-      const double v = d.y < 0 ? floor_radiance(cam.eye.x - d.x * cam.eye.y / d.y, cam.eye.z - d.z * cam.eye.y / d.y) : 0;
+      const double v =
+          d.y < 0 ? floor_radiance(cam.eye.x - d.x * cam.eye.y / d.y, cam.eye.z - d.z * cam.eye.y / d.y) : 0;
       img.set_rgb(x, y, {0.8 * v, 0.8 * v, 0.8 * v});  // another exposure: the match's scale must not matter
     }
   return img;

@@ -40,9 +40,10 @@ void register_light(CompositeScene& s, const Image& photo, const geometry::Camer
   if (job.reg == Register::Off) return;
   s.yaw = register_yaw(photo, cam, s.light.proxy, s.light.light, job.saturated);
   if (!s.yaw.valid) {
-    s.notes.push_back(fmt::format("register: the photograph and the light see only {} proxy points in common (< {}): "
-                                  "the light is used as it was given",
-                                  s.yaw.points, kMinMatchPoints));
+    s.notes.push_back(
+        fmt::format("register: the photograph and the light see only {} proxy points in common (< {}): "
+                    "the light is used as it was given",
+                    s.yaw.points, kMinMatchPoints));
     return;
   }
   const YawFit& f = s.yaw;

@@ -47,11 +47,11 @@ struct CompositeJob {
   render::ObjectDesc object = inserted_object_defaults();  // made by render::make_object
   render::Material material{{0.7, 0.7, 0.7}, {0, 0, 0}};   // its surface (render::check_material)
   LightInput light;                                        // the captured light and the proxy, from files (load.h)
-  int median_cut = 0;         // > 0: the baseline of this many median-cut lights (cut after the match)
-  Match match = Match::Auto;  // the light put in the photograph's units (match.h)
+  int median_cut = 0;            // > 0: the baseline of this many median-cut lights (cut after the match)
+  Match match = Match::Auto;     // the light put in the photograph's units (match.h)
   Register reg = Register::Off;  // the light's turn about +Y from the proxy both see (register.h), before the match
-  double saturated = 0;       // linear value at which the photograph saturates (0: never), left out of the match
-  PixelRect grey_card;        // Match::GreyCard: the card's pixels in the photograph
+  double saturated = 0;          // linear value at which the photograph saturates (0: never), left out of the match
+  PixelRect grey_card;           // Match::GreyCard: the card's pixels in the photograph
   Backend backend = Backend::Cpu;
   CompositeDesc desc;  // sampling, seed, shadows, the GL options, progress
 };

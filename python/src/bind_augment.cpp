@@ -147,8 +147,8 @@ void init_augment(py::module_& m) {
          py::object light, py::object proxy, py::object at_probe, const std::string& probe_depth, py::handle albedo,
          int median_cut, int light_samples, int object_samples, int bounce_samples, int triangle_samples,
          int pixel_samples, uint64_t seed, bool shadows, bool self_light, const std::string& backend, int gl_lights,
-         double gl_threshold, int gl_visibility, const std::string& match, const std::string& response,
-         py::object progress) {
+         double gl_threshold, int gl_visibility, const std::string& match, const std::string& reg,
+         const std::string& response, py::object progress) {
         const ibl::capture::Backplate plate = photo_input(photo, response, "composite: photo");
         const ibl::Image& ph = plate.linear;
         camera.width = ph.width();
@@ -161,6 +161,9 @@ void init_augment(py::module_& m) {
         job.median_cut = median_cut;
         if (match != "auto" && match != "off") throw py::value_error("composite: match must be \"auto\" or \"off\"");
         job.match = match == "off" ? ag::Match::Off : ag::Match::Auto;
+        if (reg != "off" && reg != "check" && reg != "yaw")
+          throw py::value_error("composite: register must be \"off\", \"check\" or \"yaw\"");
+        job.reg = ag::parse_register(reg);
         ag::CompositeDesc& d = job.desc;
         d.light_samples = light_samples;
         d.object_samples = object_samples;
@@ -217,8 +220,8 @@ void init_augment(py::module_& m) {
       py::arg("self_light") = kDefaults.self_light, py::arg("backend") = std::string(ag::backend_name(kJob.backend)),
       py::arg("gl_lights") = kDefaults.gl.split.lights, py::arg("gl_threshold") = kDefaults.gl.split.threshold,
       py::arg("gl_visibility") = kDefaults.gl.visibility_samples,
-      py::arg("match") = std::string(kJob.match == ag::Match::Auto ? "auto" : "off"), py::arg("response") = "",
-      py::arg("progress") = py::none(),
+      py::arg("match") = std::string(kJob.match == ag::Match::Auto ? "auto" : "off"), py::arg("register") = "off",
+      py::arg("response") = "", py::arg("progress") = py::none(),
       R"doc(Composites `object` (a TriMesh, e.g. TriMesh.object(at=…)) into the photograph (H, W, 3) seen by
 `camera` (its size becomes the photograph's), as `iblkit composite` (Debevec 1998): a CompositeResult
 with the composite, mask, difference, albedo and render layers.
@@ -230,7 +233,9 @@ object_samples, bounce_samples (0: no bounce), triangle_samples, pixel_samples, 
 pastes the object without its shadow; self_light=False leaves out the object's light on itself (CPU). backend= "cpu" (the ray-traced reference), "gl" (OpenGL: shadow
 maps and the soft sphere term; gl_lights, gl_threshold, gl_visibility as --gl-lights, --gl-threshold,
 --gl-visibility) or "auto". match="auto" puts the light in the photograph's units (the gains from the
-proxy points both see; result.warnings says them), "off" keeps it as captured. A uint8/uint16 photo holds the
+proxy points both see; result.warnings says them), "off" keeps it as captured. register="yaw" first turns the
+light about +Y to agree best with the photograph on those points ("check": measured and said in result.warnings
+only; docs/augment.md "Registration"). A uint8/uint16 photo holds the
 camera's codes, made linear through response= ("" = "srgb", "linear", "camera" or an iblkit.response/1 file);
 result.composite is linear: encode_photo(result.composite, photo, response) writes it back into the photo's codes.
 Every default is the library's (augment::CompositeJob). Releases the GIL; progress(stage, fraction).)doc");

@@ -147,6 +147,11 @@ def test_photograph_and_composite_match_cli(tmp_path, probe_set, scene):
     assert L.map.shape == (16, 32, 3) and L.source
     r2 = iblkit.composite(photo, cam, obj, light=L, proxy=s.proxy, **args)
     assert r2.composite.shape == (16, 24, 3)
+    r3 = iblkit.composite(photo, cam, obj, light=L, proxy=s.proxy, register="check", **args)
+    assert any(w.startswith("register:") for w in r3.warnings), r3.warnings
+    assert np.array_equal(r3.composite, r2.composite)  # check: measured, not applied
+    with pytest.raises(ValueError, match="register"):
+        iblkit.composite(photo, cam, obj, light=L, proxy=s.proxy, register="north", **args)
     err = iblkit.measure_composite(photo, r.composite, with_obj, r.mask)
     assert 0 <= err["object"] < 1
     assert iblkit.LocalRadiance(L.map, L.centre).centre == L.centre
