@@ -44,8 +44,9 @@ void chain_step(iblcli::DemoContext& ctx) {
       "lab shoot low-scene2 --at 0,0.15,0 --two-sides --distance-radii 10 --width 384 --height 384 --samples 4 "
       "--bracket 12 --until-unsaturated --ev-step 3 --bounces 1 --noise --wb 1.1,1,0.8 --backplate --out '{}'",
       set.string());
-  const std::string composite = fmt::format("--json composite --capture '{0}' --out '{1}' --layers '{2}'", set.string(),
-                                            (dir / "composite.jpg").string(), (dir / "layers").string());
+  const std::string composite =
+      fmt::format("--json composite --capture '{0}' --out '{1}' --layers '{2}' --register check", set.string(),
+                  (dir / "composite.jpg").string(), (dir / "layers").string());
   auto t0 = std::chrono::steady_clock::now();
   run_self(shoot);
   const double shoot_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -75,13 +76,15 @@ void chain_step(iblcli::DemoContext& ctx) {
                                   {"commands", {"iblkit " + shoot, "iblkit " + composite}},
                                   {"camera", c},
                                   {"errors", e},
+                                  {"registration", j.value("registration", nlohmann::json::object())},
                                   {"response", j.at("response")},
                                   {"seconds", {{"shoot", shoot_s}, {"composite_capture", chain_s}}}};
+  const double yaw = j.contains("registration") ? j.at("registration").value("yaw_deg", 0.0) : 0.0;
   iblcli::info(
-      fmt::format("capture chain: camera {:.2f} mm, {:.3f}°, {:.3f} px; object {:.1f} %, shadow {:.1f} % of its signal "
-                  "(shoot {:.1f} s, chain {:.1f} s)",
+      fmt::format("capture chain: camera {:.2f} mm, {:.3f}°, {:.3f} px; the probe's facing agrees with the backplate "
+                  "within {:.1f}°; object {:.1f} %, shadow {:.1f} % of its signal (shoot {:.1f} s, chain {:.1f} s)",
                   c.at("eye_error_mm").get<double>(), c.at("view_error_deg").get<double>(),
-                  c.at("reprojection_rms_px").get<double>(), 100 * e.at("object").get<double>(),
+                  c.at("reprojection_rms_px").get<double>(), std::abs(yaw), 100 * e.at("object").get<double>(),
                   100 * e.at("shadow").get<double>(), shoot_s, chain_s));
 }
 
