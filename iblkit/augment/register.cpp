@@ -100,6 +100,7 @@ YawFit register_yaw(const Image& photo, const geometry::Camera& cam, const geome
     int64_t nr = 0;
     f.runner_up_spread = spread_at(pts, light, floor, f.runner_up_deg, &nr);
   }
+  f.yaw_deg = std::remainder(f.yaw_deg, 360.0);  // in [−180°, 180°]
   f.valid = f.spread < 1e300;
   return f;
 }
