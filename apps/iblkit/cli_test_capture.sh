@@ -54,6 +54,16 @@ assert r["valid"] and r["applied"] and abs(r["yaw_deg"] + 40) < 6, r
 assert r["spread_stops"] < 0.7 * r["spread_given_stops"], r
 print("turned back", r["yaw_deg"])
 PY
+"$BIN" --json composite --capture "$T/turned" --out "$T/turned/p.jpg" --samples 8 --object-samples 64 --register pose \
+  2>/dev/null > "$T/pose.json"
+check register-pose ok "moved and turned" -- /usr/bin/python3 - "$T/pose.json" <<'PY'
+import json, sys
+r = json.load(open(sys.argv[1]))["registration"]
+p = r["position"]
+assert r["applied"] and p["applied"] and p["valid"] and abs(r["yaw_deg"] + 40) < 6, r
+assert max(abs(v) for v in p["offset_m"]) <= 0.2 * 3 ** 0.5 + 1e-9 and p["spread_stops"] <= p["spread_given_stops"], p
+print("moved and turned", p["offset_m"], r["yaw_deg"])
+PY
 check register-bad fail "\-\-register" -- "$BIN" composite --capture "$T/set" --out "$T/x9.jpg" --register north
 # A ChArUco board (docs/camera.md): the lab prints OpenCV's board, the chain finds it by its markers, leaves out the
 # corners it misread (a pool of light crosses the board) and meets the camera targets on a 640×480 plate.

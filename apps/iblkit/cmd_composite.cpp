@@ -32,14 +32,23 @@ using ibl::Vec3;
 // The light's turn registered from the proxy both see (--register).
 nlohmann::json registration_json(const ibl::augment::CompositeRun& run) {
   const ibl::augment::YawFit& f = run.yaw;
-  return {{"yaw_deg", f.yaw_deg},
-          {"spread_stops", f.spread},
-          {"spread_given_stops", f.spread_given},
-          {"runner_up_deg", f.runner_up_deg},
-          {"runner_up_spread_stops", f.runner_up_spread},
-          {"points", f.points},
-          {"valid", f.valid},
-          {"applied", run.turned}};
+  nlohmann::json j = {{"yaw_deg", f.yaw_deg},
+                      {"spread_stops", f.spread},
+                      {"spread_given_stops", f.spread_given},
+                      {"runner_up_deg", f.runner_up_deg},
+                      {"runner_up_spread_stops", f.runner_up_spread},
+                      {"points", f.points},
+                      {"valid", f.valid},
+                      {"applied", run.turned}};
+  const ibl::augment::PositionFit& p = run.position;
+  if (p.points > 0)
+    j["position"] = {{"offset_m", {p.offset.x, p.offset.y, p.offset.z}},
+                     {"spread_stops", p.spread},
+                     {"spread_given_stops", p.spread_given},
+                     {"points", p.points},
+                     {"valid", p.valid},
+                     {"applied", run.moved}};
+  return j;
 }
 
 struct Opts {
@@ -177,7 +186,7 @@ void run(const Opts& o, const ibl::io::EnvReadDesc& read) {
                   {"points", run.match.points},
                   {"spread_stops", run.match.spread},
                   {"applied", run.matched}};
-  if (run.yaw.points > 0) j["registration"] = registration_json(run);
+  if (run.yaw.points > 0 || run.position.points > 0) j["registration"] = registration_json(run);
   if (plate.encoded)
     j["backplate"] = {{"bits", plate.photo.bits},
                       {"response", plate.response.kind},
@@ -302,7 +311,7 @@ void run_capture(const Opts& o) {
                   {"points", c.run.match.points},
                   {"spread_stops", c.run.match.spread},
                   {"applied", c.run.matched}};
-  if (c.run.yaw.points > 0) j["registration"] = registration_json(c.run);
+  if (c.run.yaw.points > 0 || c.run.position.points > 0) j["registration"] = registration_json(c.run);
   // The lab's answers: the composite as written, in linear light, against the truth photographed through the same
   // camera; the camera against the exact one.
   ibl::augment::CompositeErrors e;
@@ -380,8 +389,9 @@ void setup(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--register", o->reg,
                  "the light's turn about +Y (which way the probe faced) from the proxy points the photograph and the "
-                 "light both see, before the match: check (measured, reported), yaw (applied) or off (docs/augment.md)")
-      ->check(CLI::IsMember({"off", "check", "yaw"}))
+                 "light both see, before the match: check (its turn and position measured, reported), yaw (the turn "
+                 "applied), pose (its position and turn applied) or off (docs/augment.md)")
+      ->check(CLI::IsMember({"off", "check", "yaw", "pose"}))
       ->capture_default_str();
   app.add_option(
       "--grey-card", o->grey_card,

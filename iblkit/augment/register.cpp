@@ -19,13 +19,23 @@ namespace {
 // absolute deviation of log2(photo / light) (luminance) from its median, over the 90 % of points nearest it (a lamp
 // seen by one and not the other, a glossy patch, stay out). The match's median spread alone is flat across a degree
 // or more: most points lie on evenly lit walls and floor, and only the edges of the pools of light tell the turn.
-double spread_at(const std::vector<SeenPoint>& pts, const LocalRadiance& light, double floor, double deg, int64_t* n) {
+// With `offset`, the light stands at its centre + offset (the points are where they were: the photograph's).
+double spread_at(const std::vector<SeenPoint>& pts, const LocalRadiance& light, double floor, double deg, int64_t* n,
+                 Vec3 offset = {0, 0, 0}) {
   std::vector<double> lr;
   lr.reserve(pts.size());
+  const bool moved = offset.x != 0 || offset.y != 0 || offset.z != 0;
   for (const SeenPoint& p : pts) {
+    SeenPoint q = p;
+    if (moved) {
+      const Vec3 w = p.dir * p.dist - offset;
+      q.dist = length(w);
+      if (!(q.dist > 1e-6)) continue;
+      q.dir = w / q.dist;
+    }
     Vec3 lp;
     // The turned light towards dir is the given one towards R⁻¹ dir.
-    if (!light_at(light, p, turn_y(p.dir, -deg), floor, &lp)) continue;
+    if (!light_at(light, q, turn_y(q.dir, -deg), floor, &lp)) continue;
     lr.push_back(std::log2(luminance(p.photo) / luminance(lp)));
   }
   *n = static_cast<int64_t>(lr.size());
@@ -102,6 +112,55 @@ YawFit register_yaw(const Image& photo, const geometry::Camera& cam, const geome
   }
   f.yaw_deg = std::remainder(f.yaw_deg, 360.0);  // in [−180°, 180°]
   f.valid = f.spread < 1e300;
+  return f;
+}
+
+PositionFit register_position(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy,
+                              const LocalRadiance& light, double saturated, double range_m, double yaw_deg) {
+  if (!(range_m > 0 && range_m <= 5)) fail(ErrorKind::Value, "register: position range {} m must lie in (0, 5]", range_m);
+  if (!std::isfinite(yaw_deg)) fail(ErrorKind::Value, "register: turn {}° is not a number", yaw_deg);
+  const std::vector<SeenPoint> pts = seen_points(photo, cam, proxy, light.centre, saturated, 40000, nullptr);
+  const double floor = light_floor_of(light);
+  PositionFit f;
+  int64_t n0 = 0;
+  f.spread_given = spread_at(pts, light, floor, yaw_deg, &n0);
+  f.points = n0;
+  if (n0 < kMinMatchPoints) return f;
+  std::vector<SeenPoint> some;
+  const size_t every = std::max<size_t>(1, pts.size() / 5000);
+  for (size_t i = 0; i < pts.size(); i += every) some.push_back(pts[i]);
+  const int64_t min_some = std::max<int64_t>(kMinMatchPoints / static_cast<int64_t>(every), 16);
+  // A grid of 11³ offsets over ±range on the few points, then twice a 5³ grid a quarter as fine around the best,
+  // the last on all of them (steps range/5, /20, /80: 4 cm, 1 cm, 2.5 mm for the default 0.2 m).
+  Vec3 best{0, 0, 0};
+  double step = range_m / 5, best_v = 1e300;
+  for (int level = 0; level < 3; ++level) {
+    const int k = level == 0 ? 5 : 2;
+    const std::vector<SeenPoint>& use = level == 2 ? pts : some;
+    const int64_t need = level == 2 ? kMinMatchPoints : min_some;
+    const int side = 2 * k + 1;
+    std::vector<double> val(static_cast<size_t>(side) * side * side);
+    const Vec3 around = best;
+    parallel_for(0, static_cast<int64_t>(val.size()), [&](int64_t i) {
+      const int a = static_cast<int>(i % side) - k, b = static_cast<int>(i / side % side) - k,
+                c = static_cast<int>(i / side / side) - k;
+      const Vec3 o = around + Vec3{a * step, b * step, c * step};
+      int64_t n = 0;
+      const double v = length(o) <= range_m * std::sqrt(3.0) + 1e-12 ? spread_at(use, light, floor, yaw_deg, &n, o) : 1e300;
+      val[static_cast<size_t>(i)] = n >= need ? v : 1e300;
+    });
+    const size_t at = static_cast<size_t>(std::min_element(val.begin(), val.end()) - val.begin());
+    best_v = val[at];
+    best = around + Vec3{(static_cast<int>(at % side) - k) * step, (static_cast<int>(at / side % side) - k) * step,
+                         (static_cast<int>(at / side / side) - k) * step};
+    step /= 4;
+  }
+  int64_t n = 0;
+  f.spread = spread_at(pts, light, floor, yaw_deg, &n, best);
+  f.offset = best;
+  f.points = n;
+  if (!(f.spread < f.spread_given)) f.offset = {0, 0, 0}, f.spread = f.spread_given, f.points = n0;  // as given
+  f.valid = best_v < 1e300 && f.spread < 1e300;
   return f;
 }
 

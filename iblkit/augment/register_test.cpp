@@ -103,4 +103,25 @@ TEST(AugmentRegister, APosedProbeTurnedIsTurnedBack) {
   EXPECT_THROW(turned(probe, std::nan("")), Error);
 }
 
+TEST(AugmentRegister, AProbeSaidToStandElsewhereIsMovedBack) {
+  const geometry::Camera cam = above();
+  const Image photo = floor_photo(cam);
+  const geometry::TriMesh floor = geometry::make_quad({0, 0, 0}, {0, 1, 0}, {0, 0, -1}, 8, 8);
+  const LocalRadiance probe = floor_probe({0, 0.4, 0});
+  const PositionFit here = register_position(photo, cam, floor, probe);
+  ASSERT_TRUE(here.valid);
+  EXPECT_LT(length(here.offset), 0.01) << here.offset.x << "," << here.offset.y << "," << here.offset.z;
+  for (Vec3 err : {Vec3{0.06, 0, -0.04}, Vec3{-0.1, 0.05, 0.08}}) {
+    LocalRadiance said = probe;
+    said.centre = probe.centre + err;
+    const PositionFit f = register_position(photo, cam, floor, said);
+    ASSERT_TRUE(f.valid);
+    const Vec3 back = said.centre + f.offset - probe.centre;
+    EXPECT_LT(length(back), 0.01) << back.x << "," << back.y << "," << back.z;
+    EXPECT_LT(f.spread, 0.5 * f.spread_given);
+  }
+  EXPECT_THROW(register_position(photo, cam, floor, probe, 0, 0), Error);
+  EXPECT_THROW(register_position(photo, cam, floor, probe, 0, 0.2, std::nan("")), Error);
+}
+
 }  // namespace ibl::augment

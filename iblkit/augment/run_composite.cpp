@@ -31,32 +31,59 @@ Register parse_register(const std::string& name) {
   if (name == "off") return Register::Off;
   if (name == "check") return Register::Check;
   if (name == "yaw") return Register::Yaw;
-  fail(ErrorKind::Value, "--register {}: expected off, check or yaw", name);
+  if (name == "pose") return Register::Pose;
+  fail(ErrorKind::Value, "--register {}: expected off, check, yaw or pose", name);
 }
 
 namespace {
 
+std::string offset_words(Vec3 o) { return fmt::format("({:+.3f}, {:+.3f}, {:+.3f}) m", o.x, o.y, o.z); }
+
 void register_light(CompositeScene& s, const Image& photo, const geometry::Camera& cam, const CompositeJob& job) {
   if (job.reg == Register::Off) return;
-  s.yaw = register_yaw(photo, cam, s.light.proxy, s.light.light, job.saturated);
-  if (!s.yaw.valid) {
-    s.notes.push_back(
-        fmt::format("register: the photograph and the light see only {} proxy points in common (< {}): "
-                    "the light is used as it was given",
-                    s.yaw.points, kMinMatchPoints));
+  LocalRadiance& L = s.light.light;
+  const bool pose = job.reg == Register::Pose, apply = job.reg == Register::Yaw || pose;
+  auto too_few = [&](int64_t points) {
+    s.notes.push_back(fmt::format("register: the photograph and the light see only {} proxy points in common (< {}): "
+                                  "the light is used as it was given",
+                                  points, kMinMatchPoints));
+  };
+  if (pose) {  // turn, position, turn again
+    const YawFit y1 = register_yaw(photo, cam, s.light.proxy, L, job.saturated);
+    if (!y1.valid) return too_few(y1.points);
+    L = turned(L, y1.yaw_deg);
+    s.position = register_position(photo, cam, s.light.proxy, L, job.saturated);
+    if (s.position.valid) L.centre = L.centre + s.position.offset, s.moved = true;
+    s.yaw = register_yaw(photo, cam, s.light.proxy, L, job.saturated);
+    if (s.yaw.valid) L = turned(L, s.yaw.yaw_deg);
+    s.yaw.yaw_deg = std::remainder(y1.yaw_deg + (s.yaw.valid ? s.yaw.yaw_deg : 0.0), 360.0);
+    s.yaw.spread_given = y1.spread_given;
+    s.turned = true;
+    s.notes.push_back(fmt::format(
+        "register: the light turned {:+.1f}° about +Y and moved by {} to agree best with the photograph "
+        "(disagreement {:.3f} stops, {:.3f} as given) from {} proxy points",
+        s.yaw.yaw_deg, offset_words(s.position.offset), s.yaw.spread, s.yaw.spread_given, s.yaw.points));
     return;
   }
+  s.yaw = register_yaw(photo, cam, s.light.proxy, L, job.saturated);
+  if (!s.yaw.valid) return too_few(s.yaw.points);
   const YawFit& f = s.yaw;
-  const bool apply = job.reg == Register::Yaw;
   s.notes.push_back(fmt::format(
-      "register: the light agrees best with the photograph turned {:+.1f}° about +Y (spread {:.3f} stops, {:.3f} as "
-      "given; the best more than 20° away {:+.0f}°, {:.3f}) from {} proxy points: {}",
+      "register: the light agrees best with the photograph turned {:+.1f}° about +Y (disagreement {:.3f} stops, "
+      "{:.3f} as given; the best more than 20° away {:+.0f}°, {:.3f}) from {} proxy points: {}",
       f.yaw_deg, f.spread, f.spread_given, f.runner_up_deg, f.runner_up_spread, f.points,
       apply ? "turned" : "not applied (--register yaw turns it)"));
   if (apply) {
-    s.light.light = turned(s.light.light, f.yaw_deg);
+    L = turned(L, f.yaw_deg);
     s.turned = true;
+    return;
   }
+  s.position = register_position(photo, cam, s.light.proxy, L, job.saturated);
+  if (s.position.valid)
+    s.notes.push_back(fmt::format(
+        "register: and moved by {} (disagreement {:.3f} stops, {:.3f} where given): not applied (--register pose moves "
+        "and turns it; a chrome ball's probe sees from the ball's face, a few cm towards its cameras: docs/augment.md)",
+        offset_words(s.position.offset), s.position.spread, s.position.spread_given));
 }
 
 }  // namespace
@@ -147,6 +174,8 @@ CompositeRun run_composite(const Image& photo, const geometry::Camera& cam, cons
   run.matched = scene.matched;
   run.yaw = scene.yaw;
   run.turned = scene.turned;
+  run.position = scene.position;
+  run.moved = scene.moved;
   run.notes.insert(run.notes.begin(), scene.notes.begin(), scene.notes.end());
   return run;
 }

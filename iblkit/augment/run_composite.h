@@ -38,9 +38,9 @@ inline render::ObjectDesc inserted_object_defaults() { return {"blob", 0.3, 2000
 // grey_card alone (a matte card both see: any light, an SH grid's too); Off leaves the light as captured.
 enum class Match { Auto, Off, GreyCard };
 
-// Registration of the light's turn about +Y (augment/register.h): off; check (measured and reported, not applied);
-// yaw (applied).
-enum class Register { Off, Check, Yaw };
+// Registration of the light (augment/register.h): off; check (its turn and position measured and reported, not
+// applied); yaw (the turn applied); pose (turn, position, turn again, applied).
+enum class Register { Off, Check, Yaw, Pose };
 Register parse_register(const std::string& name);
 
 struct CompositeJob {
@@ -64,6 +64,8 @@ struct CompositeScene {
   bool matched = false;            // the light was multiplied by match.gain
   YawFit yaw;                      // job.reg: the turn registered (yaw.valid false: not measured or no points)
   bool turned = false;             // the light was turned by yaw.yaw_deg
+  PositionFit position;            // job.reg check or pose: its position registered (offset: all moves summed)
+  bool moved = false;              // the light's centre was moved by position.offset
   std::vector<std::string> notes;  // the match, in words
 };
 // Makes the object and reads the light (checked against where the object goes); with the photograph and
@@ -84,6 +86,8 @@ struct CompositeRun {
   bool matched = false;            // the light was multiplied by match.gain
   YawFit yaw;                      // the turn registered (job.reg)
   bool turned = false;             // and applied
+  PositionFit position;            // the position registered
+  bool moved = false;              // and applied
 };
 // `photo` (linear RGB) seen by `cam` (its size the photograph's). Throws ibl::Error on bad input, and
 // (ErrorKind::Unsupported) for Backend::Gl when iblkit has no OpenGL or no context can be made.
