@@ -117,7 +117,8 @@ YawFit register_yaw(const Image& photo, const geometry::Camera& cam, const geome
 
 PositionFit register_position(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy,
                               const LocalRadiance& light, double saturated, double range_m, double yaw_deg) {
-  if (!(range_m > 0 && range_m <= 5)) fail(ErrorKind::Value, "register: position range {} m must lie in (0, 5]", range_m);
+  if (!(range_m > 0 && range_m <= 5))
+    fail(ErrorKind::Value, "register: position range {} m must lie in (0, 5]", range_m);
   if (!std::isfinite(yaw_deg)) fail(ErrorKind::Value, "register: turn {}° is not a number", yaw_deg);
   const std::vector<SeenPoint> pts = seen_points(photo, cam, proxy, light.centre, saturated, 40000, nullptr);
   const double floor = light_floor_of(light);
@@ -146,7 +147,8 @@ PositionFit register_position(const Image& photo, const geometry::Camera& cam, c
                 c = static_cast<int>(i / side / side) - k;
       const Vec3 o = around + Vec3{a * step, b * step, c * step};
       int64_t n = 0;
-      const double v = length(o) <= range_m * std::sqrt(3.0) + 1e-12 ? spread_at(use, light, floor, yaw_deg, &n, o) : 1e300;
+      const double v =
+          length(o) <= range_m * std::sqrt(3.0) + 1e-12 ? spread_at(use, light, floor, yaw_deg, &n, o) : 1e300;
       val[static_cast<size_t>(i)] = n >= need ? v : 1e300;
     });
     const size_t at = static_cast<size_t>(std::min_element(val.begin(), val.end()) - val.begin());

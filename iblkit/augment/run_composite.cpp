@@ -44,9 +44,10 @@ void register_light(CompositeScene& s, const Image& photo, const geometry::Camer
   LocalRadiance& L = s.light.light;
   const bool pose = job.reg == Register::Pose, apply = job.reg == Register::Yaw || pose;
   auto too_few = [&](int64_t points) {
-    s.notes.push_back(fmt::format("register: the photograph and the light see only {} proxy points in common (< {}): "
-                                  "the light is used as it was given",
-                                  points, kMinMatchPoints));
+    s.notes.push_back(
+        fmt::format("register: the photograph and the light see only {} proxy points in common (< {}): "
+                    "the light is used as it was given",
+                    points, kMinMatchPoints));
   };
   if (pose) {  // turn, position, turn again
     const YawFit y1 = register_yaw(photo, cam, s.light.proxy, L, job.saturated);
@@ -59,10 +60,10 @@ void register_light(CompositeScene& s, const Image& photo, const geometry::Camer
     s.yaw.yaw_deg = std::remainder(y1.yaw_deg + (s.yaw.valid ? s.yaw.yaw_deg : 0.0), 360.0);
     s.yaw.spread_given = y1.spread_given;
     s.turned = true;
-    s.notes.push_back(fmt::format(
-        "register: the light turned {:+.1f}° about +Y and moved by {} to agree best with the photograph "
-        "(disagreement {:.3f} stops, {:.3f} as given) from {} proxy points",
-        s.yaw.yaw_deg, offset_words(s.position.offset), s.yaw.spread, s.yaw.spread_given, s.yaw.points));
+    s.notes.push_back(
+        fmt::format("register: the light turned {:+.1f}° about +Y and moved by {} to agree best with the photograph "
+                    "(disagreement {:.3f} stops, {:.3f} as given) from {} proxy points",
+                    s.yaw.yaw_deg, offset_words(s.position.offset), s.yaw.spread, s.yaw.spread_given, s.yaw.points));
     return;
   }
   s.yaw = register_yaw(photo, cam, s.light.proxy, L, job.saturated);
