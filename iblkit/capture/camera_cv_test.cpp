@@ -223,7 +223,9 @@ TEST(CameraCv, ACharucoBoardPartlyHiddenGivesTheCornersItShows) {
   const size_t all = static_cast<size_t>(b.cols * b.rows);
   EXPECT_LT(pts->size(), all);  // the hidden ones are missing
   // A corner next to the disc is interpolated from a marker it half hides and can land pixels off (seen: 3 of 20,
-  // 3.6–6.3 px); every other one is within 0.3 px, and solve_board_camera leaves out exactly the misread ones.
+  // 3.6–6.3 px; find_board's check against the markers beside it leaves out those further off than a fifth of the
+  // spacing, here 8 px, so these stay): every other one is within 0.3 px, and solve_board_camera leaves out exactly
+  // the misread ones.
   int good = 0, bad = 0;
   for (const auto& c : *pts) {
     EXPECT_GT(length(c.world - hide), 0.12) << "a hidden corner was reported";
@@ -237,7 +239,7 @@ TEST(CameraCv, ACharucoBoardPartlyHiddenGivesTheCornersItShows) {
       EXPECT_LT(length(c.world - hide), 0.12 + 2.1 * b.square) << e << " px off, more than two squares from the disc";
     }
   }
-  EXPECT_GE(good, 14);
+  EXPECT_GE(good, 12);
   Solved s = solve_board_camera(b, *pts, truth, LensMode::Fixed);
   EXPECT_LT(length(s.camera.eye - truth.eye), 5e-3) << length(s.camera.eye - truth.eye);
   EXPECT_LT(s.error.rms_px, 0.2) << s.error.rms_px;
