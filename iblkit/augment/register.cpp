@@ -51,31 +51,47 @@ double spread_at(const std::vector<SeenPoint>& pts, const LocalRadiance& light, 
   return sum / static_cast<double>(keep);
 }
 
+// The points both see, traced once from the light's centre, the light's floor, an even subset of at most `few` of
+// them for a coarse search (with the count a subset's evaluation needs to stand for kMinMatchPoints), and the
+// disagreement with the light as given (turned by given_deg) over all of them.
+struct Seen {
+  std::vector<SeenPoint> all, some;
+  double floor = 0, given = 0;
+  int64_t min_some = 0, given_points = 0;
+};
+Seen seen_for(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy,
+              const LocalRadiance& light, double saturated, size_t few, double given_deg) {
+  Seen s;
+  s.all = seen_points(photo, cam, proxy, light.centre, saturated, 40000, nullptr);
+  s.floor = light_floor_of(light);
+  const size_t every = std::max<size_t>(1, s.all.size() / few);
+  for (size_t i = 0; i < s.all.size(); i += every) s.some.push_back(s.all[i]);
+  s.min_some = std::max<int64_t>(kMinMatchPoints / static_cast<int64_t>(every), 16);
+  s.given = spread_at(s.all, light, s.floor, given_deg, &s.given_points);
+  return s;
+}
+
 }  // namespace
 
 YawFit register_yaw(const Image& photo, const geometry::Camera& cam, const geometry::TriMesh& proxy,
                     const LocalRadiance& light, double saturated, double range_deg) {
   if (!(range_deg > 0 && range_deg <= 180))
     fail(ErrorKind::Value, "register: range {}° must lie in (0, 180]", range_deg);
-  const std::vector<SeenPoint> pts = seen_points(photo, cam, proxy, light.centre, saturated, 40000, nullptr);
-  const double floor = light_floor_of(light);
-  YawFit f;
-  int64_t n0 = 0;
-  f.spread_given = spread_at(pts, light, floor, 0, &n0);
-  f.points = n0;
-  if (n0 < kMinMatchPoints) return f;
   // The coarse search on at most 10,000 of the points, evenly taken; the refinement on all of them.
-  std::vector<SeenPoint> some;
-  const size_t every = std::max<size_t>(1, pts.size() / 10000);
-  for (size_t i = 0; i < pts.size(); i += every) some.push_back(pts[i]);
-  const int64_t min_some = std::max<int64_t>(kMinMatchPoints / static_cast<int64_t>(every), 16);
+  const Seen seen = seen_for(photo, cam, proxy, light, saturated, 10000, 0);
+  YawFit f;
+  f.spread_given = seen.given;
+  f.points = seen.given_points;
+  if (f.points < kMinMatchPoints) return f;
+  const std::vector<SeenPoint>&pts = seen.all, &some = seen.some;
+  const double floor = seen.floor;
   const int steps = static_cast<int>(std::floor(range_deg));
   std::vector<double> deg, val(static_cast<size_t>(2 * steps + 1));
   for (int k = -steps; k <= steps; ++k) deg.push_back(k);
   parallel_for(0, static_cast<int64_t>(deg.size()), [&](int64_t i) {
     int64_t n = 0;
     const double v = spread_at(some, light, floor, deg[i], &n);
-    val[i] = n >= min_some ? v : 1e300;
+    val[i] = n >= seen.min_some ? v : 1e300;
   });
   const size_t best = static_cast<size_t>(std::min_element(val.begin(), val.end()) - val.begin());
   // Golden section on [best − 1°, best + 1°].
@@ -120,17 +136,12 @@ PositionFit register_position(const Image& photo, const geometry::Camera& cam, c
   if (!(range_m > 0 && range_m <= 5))
     fail(ErrorKind::Value, "register: position range {} m must lie in (0, 5]", range_m);
   if (!std::isfinite(yaw_deg)) fail(ErrorKind::Value, "register: turn {}° is not a number", yaw_deg);
-  const std::vector<SeenPoint> pts = seen_points(photo, cam, proxy, light.centre, saturated, 40000, nullptr);
-  const double floor = light_floor_of(light);
+  const Seen seen = seen_for(photo, cam, proxy, light, saturated, 5000, yaw_deg);
   PositionFit f;
-  int64_t n0 = 0;
-  f.spread_given = spread_at(pts, light, floor, yaw_deg, &n0);
-  f.points = n0;
-  if (n0 < kMinMatchPoints) return f;
-  std::vector<SeenPoint> some;
-  const size_t every = std::max<size_t>(1, pts.size() / 5000);
-  for (size_t i = 0; i < pts.size(); i += every) some.push_back(pts[i]);
-  const int64_t min_some = std::max<int64_t>(kMinMatchPoints / static_cast<int64_t>(every), 16);
+  f.spread_given = seen.given;
+  f.points = seen.given_points;
+  if (f.points < kMinMatchPoints) return f;
+  const std::vector<SeenPoint>&pts = seen.all, &some = seen.some;
   // A grid of 11³ offsets over ±range on the few points, then twice a 5³ grid a quarter as fine around the best,
   // the last on all of them (steps range/5, /20, /80: 4 cm, 1 cm, 2.5 mm for the default 0.2 m).
   Vec3 best{0, 0, 0};
@@ -138,7 +149,7 @@ PositionFit register_position(const Image& photo, const geometry::Camera& cam, c
   for (int level = 0; level < 3; ++level) {
     const int k = level == 0 ? 5 : 2;
     const std::vector<SeenPoint>& use = level == 2 ? pts : some;
-    const int64_t need = level == 2 ? kMinMatchPoints : min_some;
+    const int64_t need = level == 2 ? kMinMatchPoints : seen.min_some;
     const int side = 2 * k + 1;
     std::vector<double> val(static_cast<size_t>(side) * side * side);
     const Vec3 around = best;
@@ -148,7 +159,7 @@ PositionFit register_position(const Image& photo, const geometry::Camera& cam, c
       const Vec3 o = around + Vec3{a * step, b * step, c * step};
       int64_t n = 0;
       const double v =
-          length(o) <= range_m * std::sqrt(3.0) + 1e-12 ? spread_at(use, light, floor, yaw_deg, &n, o) : 1e300;
+          length(o) <= range_m * std::sqrt(3.0) + 1e-12 ? spread_at(use, light, seen.floor, yaw_deg, &n, o) : 1e300;
       val[static_cast<size_t>(i)] = n >= need ? v : 1e300;
     });
     const size_t at = static_cast<size_t>(std::min_element(val.begin(), val.end()) - val.begin());
@@ -158,10 +169,11 @@ PositionFit register_position(const Image& photo, const geometry::Camera& cam, c
     step /= 4;
   }
   int64_t n = 0;
-  f.spread = spread_at(pts, light, floor, yaw_deg, &n, best);
+  f.spread = spread_at(pts, light, seen.floor, yaw_deg, &n, best);
   f.offset = best;
   f.points = n;
-  if (!(f.spread < f.spread_given)) f.offset = {0, 0, 0}, f.spread = f.spread_given, f.points = n0;  // as given
+  if (!(f.spread < f.spread_given))
+    f.offset = {0, 0, 0}, f.spread = f.spread_given, f.points = seen.given_points;  // as given
   f.valid = best_v < 1e300 && f.spread < 1e300;
   return f;
 }

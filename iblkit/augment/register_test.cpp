@@ -60,13 +60,19 @@ geometry::Camera above() {
   return c;
 }
 
+// The scene both tests register in: the camera above, its photograph of the floor, the floor, the probe 0.4 m up.
+struct FloorScene {
+  geometry::Camera cam = above();
+  Image photo = floor_photo(cam);
+  geometry::TriMesh floor = geometry::make_quad({0, 0, 0}, {0, 1, 0}, {0, 0, -1}, 8, 8);
+  LocalRadiance probe = floor_probe({0, 0.4, 0});
+};
+
 }  // namespace
 
 TEST(AugmentRegister, APosedProbeTurnedIsTurnedBack) {
-  const geometry::Camera cam = above();
-  const Image photo = floor_photo(cam);
-  const geometry::TriMesh floor = geometry::make_quad({0, 0, 0}, {0, 1, 0}, {0, 0, -1}, 8, 8);
-  const LocalRadiance probe = floor_probe({0, 0.4, 0});
+  const FloorScene sc;
+  const auto& [cam, photo, floor, probe] = sc;
   // As given: no turn, and nothing to gain.
   const YawFit f0 = register_yaw(photo, cam, floor, probe);
   ASSERT_TRUE(f0.valid);
@@ -104,10 +110,8 @@ TEST(AugmentRegister, APosedProbeTurnedIsTurnedBack) {
 }
 
 TEST(AugmentRegister, AProbeSaidToStandElsewhereIsMovedBack) {
-  const geometry::Camera cam = above();
-  const Image photo = floor_photo(cam);
-  const geometry::TriMesh floor = geometry::make_quad({0, 0, 0}, {0, 1, 0}, {0, 0, -1}, 8, 8);
-  const LocalRadiance probe = floor_probe({0, 0.4, 0});
+  const FloorScene sc;
+  const auto& [cam, photo, floor, probe] = sc;
   const PositionFit here = register_position(photo, cam, floor, probe);
   ASSERT_TRUE(here.valid);
   EXPECT_LT(length(here.offset), 0.01) << here.offset.x << "," << here.offset.y << "," << here.offset.z;
